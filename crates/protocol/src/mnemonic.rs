@@ -1,0 +1,249 @@
+//! Mnemonic text of single instructions: the operand layout of every
+//! mnemonic, its symbolic operands, and a one-line parser and formatter.
+//!
+//! The parser accepts what a person types for one direct-mode command
+//! (`MVP ABS, 0, 90000`, `SAP 4 0 1000`, `GAP 1,0`, `$47` and `0x47`
+//! numbers) and the lenient spellings the manuals print (`MVP ABS 2, 10000`,
+//! `JC NZ Label` needs a number here, labels are the assembler's). A raw
+//! instruction is written as `#136 1 0 0` (opcode, type, motor, value).
+
+use crate::frame::Instruction;
+use crate::opcode as op;
+
+/// Which field of the instruction an operand fills.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Operand {
+    /// The type byte as a number (parameter, port, coordinate, interrupt…).
+    Type,
+    /// The type byte given by a symbol from this table (or a number).
+    TypeSymbol(&'static [&'static str]),
+    /// The motor/bank byte.
+    Motor,
+    /// The 32-bit value.
+    Value,
+    /// The 32-bit value holding a program address (a label in source).
+    Address,
+}
+
+pub const MOVE_MODES: &[&str] = &["ABS", "REL", "COORD"];
+pub const RFS_ACTIONS: &[&str] = &["START", "STOP", "STATUS"];
+pub const CALC_OPS: &[&str] = &["ADD", "SUB", "MUL", "DIV", "MOD", "AND", "OR", "XOR", "NOT", "LOAD", "SWAP", "COMP"];
+pub const CONDITIONS: &[&str] = &["ZE", "NZ", "EQ", "NE", "GT", "GE", "LT", "LE", "ETO", "EAL", "EDV", "EPO"];
+pub const WAIT_CONDITIONS: &[&str] = &["TICKS", "POS", "REFSW", "LIMSW", "RFS"];
+pub const ERROR_FLAGS: &[&str] = &["ALL", "ETO", "EAL", "EDV", "EPO", "ESD"];
+
+/// Operands of a mnemonic in source order; `None` for instruction numbers
+/// without mnemonic (control commands).
+pub fn layout(opcode: u8) -> Option<&'static [Operand]> {
+    use Operand::*;
+    const MODE: Operand = TypeSymbol(MOVE_MODES);
+    const CALC: Operand = TypeSymbol(CALC_OPS);
+    const COND: Operand = TypeSymbol(CONDITIONS);
+    Some(match opcode {
+        op::ROR | op::ROL => &[Motor, Value],
+        op::MST | op::ROLA | op::RORA => &[Motor],
+        op::MVP => &[MODE, Motor, Value],
+        op::MVPA => &[MODE, Motor],
+        op::SAP | op::SGP | op::SIO | op::SCO | op::SAC => &[Type, Motor, Value],
+        op::GAP | op::STAP | op::RSAP | op::GGP | op::STGP | op::RSGP | op::GIO | op::GCO | op::CCO | op::ACO
+        | op::AAP | op::AGP => &[Type, Motor],
+        op::RFS => &[TypeSymbol(RFS_ACTIONS), Motor],
+        op::CALC => &[CALC, Value],
+        op::COMP | op::SIV => &[Value],
+        op::JC | op::CALL => &[COND, Address],
+        op::JA | op::CSUB | op::RST => &[Address],
+        op::RSUB | op::STOP | op::RETI | op::GIV | op::AIV => &[],
+        op::EI | op::DI => &[Type],
+        op::WAIT => &[TypeSymbol(WAIT_CONDITIONS), Motor, Value],
+        op::CALCX => &[CALC],
+        op::CLE => &[TypeSymbol(ERROR_FLAGS)],
+        op::VECT => &[Type, Address],
+        op::CALCVV | op::CALCV => &[CALC, Motor, Value],
+        op::CALCVA | op::CALCAV | op::CALCVX | op::CALCXV => &[CALC, Motor],
+        op::DJNZ => &[Type, Address],
+        op::UF0..=op::UF7 => &[Type, Motor, Value],
+        _ => return None,
+    })
+}
+
+/// A parse error with the byte column (1-based) where it was found.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParseError {
+    pub column: usize,
+    pub message: String,
+}
+
+impl std::fmt::Display for ParseError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "column {}: {}", self.column, self.message)
+    }
+}
+
+impl std::error::Error for ParseError {}
+
+/// Parses a number as TMCL sources write it: decimal, negative, `$47`,
+/// `0x47`, `0b101`.
+pub fn parse_number(text: &str) -> Option<i64> {
+    let (neg, t) = match text.strip_prefix('-') {
+        Some(rest) => (true, rest),
+        None => (false, text.strip_prefix('+').unwrap_or(text)),
+    };
+    let v = if let Some(h) = t.strip_prefix('$').or_else(|| t.strip_prefix("0x")).or_else(|| t.strip_prefix("0X")) {
+        i64::from_str_radix(h, 16).ok()?
+    } else if let Some(b) = t.strip_prefix("0b").or_else(|| t.strip_prefix("0B")) {
+        i64::from_str_radix(b, 2).ok()?
+    } else if !t.is_empty() && t.bytes().all(|c| c.is_ascii_digit()) {
+        t.parse().ok()?
+    } else {
+        return None;
+    };
+    Some(if neg { -v } else { v })
+}
+
+/// Splits operand text at commas and blanks, keeping the column of each
+/// token.
+pub fn tokens(text: &str) -> Vec<(usize, &str)> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, c) in text.char_indices() {
+        let sep = c == ',' || c.is_whitespace();
+        match (sep, start) {
+            (true, Some(s)) => {
+                out.push((s, &text[s..i]));
+                start = None;
+            }
+            (false, None) => start = Some(i),
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        out.push((s, &text[s..]));
+    }
+    out
+}
+
+fn symbol_index(table: &[&str], name: &str) -> Option<u8> {
+    table.iter().position(|s| s.eq_ignore_ascii_case(name)).map(|p| p as u8)
+}
+
+/// Parses one instruction with numeric operands (no labels, no constants).
+pub fn parse_line(line: &str) -> Result<Instruction, ParseError> {
+    let toks = tokens(line);
+    let err = |column: usize, message: String| ParseError { column: column + 1, message };
+    let Some(&(c0, head)) = toks.first() else {
+        return Err(err(0, "empty command".into()));
+    };
+    if let Some(raw) = head.strip_prefix('#') {
+        // Raw form: #opcode type motor value
+        let mut fields = vec![(c0 + 1, raw)];
+        fields.extend(toks[1..].iter().copied());
+        if fields.len() != 4 {
+            return Err(err(c0, "a raw instruction is #opcode type motor value".into()));
+        }
+        let mut n = [0i64; 4];
+        for (k, (c, t)) in fields.iter().enumerate() {
+            n[k] = parse_number(t).ok_or_else(|| err(*c, format!("'{t}' is not a number")))?;
+        }
+        let byte = |k: usize| -> Result<u8, ParseError> {
+            u8::try_from(n[k]).map_err(|_| err(fields[k].0, format!("{} does not fit in a byte", n[k])))
+        };
+        return Ok(Instruction::new(byte(0)?, byte(1)?, byte(2)?, to_i32(n[3]).ok_or_else(|| err(fields[3].0, "value out of 32-bit range".into()))?));
+    }
+    let opcode = op::from_mnemonic(head).ok_or_else(|| err(c0, format!("unknown command '{head}'")))?;
+    let layout = layout(opcode).expect("every mnemonic has a layout");
+    let operands = &toks[1..];
+    if operands.len() != layout.len() {
+        let end = line.trim_end().len();
+        let at = operands.get(layout.len()).map_or(end, |t| t.0);
+        return Err(err(at, format!("{head} takes {} operand(s), found {}", layout.len(), operands.len())));
+    }
+    let mut ins = Instruction::new(opcode, 0, 0, 0);
+    for (&(col, text), &kind) in operands.iter().zip(layout) {
+        let number = || parse_number(text).ok_or_else(|| err(col, format!("'{text}' is not a number")));
+        let byte = |v: i64| u8::try_from(v).map_err(|_| err(col, format!("{v} is out of range 0…255")));
+        match kind {
+            Operand::Type => ins.kind = byte(number()?)?,
+            Operand::TypeSymbol(table) => {
+                ins.kind = match symbol_index(table, text) {
+                    Some(k) => k,
+                    None => byte(number().map_err(|_| err(col, format!("'{text}' is not one of {}", table.join(" "))))?)?,
+                }
+            }
+            Operand::Motor => ins.motor = byte(number()?)?,
+            Operand::Value | Operand::Address => {
+                ins.value = to_i32(number()?).ok_or_else(|| err(col, format!("'{text}' is out of 32-bit range")))?
+            }
+        }
+    }
+    Ok(ins)
+}
+
+/// Values from −2^31 to 2^32−1 are accepted; the upper half wraps to the
+/// negative numbers the wire carries.
+fn to_i32(v: i64) -> Option<i32> {
+    if (i32::MIN as i64..=u32::MAX as i64).contains(&v) { Some(v as u32 as i32) } else { None }
+}
+
+/// Formats an instruction as source text. `label` names jump targets;
+/// pass `|a| a.to_string()` for plain addresses.
+pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
+    let Some(name) = op::mnemonic(ins.opcode) else {
+        return format!("#{} {} {} {}", ins.opcode, ins.kind, ins.motor, ins.value);
+    };
+    let layout = layout(ins.opcode).unwrap_or(&[]);
+    let parts: Vec<String> = layout
+        .iter()
+        .map(|k| match k {
+            Operand::Type => ins.kind.to_string(),
+            Operand::TypeSymbol(table) => table.get(ins.kind as usize).map_or(ins.kind.to_string(), |s| s.to_string()),
+            Operand::Motor => ins.motor.to_string(),
+            Operand::Value => ins.value.to_string(),
+            Operand::Address => label(ins.value),
+        })
+        .collect();
+    if parts.is_empty() { name.to_string() } else { format!("{name} {}", parts.join(", ")) }
+}
+
+pub fn format(ins: Instruction) -> String {
+    format_with(ins, |a| a.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bytes(line: &str) -> [u8; 9] {
+        crate::Request::new(1, parse_line(line).unwrap()).encode()
+    }
+
+    #[test]
+    fn manual_frames_from_mnemonics() {
+        assert_eq!(bytes("MVP ABS, 0, 90000"), [0x01, 0x04, 0x00, 0x00, 0x00, 0x01, 0x5F, 0x90, 0xF5]);
+        assert_eq!(bytes("MVP ABS 0, 90000"), bytes("MVP ABS, 0, 90000"));
+        assert_eq!(bytes("CALC MUL, -5000"), [0x01, 0x13, 0x02, 0x00, 0xFF, 0xFF, 0xEC, 0x78, 0x78]);
+        assert_eq!(bytes("CALCVV SUB, 65, 42"), [0x01, 0x28, 0x01, 0x41, 0x00, 0x00, 0x00, 0x2A, 0x95]);
+        assert_eq!(bytes("EI 255"), [0x01, 0x19, 0xFF, 0x00, 0x00, 0x00, 0x00, 0x00, 0x19]);
+        assert_eq!(bytes("SGP $42, 0, 0x3"), [0x01, 0x09, 0x42, 0x00, 0x00, 0x00, 0x00, 0x03, 0x4F]);
+        assert_eq!(bytes("#138 1 0 1"), [0x01, 0x8A, 0x01, 0x00, 0x00, 0x00, 0x00, 0x01, 0x8D]);
+    }
+
+    #[test]
+    fn errors_name_the_column() {
+        let e = parse_line("SAP 4, 0, x12").unwrap_err();
+        assert_eq!(e.column, 11);
+        let e = parse_line("FOO 1").unwrap_err();
+        assert_eq!(e.column, 1);
+        let e = parse_line("MVP UP, 0, 1").unwrap_err();
+        assert_eq!(e.column, 5);
+        assert!(e.message.contains("ABS REL COORD"));
+        assert!(parse_line("GAP 1").is_err());
+        assert!(parse_line("SAP 256, 0, 1").is_err());
+    }
+
+    #[test]
+    fn format_round_trips() {
+        for line in ["MVP ABS, 0, 90000", "WAIT POS, 0, 0", "CALCX MUL", "RSUB", "CLE ETO", "#136 0 0 0"] {
+            assert_eq!(format(parse_line(line).unwrap()), line);
+        }
+    }
+}

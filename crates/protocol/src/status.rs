@@ -1,0 +1,71 @@
+//! TMCL reply status codes (TMCM-1141 manual, table 4).
+
+/// The status byte of a TMCL reply.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Status {
+    /// 1: the frame's checksum is wrong.
+    WrongChecksum = 1,
+    /// 2: the opcode is unknown or not available on this module.
+    InvalidCommand = 2,
+    /// 3: the type (or parameter number) is out of range or not accessible.
+    WrongType = 3,
+    /// 4: the value (or motor/bank number) is out of range.
+    InvalidValue = 4,
+    /// 5: the configuration EEPROM is locked.
+    EepromLocked = 5,
+    /// 6: the command is not available (in this mode).
+    NotAvailable = 6,
+    /// 100: successfully executed.
+    Ok = 100,
+    /// 101: command loaded into the TMCL program memory.
+    Loaded = 101,
+    /// 128: unsolicited "target position reached" event (command 138).
+    Event = 128,
+}
+
+impl Status {
+    pub const fn code(self) -> u8 {
+        self as u8
+    }
+
+    pub fn from_code(code: u8) -> Option<Status> {
+        Some(match code {
+            1 => Status::WrongChecksum,
+            2 => Status::InvalidCommand,
+            3 => Status::WrongType,
+            4 => Status::InvalidValue,
+            5 => Status::EepromLocked,
+            6 => Status::NotAvailable,
+            100 => Status::Ok,
+            101 => Status::Loaded,
+            128 => Status::Event,
+            _ => return None,
+        })
+    }
+
+    /// True for the codes below 100, which report an error.
+    pub const fn is_error(self) -> bool {
+        (self as u8) < 100
+    }
+
+    pub const fn describe(self) -> &'static str {
+        match self {
+            Status::WrongChecksum => "wrong checksum",
+            Status::InvalidCommand => "invalid command",
+            Status::WrongType => "wrong type",
+            Status::InvalidValue => "invalid value",
+            Status::EepromLocked => "configuration EEPROM locked",
+            Status::NotAvailable => "command not available",
+            Status::Ok => "ok",
+            Status::Loaded => "command loaded into program memory",
+            Status::Event => "target position reached",
+        }
+    }
+}
+
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} ({})", self.code(), self.describe())
+    }
+}
