@@ -1,14 +1,17 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! The TMCL firmware as software: module profiles, the command executor,
+//! EEPROM, the TMC429 motion model and the simulated world.
+//!
+//! Pure and deterministic: a [`Module`] changes only through
+//! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+pub mod eeprom;
+pub mod executor;
+pub mod module;
+pub mod motion;
+pub mod profile;
+pub mod world;
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+pub use eeprom::Eeprom;
+pub use module::{Module, Outcome, Special};
+pub use profile::Profile;
+pub use world::World;

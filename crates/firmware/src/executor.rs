@@ -1,0 +1,719 @@
+//! The command executor: what each TMCL command does to a module.
+//!
+//! `execute` is direct mode (a host sent the command); `run_command` is
+//! shared with the program interpreter, which passes `Origin::Program` so
+//! that reads load the accumulator and branch commands are allowed.
+
+use crate::module::{ap, error_flag, gp, Compare, Module, Origin, Outcome, Special};
+use crate::motion::RampMode;
+use crate::profile::{Parameter, PortDirection};
+use tmclsim_protocol::{opcode, CalcOp, Command, ErrorFlag, Instruction, MoveMode, Status};
+
+type Exec = Result<i32, Status>;
+
+/// Key that 137 and 255 require.
+pub const MAGIC_KEY: i32 = 1234;
+
+impl Module {
+    /// Executes one instruction in direct mode.
+    pub fn execute(&mut self, ins: Instruction) -> Outcome {
+        if !self.profile.has_opcode(ins.opcode) {
+            return Outcome::error(Status::InvalidCommand, ins.value);
+        }
+        let cmd = match Command::decode(ins) {
+            Ok(c) => c,
+            Err(e) => return Outcome::error(e.status(), ins.value),
+        };
+        if cmd.is_program_only() {
+            return Outcome::error(Status::NotAvailable, ins.value);
+        }
+        match cmd {
+            Command::FirmwareVersion { binary: false } => {
+                return Outcome { status: Status::Ok, value: 0, special: Special::Frame(self.special_version()) };
+            }
+            Command::FactoryDefaults { key } => {
+                if key != MAGIC_KEY {
+                    return Outcome::error(Status::InvalidValue, key);
+                }
+                self.eeprom.clear();
+                self.eeprom_generation += 1;
+                self.reset();
+                return Outcome { status: Status::Ok, value: key, special: Special::Silent };
+            }
+            _ => {}
+        }
+        match self.run_command(cmd, ins, Origin::Direct) {
+            Ok(value) => Outcome::ok(value),
+            Err(status) => Outcome::error(status, ins.value),
+        }
+    }
+
+    /// Executes a decoded command. The value is what a direct-mode reply
+    /// carries.
+    pub(crate) fn run_command(&mut self, cmd: Command, ins: Instruction, origin: Origin) -> Exec {
+        use Command::*;
+        let echo = ins.value;
+        let program = origin == Origin::Program;
+        match cmd {
+            Ror { motor, velocity } => self.rotate(motor, velocity, 1).map(|_| echo),
+            Rol { motor, velocity } => self.rotate(motor, velocity, -1).map(|_| echo),
+            Mst { motor } => {
+                let m = self.motor(motor)?;
+                self.motor_stop(m);
+                Ok(echo)
+            }
+            Mvp { mode, motor, value } => self.move_to(mode, motor, value).map(|_| echo),
+            Mvpa { mode, motor } => {
+                let a = self.registers.accumulator;
+                self.move_to(mode, motor, a).map(|_| echo)
+            }
+            Rola { motor } => self.rotate(motor, self.registers.accumulator, -1).map(|_| echo),
+            Rora { motor } => self.rotate(motor, self.registers.accumulator, 1).map(|_| echo),
+            Sap { param, motor, value } => self.set_axis_parameter(param, motor, value).map(|_| echo),
+            Aap { param, motor } => self.set_axis_parameter(param, motor, self.registers.accumulator).map(|_| echo),
+            Gap { param, motor } => {
+                let v = self.get_axis_parameter(param, motor)?;
+                Ok(self.loaded(v, program))
+            }
+            Stap { param, motor } => {
+                let m = self.motor(motor)?;
+                self.axis_spec(param, |a| a.eeprom)?;
+                let v = self.axes[m].params[param as usize];
+                self.eeprom.set_axis(motor, param, v);
+                self.eeprom_generation += 1;
+                Ok(echo)
+            }
+            Rsap { param, motor } => {
+                let m = self.motor(motor)?;
+                let spec = self.axis_spec(param, |a| a.eeprom)?;
+                let v = self.eeprom.axis(motor, param).unwrap_or(spec.default_word());
+                self.write_axis_parameter(m, param, v);
+                Ok(echo)
+            }
+            Sgp { param, bank, value } => self.set_global_parameter(param, bank, value).map(|_| echo),
+            Agp { param, bank } => self.set_global_parameter(param, bank, self.registers.accumulator).map(|_| echo),
+            Ggp { param, bank } => {
+                let v = self.get_global_parameter(param, bank)?;
+                Ok(self.loaded(v, program))
+            }
+            Stgp { param, bank } => {
+                self.global_spec(param, bank, |a| a.eeprom)?;
+                let v = self.globals[bank as usize][param as usize];
+                self.eeprom.set_global(bank, param, v);
+                self.eeprom_generation += 1;
+                Ok(echo)
+            }
+            Rsgp { param, bank } => {
+                let spec = self.global_spec(param, bank, |a| a.eeprom)?;
+                let v = self.eeprom.global(bank, param).unwrap_or(spec.default_word());
+                self.globals[bank as usize][param as usize] = v;
+                Ok(echo)
+            }
+            Sio { port, bank, value } => self.set_output(port, bank, value).map(|_| echo),
+            Gio { port, bank } => {
+                let v = self.get_input(port, bank)?;
+                Ok(self.loaded(v, program))
+            }
+            Sco { coordinate, motor, value } => self.set_coordinate(coordinate, motor, Some(value)).map(|_| echo),
+            Aco { coordinate, motor } => {
+                let a = self.registers.accumulator;
+                self.set_coordinate(coordinate, motor, Some(a)).map(|_| echo)
+            }
+            Cco { coordinate, motor } => {
+                let m = self.motor(motor)?;
+                let pos = self.actual_position(m);
+                self.set_coordinate(coordinate, motor, Some(pos))?;
+                Ok(pos)
+            }
+            Gco { coordinate, motor } => {
+                if motor == 255 {
+                    self.coordinates_from_eeprom(coordinate)?;
+                    return Ok(echo);
+                }
+                let m = self.motor(motor)?;
+                let v = *self.axes[m].coordinates.get(coordinate as usize).ok_or(Status::WrongType)?;
+                Ok(self.loaded(v, program))
+            }
+            Calc { op, value } => {
+                let a = self.registers.accumulator;
+                let r = self.calculate(op, a, value)?;
+                self.load_accumulator(r);
+                Ok(echo)
+            }
+            Comp { value } => {
+                self.registers.compare = Compare::of(self.registers.accumulator, value);
+                Ok(echo)
+            }
+            CalcX { op } => {
+                let (a, x) = (self.registers.accumulator, self.registers.x);
+                match op {
+                    CalcOp::Load => self.registers.x = a,
+                    CalcOp::Swap => {
+                        self.registers.x = a;
+                        self.load_accumulator(x);
+                    }
+                    CalcOp::Not => self.registers.x = !x,
+                    _ => {
+                        let r = self.calculate(op, a, x)?;
+                        self.load_accumulator(r);
+                    }
+                }
+                Ok(echo)
+            }
+            CalcVV { op, var1, var2 } => {
+                let i2 = self.user_variable_index(var2)?;
+                let (a, b) = (self.user_variable(var1 as usize), self.user_variable(i2));
+                let r = self.calc_into(op, a, b, |m, v| m.set_user_variable(var1 as usize, v), |m, v| m.set_user_variable(i2, v))?;
+                let _ = r;
+                Ok(echo)
+            }
+            CalcVA { op, var } => {
+                let (v, a) = (self.user_variable(var as usize), self.registers.accumulator);
+                self.calc_into(op, v, a, |m, r| m.set_user_variable(var as usize, r), |m, r| m.load_accumulator(r))?;
+                Ok(echo)
+            }
+            CalcAV { op, var } => {
+                let (a, v) = (self.registers.accumulator, self.user_variable(var as usize));
+                self.calc_into(op, a, v, |m, r| m.load_accumulator(r), |m, r| m.set_user_variable(var as usize, r))?;
+                Ok(echo)
+            }
+            CalcVX { op, var } => {
+                let (v, x) = (self.user_variable(var as usize), self.registers.x);
+                self.calc_into(op, v, x, |m, r| m.set_user_variable(var as usize, r), |m, r| m.registers.x = r)?;
+                Ok(echo)
+            }
+            CalcXV { op, var } => {
+                let (x, v) = (self.registers.x, self.user_variable(var as usize));
+                self.calc_into(op, x, v, |m, r| m.registers.x = r, |m, r| m.set_user_variable(var as usize, r))?;
+                Ok(echo)
+            }
+            CalcV { op, var, value } => {
+                let v = self.user_variable(var as usize);
+                self.calc_into(op, v, value, |m, r| m.set_user_variable(var as usize, r), |_, _| {})?;
+                Ok(echo)
+            }
+            Siv { value } => {
+                if let Ok(i) = self.user_variable_index(self.registers.x) {
+                    self.set_user_variable(i, value);
+                }
+                Ok(echo)
+            }
+            Aiv => {
+                if let Ok(i) = self.user_variable_index(self.registers.x) {
+                    self.set_user_variable(i, self.registers.accumulator);
+                }
+                Ok(echo)
+            }
+            Giv => match self.user_variable_index(self.registers.x) {
+                Ok(i) => {
+                    let v = self.user_variable(i);
+                    Ok(self.loaded(v, program))
+                }
+                Err(_) => Ok(echo),
+            },
+            Cle { flag } => {
+                self.registers.errors &= !match flag {
+                    ErrorFlag::All => 0xFF,
+                    ErrorFlag::Timeout => error_flag::TIMEOUT,
+                    ErrorFlag::Alarm => error_flag::ALARM,
+                    ErrorFlag::Deviation => error_flag::DEVIATION,
+                    ErrorFlag::Position => error_flag::POSITION,
+                    ErrorFlag::Shutdown => error_flag::SHUTDOWN,
+                };
+                Ok(echo)
+            }
+            Ei { interrupt } | Di { interrupt } => {
+                let enable = matches!(cmd, Ei { .. });
+                if interrupt == 255 {
+                    self.interrupts_global = enable;
+                } else {
+                    self.profile.interrupt(interrupt).ok_or(Status::WrongType)?;
+                    self.interrupts_enabled[interrupt as usize] = enable;
+                }
+                Ok(echo)
+            }
+            Vect { interrupt, address } => {
+                if interrupt == 255 || self.profile.interrupt(interrupt).is_none() {
+                    return Err(Status::WrongType);
+                }
+                if address < 0 || address >= self.profile.module.program_memory as i32 {
+                    return Err(Status::InvalidValue);
+                }
+                self.interrupt_vectors[interrupt as usize] = Some(address as u16);
+                Ok(echo)
+            }
+            FirmwareVersion { binary: true } => Ok(self.profile.version_word()),
+            TargetReachedEvent { every_move, mask } => {
+                let valid = (1u32 << self.axes.len()) - 1;
+                if mask <= 0 || mask as u32 & !valid != 0 {
+                    return Err(Status::InvalidValue);
+                }
+                self.event_arm = Some((every_move, mask as u32));
+                Ok(mask)
+            }
+            Reset { key } => {
+                if key != MAGIC_KEY {
+                    return Err(Status::InvalidValue);
+                }
+                // handle_frame resets after the reply has been built.
+                Ok(echo)
+            }
+            UserFunction { .. } => Err(Status::NotAvailable),
+            // Reference search and the control commands of standalone
+            // programs and ASCII mode are not part of this firmware yet.
+            Rfs { .. } | StopApplication | RunApplication { .. } | StepApplication | ResetApplication | EnterDownload { .. }
+            | ExitDownload | ReadMemory { .. } | ApplicationStatus { .. } | AsciiMode => Err(Status::NotAvailable),
+            Sac { .. } => Err(Status::InvalidCommand),
+            FirmwareVersion { binary: false } | FactoryDefaults { .. } => unreachable!("handled in execute"),
+            Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti => {
+                Err(Status::NotAvailable)
+            }
+        }
+    }
+
+    // ----- registers --------------------------------------------------
+
+    /// A read in a program loads the accumulator and sets the flags; a
+    /// direct-mode read leaves them alone (decisions.md rules 7, 18).
+    fn loaded(&mut self, v: i32, program: bool) -> i32 {
+        if program {
+            self.load_accumulator(v);
+        }
+        v
+    }
+
+    pub(crate) fn load_accumulator(&mut self, v: i32) {
+        self.registers.accumulator = v;
+        self.registers.compare = Compare::of(v, 0);
+    }
+
+    /// 32-bit two's complement arithmetic (decisions.md rule 19).
+    fn calculate(&self, op: CalcOp, a: i32, b: i32) -> Exec {
+        Ok(match op {
+            CalcOp::Add => a.wrapping_add(b),
+            CalcOp::Sub => a.wrapping_sub(b),
+            CalcOp::Mul => a.wrapping_mul(b),
+            CalcOp::Div => {
+                if b == 0 {
+                    return Err(Status::InvalidValue);
+                }
+                a.wrapping_div(b)
+            }
+            CalcOp::Mod => {
+                if b == 0 {
+                    return Err(Status::InvalidValue);
+                }
+                a.wrapping_rem(b)
+            }
+            CalcOp::And => a & b,
+            CalcOp::Or => a | b,
+            CalcOp::Xor => a ^ b,
+            CalcOp::Not => !a,
+            CalcOp::Load => b,
+            CalcOp::Swap | CalcOp::Comp => unreachable!("handled by the caller"),
+        })
+    }
+
+    /// The CALCVV family: `target op= source`, with NOT and LOAD copying
+    /// from the source, SWAP exchanging, COMP comparing.
+    fn calc_into(
+        &mut self,
+        op: CalcOp,
+        target: i32,
+        source: i32,
+        set_target: impl FnOnce(&mut Module, i32),
+        set_source: impl FnOnce(&mut Module, i32),
+    ) -> Exec {
+        match op {
+            CalcOp::Comp => {
+                self.registers.compare = Compare::of(target, source);
+                Ok(target)
+            }
+            CalcOp::Swap => {
+                set_target(self, source);
+                set_source(self, target);
+                Ok(source)
+            }
+            CalcOp::Not => {
+                set_target(self, !source);
+                Ok(!source)
+            }
+            _ => {
+                let r = self.calculate(op, target, source)?;
+                set_target(self, r);
+                Ok(r)
+            }
+        }
+    }
+
+    fn user_variable_index(&self, i: i32) -> Result<usize, Status> {
+        if (0..self.profile.module.user_variables as i32).contains(&i) { Ok(i as usize) } else { Err(Status::InvalidValue) }
+    }
+
+    pub(crate) fn user_variable(&self, i: usize) -> i32 {
+        self.globals[2][i]
+    }
+
+    pub(crate) fn set_user_variable(&mut self, i: usize, v: i32) {
+        self.globals[2][i] = v;
+    }
+
+    // ----- motion commands --------------------------------------------
+
+    pub(crate) fn motor(&self, motor: u8) -> Result<usize, Status> {
+        if (motor as usize) < self.axes.len() { Ok(motor as usize) } else { Err(Status::InvalidValue) }
+    }
+
+    fn rotate(&mut self, motor: u8, velocity: i32, sign: i32) -> Result<(), Status> {
+        let m = self.motor(motor)?;
+        if !(-2047..=2047).contains(&velocity) {
+            return Err(Status::InvalidValue);
+        }
+        self.clear_motion_errors(m);
+        let axis = &mut self.axes[m];
+        axis.params[ap::TARGET_SPEED as usize] = velocity * sign;
+        axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
+        axis.motion.mode = RampMode::Velocity;
+        axis.notify_on_arrival = false;
+        Ok(())
+    }
+
+    /// MST: velocity mode with target speed 0.
+    pub(crate) fn motor_stop(&mut self, m: usize) {
+        let axis = &mut self.axes[m];
+        axis.params[ap::TARGET_SPEED as usize] = 0;
+        axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
+        axis.motion.mode = RampMode::Velocity;
+        axis.notify_on_arrival = false;
+    }
+
+    fn move_to(&mut self, mode: MoveMode, motor: u8, value: i32) -> Result<(), Status> {
+        let m = self.motor(motor)?;
+        let target = match mode {
+            MoveMode::Absolute => value,
+            MoveMode::Relative => self.wrap_position(self.actual_position(m) as i64 + value as i64),
+            MoveMode::Coordinate => {
+                let n = usize::try_from(value).map_err(|_| Status::InvalidValue)?;
+                *self.axes[m].coordinates.get(n).ok_or(Status::InvalidValue)?
+            }
+        };
+        self.clear_motion_errors(m);
+        let axis = &mut self.axes[m];
+        // MVP selects position mode; soft mode, once chosen, stays.
+        if axis.motion.mode != RampMode::Soft {
+            axis.motion.mode = RampMode::Position;
+            axis.params[ap::RAMP_MODE as usize] = RampMode::Position as i32;
+        }
+        self.set_target(m, target);
+        if let Some((every, mask)) = self.event_arm {
+            if mask & (1 << m) != 0 {
+                self.axes[m].notify_on_arrival = true;
+                if !every {
+                    self.event_arm = None;
+                }
+                if self.axes[m].motion.x == self.axes[m].motion.target && self.axes[m].motion.v == 0.0 {
+                    // Already there: the event follows at once.
+                    self.axes[m].notify_on_arrival = false;
+                    self.push_event(1 << m);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn clear_motion_errors(&mut self, m: usize) {
+        self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 0;
+    }
+
+    /// Sets AP 0 and the target the ramp generator runs to: the short way
+    /// round in the module's position counter width.
+    pub(crate) fn set_target(&mut self, m: usize, target: i32) {
+        let actual = self.actual_position(m);
+        let diff = self.wrap_position(target as i64 - actual as i64);
+        let axis = &mut self.axes[m];
+        axis.target_word = target;
+        axis.params[ap::TARGET_POSITION as usize] = target;
+        axis.motion.target = axis.motion.x.round() + diff as f64;
+    }
+
+    /// Sign-extends to the module's position width (32 or 24 bits).
+    pub(crate) fn wrap_position(&self, v: i64) -> i32 {
+        let bits = self.profile.position_bits();
+        let shift = 64 - bits;
+        ((v << shift) >> shift) as i32
+    }
+
+    pub(crate) fn actual_position(&self, m: usize) -> i32 {
+        self.wrap_position(self.axes[m].motion.x.round() as i64)
+    }
+
+    // ----- axis parameters ----------------------------------------------
+
+    fn axis_spec(&self, param: u8, need: impl Fn(crate::profile::Access) -> bool) -> Result<&Parameter, Status> {
+        let spec = self.profile.axis_parameter(param).ok_or(Status::WrongType)?;
+        if need(spec.access) { Ok(spec) } else { Err(Status::WrongType) }
+    }
+
+    pub fn set_axis_parameter(&mut self, param: u8, motor: u8, value: i32) -> Result<(), Status> {
+        let m = self.motor(motor)?;
+        let spec = self.axis_spec(param, |a| a.write)?;
+        if !spec.accepts(value) {
+            return Err(Status::InvalidValue);
+        }
+        self.write_axis_parameter(m, param, value);
+        Ok(())
+    }
+
+    pub fn get_axis_parameter(&mut self, param: u8, motor: u8) -> Result<i32, Status> {
+        let m = self.motor(motor)?;
+        self.axis_spec(param, |a| a.read)?;
+        Ok(self.read_axis_parameter(m, param))
+    }
+
+    /// Writes a parameter with its side effects (no access check).
+    pub(crate) fn write_axis_parameter(&mut self, m: usize, param: u8, value: i32) {
+        match param {
+            ap::TARGET_POSITION => self.set_target(m, value),
+            ap::ACTUAL_POSITION => {
+                let target = self.axes[m].target_word;
+                let sign = self.shaft_sign();
+                let axis = &mut self.axes[m];
+                // The carriage does not move: only the counter changes.
+                let mech = axis.motion.x * sign + axis.mech_offset;
+                axis.motion.x = value as f64;
+                axis.mech_offset = mech - axis.motion.x * sign;
+                self.set_target(m, target);
+            }
+            ap::RAMP_MODE => {
+                let axis = &mut self.axes[m];
+                axis.params[param as usize] = value;
+                axis.motion.mode = RampMode::from_code(value);
+            }
+            _ => self.axes[m].params[param as usize] = value,
+        }
+    }
+
+    /// Reads a parameter, computing the measured ones.
+    pub(crate) fn read_axis_parameter(&mut self, m: usize, param: u8) -> i32 {
+        let pd = self.axes[m].params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        let rd = self.axes[m].params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
+        let motion = &self.axes[m].motion;
+        match param {
+            ap::TARGET_POSITION => self.axes[m].target_word,
+            ap::ACTUAL_POSITION => self.actual_position(m),
+            ap::ACTUAL_SPEED => crate::motion::velocity_internal(motion.v, pd).trunc() as i32,
+            ap::ACTUAL_ACCELERATION => crate::motion::accel_internal(motion.a, rd, pd).round().clamp(-2047.0, 2047.0) as i32,
+            ap::POSITION_REACHED => (self.actual_position(m) == self.axes[m].target_word) as i32,
+            ap::LEFT_SWITCH => self.switches(m).0 as i32,
+            ap::RIGHT_SWITCH => self.switches(m).1 as i32,
+            ap::HOME_SWITCH => self.switches(m).2 as i32,
+            ap::ACTUAL_CURRENT => (self.motor_current(m) >> 3) as i32,
+            ap::EXTENDED_ERROR_FLAGS => {
+                // Cleared by reading.
+                std::mem::take(&mut self.axes[m].params[param as usize])
+            }
+            _ => self.axes[m].params[param as usize],
+        }
+    }
+
+    /// The current setting in effect (0…255): run, boost, standby or off.
+    pub fn motor_current(&self, m: usize) -> u32 {
+        let axis = &self.axes[m];
+        let p = &axis.params;
+        let run = p[ap::MAX_CURRENT as usize].clamp(0, 255) as u32;
+        if axis.motion.v != 0.0 {
+            let boost = p[ap::BOOST_CURRENT as usize].clamp(0, 255) as u32;
+            return if axis.motion.a != 0.0 && boost > 0 { boost } else { run };
+        }
+        let standby = p[ap::STANDBY_CURRENT as usize].clamp(0, 255) as u32;
+        if axis.motion.stopped_by_switch && p[ap::END_SWITCH_POWER_DOWN as usize] == 1 {
+            return standby;
+        }
+        let Some(since) = axis.standstill_since else { return run };
+        let still_ms = (self.now_ns.saturating_sub(since)) / 1_000_000;
+        let freewheel = p[ap::FREEWHEELING as usize].max(0) as u64 * 10;
+        if freewheel > 0 && still_ms >= freewheel {
+            return 0;
+        }
+        let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * 10;
+        if still_ms >= delay { standby } else { run }
+    }
+
+    // ----- global parameters ------------------------------------------
+
+    fn global_spec(&self, param: u8, bank: u8, need: impl Fn(crate::profile::Access) -> bool) -> Result<&Parameter, Status> {
+        if !self.profile.has_bank(bank) {
+            return Err(Status::InvalidValue);
+        }
+        let spec = self.profile.global_parameter(bank, param).ok_or(Status::WrongType)?;
+        if need(spec.access) { Ok(spec) } else { Err(Status::WrongType) }
+    }
+
+    pub fn set_global_parameter(&mut self, param: u8, bank: u8, value: i32) -> Result<(), Status> {
+        let spec = self.global_spec(param, bank, |a| a.write)?;
+        if !spec.accepts(value) {
+            return Err(Status::InvalidValue);
+        }
+        let auto = spec.access.auto;
+        match (bank, param) {
+            (0, gp::TICK_TIMER) => {
+                self.tick_base_ns = self.now_ns;
+                self.tick_offset_ms = value as i64;
+            }
+            (0, gp::RANDOM) => self.rng = value as u32 | 1,
+            _ => self.globals[bank as usize][param as usize] = value,
+        }
+        if auto {
+            self.eeprom.set_global(bank, param, value);
+            self.eeprom_generation += 1;
+        }
+        Ok(())
+    }
+
+    pub fn get_global_parameter(&mut self, param: u8, bank: u8) -> Result<i32, Status> {
+        self.global_spec(param, bank, |a| a.read)?;
+        Ok(match (bank, param) {
+            (0, gp::TICK_TIMER) => {
+                let ms = (self.now_ns - self.tick_base_ns) / 1_000_000;
+                (self.tick_offset_ms + ms as i64) as i32 & i32::MAX
+            }
+            (0, gp::RANDOM) => {
+                // xorshift32, 31 bits.
+                let mut x = self.rng;
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                self.rng = x;
+                (x >> 1) as i32
+            }
+            _ => self.globals[bank as usize][param as usize],
+        })
+    }
+
+    // ----- I/O ----------------------------------------------------------
+
+    fn set_output(&mut self, port: u8, bank: u8, value: i32) -> Result<(), Status> {
+        let has = |d: PortDirection| self.profile.ports.iter().any(|p| p.direction == d && p.bank == bank);
+        if has(PortDirection::Pullup) {
+            if self.profile.port(PortDirection::Pullup, bank, port).is_none() {
+                return Err(Status::WrongType);
+            }
+            if !(0..=1).contains(&value) {
+                return Err(Status::InvalidValue);
+            }
+            self.pullups = value == 1;
+            return Ok(());
+        }
+        if !has(PortDirection::Output) {
+            return Err(Status::InvalidValue);
+        }
+        if port == 255 {
+            let v = if value == -1 { self.registers.accumulator } else { value };
+            if !(0..=255).contains(&v) {
+                return Err(Status::InvalidValue);
+            }
+            let mask = self.output_mask(bank);
+            self.outputs = (self.outputs & !mask) | (v as u32 & mask);
+            return Ok(());
+        }
+        if self.profile.port(PortDirection::Output, bank, port).is_none() {
+            return Err(Status::WrongType);
+        }
+        if !(0..=1).contains(&value) {
+            return Err(Status::InvalidValue);
+        }
+        if value == 1 {
+            self.outputs |= 1 << port;
+        } else {
+            self.outputs &= !(1 << port);
+        }
+        Ok(())
+    }
+
+    fn output_mask(&self, bank: u8) -> u32 {
+        self.profile
+            .ports
+            .iter()
+            .filter(|p| p.direction == PortDirection::Output && p.bank == bank && p.number < 32)
+            .fold(0, |m, p| m | 1 << p.number)
+    }
+
+    fn get_input(&mut self, port: u8, bank: u8) -> Exec {
+        let in_bank: Vec<_> = self.profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup).collect();
+        if in_bank.is_empty() {
+            return Err(Status::InvalidValue);
+        }
+        let outputs = in_bank.iter().all(|p| p.direction == PortDirection::Output);
+        if port == 255 {
+            return Ok(if outputs {
+                (self.outputs & self.output_mask(bank)) as i32
+            } else {
+                in_bank.iter().filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | (self.world.digital(p.number) as i32) << p.number)
+            });
+        }
+        let p = in_bank.iter().find(|p| p.number == port).ok_or(Status::WrongType)?;
+        Ok(match p.direction {
+            PortDirection::Output => (self.outputs >> port & 1) as i32,
+            _ if p.max == 1 => self.world.digital(port) as i32,
+            // The supply voltage channel is the one with a 0.1 V unit.
+            _ if p.unit.as_deref().is_some_and(|u| u.contains('V')) => self.world.supply_decivolts as i32,
+            _ => self.world.analog_inputs.get(port as usize).copied().unwrap_or(0) as i32,
+        })
+    }
+
+    /// The states of the digital outputs, bit n = OUTn.
+    pub fn outputs(&self) -> u32 {
+        self.outputs
+    }
+
+    pub fn pullups(&self) -> bool {
+        self.pullups
+    }
+
+    // ----- coordinates --------------------------------------------------
+
+    fn set_coordinate(&mut self, n: u8, motor: u8, value: Option<i32>) -> Result<(), Status> {
+        if n as usize > self.profile.module.coordinates as usize {
+            return Err(Status::WrongType);
+        }
+        if motor == 255 {
+            // SCO n, 255, 0: RAM → EEPROM (0 = all but coordinate 0).
+            let range = if n == 0 { 1..=self.profile.module.coordinates } else { n..=n };
+            for m in 0..self.axes.len() {
+                for c in range.clone() {
+                    let v = self.axes[m].coordinates[c as usize];
+                    self.eeprom.set_coordinate(m as u8, c, v);
+                }
+            }
+            self.eeprom_generation += 1;
+            return Ok(());
+        }
+        let m = self.motor(motor)?;
+        let v = value.unwrap_or(0);
+        self.axes[m].coordinates[n as usize] = v;
+        if n > 0 && self.globals[0][gp::COORDINATE_STORAGE as usize] == 1 {
+            self.eeprom.set_coordinate(motor, n, v);
+            self.eeprom_generation += 1;
+        }
+        Ok(())
+    }
+
+    /// GCO n, 255: EEPROM → RAM (0 = all but coordinate 0).
+    fn coordinates_from_eeprom(&mut self, n: u8) -> Result<(), Status> {
+        if n as usize > self.profile.module.coordinates as usize {
+            return Err(Status::WrongType);
+        }
+        let range = if n == 0 { 1..=self.profile.module.coordinates } else { n..=n };
+        for m in 0..self.axes.len() {
+            for c in range.clone() {
+                self.axes[m].coordinates[c as usize] = self.eeprom.coordinate(m as u8, c).unwrap_or(0);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Frame-level helpers for tests and tools.
+pub fn opcode_name(op: u8) -> &'static str {
+    opcode::name(op)
+}

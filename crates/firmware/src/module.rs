@@ -1,0 +1,583 @@
+//! A virtual TMCL module: profile, state, EEPROM, motion and world, driven
+//! by `handle_frame` (or `execute`) and `advance`.
+
+use crate::eeprom::Eeprom;
+use crate::motion::{self, Motion, RampMode};
+use crate::profile::Profile;
+use crate::world::World;
+use std::sync::Arc;
+use tmclsim_protocol::frame::version_string_reply;
+use tmclsim_protocol::{opcode, Reply, Request, Status, FRAME_LEN};
+
+/// Axis parameter numbers the firmware gives a meaning to.
+pub mod ap {
+    pub const TARGET_POSITION: u8 = 0;
+    pub const ACTUAL_POSITION: u8 = 1;
+    pub const TARGET_SPEED: u8 = 2;
+    pub const ACTUAL_SPEED: u8 = 3;
+    pub const MAX_SPEED: u8 = 4;
+    pub const MAX_ACCELERATION: u8 = 5;
+    pub const MAX_CURRENT: u8 = 6;
+    pub const STANDBY_CURRENT: u8 = 7;
+    pub const POSITION_REACHED: u8 = 8;
+    pub const HOME_SWITCH: u8 = 9;
+    pub const RIGHT_SWITCH: u8 = 10;
+    pub const LEFT_SWITCH: u8 = 11;
+    pub const RIGHT_SWITCH_DISABLE: u8 = 12;
+    pub const LEFT_SWITCH_DISABLE: u8 = 13;
+    pub const MIN_SPEED: u8 = 130;
+    pub const ACTUAL_ACCELERATION: u8 = 135;
+    pub const RAMP_MODE: u8 = 138;
+    pub const SOFT_STOP: u8 = 149;
+    pub const END_SWITCH_POWER_DOWN: u8 = 150;
+    pub const RAMP_DIVISOR: u8 = 153;
+    pub const PULSE_DIVISOR: u8 = 154;
+    pub const ACTUAL_CURRENT: u8 = 180;
+    pub const BOOST_CURRENT: u8 = 200;
+    pub const FREEWHEELING: u8 = 204;
+    pub const EXTENDED_ERROR_FLAGS: u8 = 207;
+    pub const POWER_DOWN_DELAY: u8 = 214;
+}
+
+/// Global parameter numbers (bank 0) the firmware gives a meaning to.
+pub mod gp {
+    pub const SERIAL_ADDRESS: u8 = 66;
+    pub const HEARTBEAT: u8 = 68;
+    pub const TELEGRAM_PAUSE: u8 = 75;
+    pub const HOST_ADDRESS: u8 = 76;
+    pub const END_SWITCH_POLARITY: u8 = 79;
+    pub const COORDINATE_STORAGE: u8 = 84;
+    pub const DONT_RESTORE_USER_VARIABLES: u8 = 85;
+    pub const SECONDARY_ADDRESS: u8 = 87;
+    pub const REVERSE_SHAFT: u8 = 90;
+    pub const APPLICATION_STATUS: u8 = 128;
+    pub const DOWNLOAD_MODE: u8 = 129;
+    pub const PROGRAM_COUNTER: u8 = 130;
+    pub const TICK_TIMER: u8 = 132;
+    pub const RANDOM: u8 = 133;
+    pub const SUPPRESS_REPLY: u8 = 255;
+}
+
+/// One motor axis.
+#[derive(Clone, Debug)]
+pub struct Axis {
+    /// RAM values of the axis parameters (stored ones; measured ones are
+    /// computed on read).
+    pub params: [i32; 256],
+    pub motion: Motion,
+    /// AP 0 as the host wrote it.
+    pub target_word: i32,
+    /// Coordinates 0…N.
+    pub coordinates: Vec<i32>,
+    /// Mechanical position minus motor position counter.
+    pub mech_offset: f64,
+    /// Virtual time (ns) since which the motor stands still.
+    pub standstill_since: Option<u64>,
+    /// A 138 event is due when this axis reaches its target.
+    pub notify_on_arrival: bool,
+}
+
+/// Result of the last comparison (or of an accumulator load against 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compare {
+    Less,
+    #[default]
+    Equal,
+    Greater,
+}
+
+impl Compare {
+    pub fn of(a: i32, b: i32) -> Compare {
+        match a.cmp(&b) {
+            std::cmp::Ordering::Less => Compare::Less,
+            std::cmp::Ordering::Equal => Compare::Equal,
+            std::cmp::Ordering::Greater => Compare::Greater,
+        }
+    }
+}
+
+/// Error flags (CLE / JC ETO…EPO), one bit each.
+pub mod error_flag {
+    pub const TIMEOUT: u8 = 1 << 1;
+    pub const ALARM: u8 = 1 << 2;
+    pub const DEVIATION: u8 = 1 << 3;
+    pub const POSITION: u8 = 1 << 4;
+    pub const SHUTDOWN: u8 = 1 << 5;
+}
+
+/// Accumulator, X register and flags of the TMCL interpreter.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Registers {
+    pub accumulator: i32,
+    pub x: i32,
+    pub compare: Compare,
+    /// Error flags, see [`error_flag`].
+    pub errors: u8,
+}
+
+/// How `execute` was reached: the host (direct mode) or a program.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Origin {
+    Direct,
+    Program,
+}
+
+/// What a command produced besides status and value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Special {
+    /// A normal reply.
+    None,
+    /// Send these 9 bytes instead of a normal reply.
+    Frame([u8; FRAME_LEN]),
+    /// Send no reply at all.
+    Silent,
+}
+
+/// The result of executing one instruction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Outcome {
+    pub status: Status,
+    pub value: i32,
+    pub special: Special,
+}
+
+impl Outcome {
+    pub fn ok(value: i32) -> Outcome {
+        Outcome { status: Status::Ok, value, special: Special::None }
+    }
+
+    pub fn error(status: Status, value: i32) -> Outcome {
+        Outcome { status, value, special: Special::None }
+    }
+}
+
+/// A virtual TMCL module.
+#[derive(Clone, Debug)]
+pub struct Module {
+    pub(crate) profile: Arc<Profile>,
+    /// Virtual time in nanoseconds since the module was created.
+    pub(crate) now_ns: u64,
+    pub(crate) axes: Vec<Axis>,
+    /// Global parameter RAM, banks 0…3.
+    pub(crate) globals: [[i32; 256]; 4],
+    pub(crate) outputs: u32,
+    pub(crate) pullups: bool,
+    pub(crate) world: World,
+    pub(crate) eeprom: Eeprom,
+    /// Bumped on every EEPROM write; a server saves the image when it changes.
+    pub(crate) eeprom_generation: u64,
+    pub(crate) registers: Registers,
+    /// Interrupt configuration: enabled flags, vectors, global enable.
+    pub(crate) interrupts_enabled: [bool; 256],
+    pub(crate) interrupt_vectors: [Option<u16>; 256],
+    pub(crate) interrupts_global: bool,
+    /// 138: arm for the next MVP (`Some(false)`) or every MVP (`Some(true)`).
+    pub(crate) event_arm: Option<(bool, u32)>,
+    pub(crate) events: Vec<[u8; FRAME_LEN]>,
+    /// Address byte of the last request (events answer with it).
+    pub(crate) last_address: u8,
+    pub(crate) last_frame_ns: u64,
+    pub(crate) heartbeat_tripped: bool,
+    pub(crate) tick_base_ns: u64,
+    pub(crate) tick_offset_ms: i64,
+    pub(crate) rng: u32,
+    pub(crate) restored_from_eeprom: bool,
+    pub(crate) resets: u32,
+}
+
+impl Module {
+    /// A module fresh from the factory (empty EEPROM), in a world without
+    /// switches.
+    pub fn new(profile: Arc<Profile>) -> Module {
+        let eeprom = Eeprom::new(&profile.module.name);
+        Module::with_eeprom(profile, eeprom)
+    }
+
+    /// A module powered up with the given EEPROM contents.
+    pub fn with_eeprom(profile: Arc<Profile>, eeprom: Eeprom) -> Module {
+        let axes = profile.module.axes as usize;
+        let mut m = Module {
+            world: World::free(axes),
+            axes: Vec::new(),
+            globals: [[0; 256]; 4],
+            outputs: 0,
+            pullups: true,
+            eeprom_generation: 0,
+            registers: Registers::default(),
+            interrupts_enabled: [false; 256],
+            interrupt_vectors: [None; 256],
+            interrupts_global: false,
+            event_arm: None,
+            events: Vec::new(),
+            last_address: 1,
+            last_frame_ns: 0,
+            heartbeat_tripped: false,
+            tick_base_ns: 0,
+            tick_offset_ms: 0,
+            rng: 0x2545_F491,
+            restored_from_eeprom: false,
+            resets: 0,
+            now_ns: 0,
+            eeprom,
+            profile,
+        };
+        m.power_on();
+        m
+    }
+
+    /// A module by built-in profile name.
+    pub fn built_in(name: &str) -> Result<Module, String> {
+        Ok(Module::new(Profile::built_in(name)?))
+    }
+
+    pub fn profile(&self) -> &Arc<Profile> {
+        &self.profile
+    }
+
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+
+    pub fn eeprom(&self) -> &Eeprom {
+        &self.eeprom
+    }
+
+    /// Changes whenever a command wrote the EEPROM.
+    pub fn eeprom_generation(&self) -> u64 {
+        self.eeprom_generation
+    }
+
+    /// True when this power-up found stored values in the EEPROM; false
+    /// when the module started from factory defaults.
+    pub fn restored_from_eeprom(&self) -> bool {
+        self.restored_from_eeprom
+    }
+
+    /// How many times the module was reset (255) or reinitialised (137).
+    pub fn resets(&self) -> u32 {
+        self.resets
+    }
+
+    pub fn registers(&self) -> Registers {
+        self.registers
+    }
+
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
+    }
+
+    pub fn axis(&self, motor: usize) -> &Axis {
+        &self.axes[motor]
+    }
+
+    /// The module address (GP 66).
+    pub fn address(&self) -> u8 {
+        self.globals[0][gp::SERIAL_ADDRESS as usize] as u8
+    }
+
+    /// GP 87; 0 = off.
+    pub fn secondary_address(&self) -> u8 {
+        self.globals[0][gp::SECONDARY_ADDRESS as usize] as u8
+    }
+
+    pub fn host_address(&self) -> u8 {
+        self.globals[0][gp::HOST_ADDRESS as usize] as u8
+    }
+
+    /// GP 75: delay before every reply.
+    pub fn reply_delay_ns(&self) -> u64 {
+        self.globals[0][gp::TELEGRAM_PAUSE as usize].max(0) as u64 * 1_000_000
+    }
+
+    /// Sets the module address (GP 66) the way SGP 66 would, without a
+    /// frame (used by servers for `--address`).
+    pub fn set_address(&mut self, address: u8) {
+        self.globals[0][gp::SERIAL_ADDRESS as usize] = address as i32;
+        self.eeprom.set_global(0, gp::SERIAL_ADDRESS, address as i32);
+        self.eeprom_generation += 1;
+    }
+
+    /// Does a frame with this address byte reach this module?
+    pub fn answers_to(&self, address: u8) -> bool {
+        address == self.address() || (self.secondary_address() != 0 && address == self.secondary_address())
+    }
+
+    /// Power cycle: RAM from factory defaults, then what the EEPROM holds.
+    pub fn power_on(&mut self) {
+        let profile = self.profile.clone();
+        let ee = &self.eeprom;
+        let restored = !ee.axis.is_empty() || !ee.global.is_empty() || !ee.coordinates.is_empty();
+        self.globals = [[0; 256]; 4];
+        for bank in 0..4u8 {
+            for p in profile.global_parameters(bank) {
+                let stored = if p.access.auto || p.access.eeprom { ee.global(bank, p.number) } else { None };
+                self.globals[bank as usize][p.number as usize] = stored.unwrap_or(p.default_word());
+            }
+        }
+        // Bank 2 is restored unless GP 85 says otherwise.
+        if self.globals[0][gp::DONT_RESTORE_USER_VARIABLES as usize] == 1 {
+            for p in profile.global_parameters(2) {
+                self.globals[2][p.number as usize] = p.default_word();
+            }
+        }
+        self.globals[0][gp::SUPPRESS_REPLY as usize] = 0;
+        let coords_from_eeprom = self.globals[0][gp::COORDINATE_STORAGE as usize] == 1;
+        let old_axes = std::mem::take(&mut self.axes);
+        for motor in 0..profile.module.axes {
+            let mut params = [0i32; 256];
+            for p in profile.axis_parameters() {
+                let stored = if p.access.eeprom { ee.axis(motor, p.number) } else { None };
+                params[p.number as usize] = stored.unwrap_or(p.default_word());
+            }
+            let mut coordinates = vec![0; profile.module.coordinates as usize + 1];
+            if coords_from_eeprom {
+                for (n, c) in coordinates.iter_mut().enumerate().skip(1) {
+                    *c = ee.coordinate(motor, n as u8).unwrap_or(0);
+                }
+            }
+            // The carriage stays where it is; the position counter restarts at 0.
+            let mech = old_axes.get(motor as usize).map_or(0.0, |a| a.motion.x + a.mech_offset);
+            let mode = RampMode::from_code(params[ap::RAMP_MODE as usize]);
+            self.axes.push(Axis {
+                params,
+                motion: Motion { mode, ..Motion::default() },
+                target_word: 0,
+                coordinates,
+                mech_offset: mech,
+                standstill_since: Some(self.now_ns),
+                notify_on_arrival: false,
+            });
+        }
+        self.restored_from_eeprom = restored;
+        self.outputs = 0;
+        self.pullups = profile.ports.iter().find(|p| p.direction == crate::profile::PortDirection::Pullup).is_none_or(|p| p.default != 0);
+        self.registers = Registers::default();
+        self.interrupts_enabled = [false; 256];
+        self.interrupt_vectors = [None; 256];
+        self.interrupts_global = false;
+        self.event_arm = None;
+        self.events.clear();
+        self.last_frame_ns = self.now_ns;
+        self.heartbeat_tripped = false;
+        self.tick_base_ns = self.now_ns;
+        self.tick_offset_ms = 0;
+    }
+
+    /// Handles one 9-byte frame from a serial-type link: address filter,
+    /// checksum, execution, reply (decisions.md rules 2–4, 11).
+    pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
+        let (request, checksum_ok) = match Request::decode(frame) {
+            Ok(r) => (r, true),
+            Err(r) => (r, false),
+        };
+        if !self.answers_to(request.address) {
+            return None;
+        }
+        self.last_address = request.address;
+        self.last_frame_ns = self.now_ns;
+        self.heartbeat_tripped = false;
+        let host = self.host_address();
+        if !checksum_ok {
+            if self.replies_suppressed(0) {
+                return None;
+            }
+            return Some(Reply::new(host, request.address, Status::WrongChecksum, 0, 0).encode());
+        }
+        let ins = request.instruction;
+        let outcome = self.execute(ins);
+        let reply = match outcome.special {
+            Special::Silent => return None,
+            Special::Frame(f) => f,
+            Special::None => Reply::new(host, request.address, outcome.status, ins.opcode, outcome.value).encode(),
+        };
+        if ins.opcode == opcode::RESET && outcome.status == Status::Ok {
+            // The reply goes out, then the module restarts.
+            self.reset();
+            return Some(reply);
+        }
+        if self.replies_suppressed(ins.opcode) {
+            return None;
+        }
+        Some(reply)
+    }
+
+    /// GP 255: replies in direct mode are suppressed except for GAP, GGP
+    /// and GIO.
+    fn replies_suppressed(&self, op: u8) -> bool {
+        self.globals[0][gp::SUPPRESS_REPLY as usize] == 1 && !matches!(op, opcode::GAP | opcode::GGP | opcode::GIO)
+    }
+
+    /// Software reset (255 with 1234): a power cycle.
+    pub fn reset(&mut self) {
+        self.resets += 1;
+        self.power_on();
+    }
+
+    /// Unsolicited frames (138 events) produced since the last call.
+    pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
+        std::mem::take(&mut self.events)
+    }
+
+    pub fn has_events(&self) -> bool {
+        !self.events.is_empty()
+    }
+
+    pub(crate) fn push_event(&mut self, mask: u32) {
+        let reply = Reply::new(self.host_address(), self.last_address, Status::Event, opcode::TARGET_REACHED_EVENT, mask as i32);
+        self.events.push(reply.encode());
+    }
+
+    pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
+        version_string_reply(self.host_address(), &self.profile.version_text())
+    }
+
+
+    // ----- time -------------------------------------------------------
+
+    /// Advances virtual time by `dt_ns` nanoseconds.
+    pub fn advance(&mut self, dt_ns: u64) {
+        let end = self.now_ns.saturating_add(dt_ns);
+        while self.now_ns < end {
+            let mut step_end = end;
+            if let Some(deadline) = self.heartbeat_deadline() {
+                if deadline > self.now_ns && deadline < step_end {
+                    step_end = deadline;
+                }
+            }
+            let dt = step_end - self.now_ns;
+            for motor in 0..self.axes.len() {
+                self.advance_axis(motor, dt);
+            }
+            self.now_ns = step_end;
+            if let Some(deadline) = self.heartbeat_deadline() {
+                if self.now_ns >= deadline {
+                    self.heartbeat_tripped = true;
+                    for motor in 0..self.axes.len() {
+                        self.motor_stop(motor);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Advances virtual time to an absolute time (no-op if in the past).
+    pub fn advance_to(&mut self, t_ns: u64) {
+        if t_ns > self.now_ns {
+            self.advance(t_ns - self.now_ns);
+        }
+    }
+
+    fn heartbeat_deadline(&self) -> Option<u64> {
+        let hb = self.globals[0][gp::HEARTBEAT as usize];
+        (hb > 0 && !self.heartbeat_tripped).then(|| self.last_frame_ns + hb as u64 * 1_000_000)
+    }
+
+    /// The next virtual time at which something observable happens on its
+    /// own (a heartbeat stop, a 138 event); `None` if nothing is pending.
+    pub fn next_event_ns(&self) -> Option<u64> {
+        let mut next = self.heartbeat_deadline();
+        for (motor, axis) in self.axes.iter().enumerate() {
+            if axis.notify_on_arrival {
+                if let Some(t) = self.time_to_rest(motor) {
+                    let t = self.now_ns + (t * 1e9).ceil() as u64;
+                    next = Some(next.map_or(t, |n| n.min(t)));
+                }
+            }
+        }
+        next
+    }
+
+    fn time_to_rest(&self, motor: usize) -> Option<f64> {
+        let mut probe = self.axes[motor].motion.clone();
+        let ramp = self.ramp(motor);
+        let mut total = 0.0;
+        // Walk in growing steps; the motion model is exact for any step.
+        let mut step = 0.001;
+        for _ in 0..60 {
+            if probe.is_idle(&ramp, &self.stops_at(motor, probe.x)) {
+                return Some(total);
+            }
+            let mut stops = |x: f64| self.stops_at(motor, x);
+            probe.advance(step, &ramp, &mut stops, &[]);
+            total += step;
+            step *= 1.5;
+        }
+        None
+    }
+
+    fn advance_axis(&mut self, motor: usize, dt_ns: u64) {
+        let ramp = self.ramp(motor);
+        let offset = self.axes[motor].mech_offset;
+        let sign = self.shaft_sign();
+        // Switch thresholds in motor coordinates.
+        let thresholds: Vec<f64> = self.world.axes[motor].thresholds().map(|m| (m - offset) * sign).collect();
+        let was_moving = self.axes[motor].motion.v != 0.0;
+        let mut motion = std::mem::take(&mut self.axes[motor].motion);
+        let arrived = {
+            let mut stops = |x: f64| self.stops_at(motor, x);
+            motion.advance(dt_ns as f64 * 1e-9, &ramp, &mut stops, &thresholds)
+        };
+        let moving = motion.v != 0.0;
+        let axis = &mut self.axes[motor];
+        axis.motion = motion;
+        if moving {
+            axis.standstill_since = None;
+        } else if was_moving || axis.standstill_since.is_none() {
+            axis.standstill_since = Some(self.now_ns + dt_ns);
+        }
+        if arrived && axis.notify_on_arrival {
+            axis.notify_on_arrival = false;
+            self.push_event(1 << motor);
+        }
+    }
+
+    pub(crate) fn shaft_sign(&self) -> f64 {
+        if self.globals[0][gp::REVERSE_SHAFT as usize] == 1 { -1.0 } else { 1.0 }
+    }
+
+    /// Mechanical position of an axis for a motor position.
+    pub(crate) fn mech(&self, motor: usize, x: f64) -> f64 {
+        x * self.shaft_sign() + self.axes[motor].mech_offset
+    }
+
+    /// Logical switch states (after GP 79 polarity): (left, right, home).
+    pub fn switches(&self, motor: usize) -> (bool, bool, bool) {
+        self.switches_at(motor, self.axes[motor].motion.x)
+    }
+
+    fn switches_at(&self, motor: usize, x: f64) -> (bool, bool, bool) {
+        let w = &self.world.axes[motor];
+        let m = self.mech(motor, x);
+        let invert = self.globals[0][gp::END_SWITCH_POLARITY as usize] == 1;
+        (w.left_pressed(m) ^ invert, w.right_pressed(m) ^ invert, w.home_pressed(m))
+    }
+
+    fn stops_at(&self, motor: usize, x: f64) -> motion::Stops {
+        let (left, right, _) = self.switches_at(motor, x);
+        let p = &self.axes[motor].params;
+        motion::Stops {
+            block_positive: right && p[ap::RIGHT_SWITCH_DISABLE as usize] == 0,
+            block_negative: left && p[ap::LEFT_SWITCH_DISABLE as usize] == 0,
+            soft: p[ap::SOFT_STOP as usize] == 1,
+        }
+    }
+
+    /// Ramp settings of an axis in µsteps and seconds.
+    pub(crate) fn ramp(&self, motor: usize) -> motion::Ramp {
+        let p = &self.axes[motor].params;
+        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
+        let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
+        motion::Ramp {
+            vmax: motion::velocity_pps(p[ap::MAX_SPEED as usize].clamp(0, 2047) as f64, pd),
+            vmin: motion::velocity_pps(p[ap::MIN_SPEED as usize].clamp(0, 2047) as f64, pd),
+            accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
+            accel_velocity: motion::accel_pps2(a.max(1) as f64, rd, pd),
+            target_velocity: motion::velocity_pps(p[ap::TARGET_SPEED as usize] as f64, pd),
+        }
+    }
+}

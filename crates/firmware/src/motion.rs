@@ -1,0 +1,526 @@
+//! The TMC429/TMC428 ramp generator in continuous time.
+//!
+//! Units and formulas follow decisions.md rules 23–25:
+//! `v_pps = fclk·v / 2^(pulse_div+16)`,
+//! `a_pps = fclk²·a / 2^(ramp_div+pulse_div+29)`, fclk = 16 MHz.
+//!
+//! The profile is planned piecewise: every phase has a constant
+//! acceleration (or, in soft mode, an exponential approach) and an end time
+//! known in closed form, so advancing an hour of virtual time costs a handful
+//! of phases, not millions of ticks. Positions are kept unwrapped in `f64`
+//! and snapped to the exact target on arrival.
+
+pub const FCLK: f64 = 16_000_000.0;
+
+/// Microsteps per second of an internal velocity value.
+pub fn velocity_pps(v: f64, pulse_div: u32) -> f64 {
+    FCLK * v / 2f64.powi(pulse_div as i32 + 16)
+}
+
+/// Internal velocity units of a step rate.
+pub fn velocity_internal(pps: f64, pulse_div: u32) -> f64 {
+    pps * 2f64.powi(pulse_div as i32 + 16) / FCLK
+}
+
+/// Microsteps per second² of an internal acceleration value.
+pub fn accel_pps2(a: f64, ramp_div: u32, pulse_div: u32) -> f64 {
+    FCLK * FCLK * a / 2f64.powi((ramp_div + pulse_div) as i32 + 29)
+}
+
+/// Internal acceleration units of an acceleration in µsteps/s².
+pub fn accel_internal(pps2: f64, ramp_div: u32, pulse_div: u32) -> f64 {
+    pps2 * 2f64.powi((ramp_div + pulse_div) as i32 + 29) / (FCLK * FCLK)
+}
+
+/// The acceleration the TMC429 can use for positioning ramps: AP 5 clamped
+/// to `[2^(rd−pd−1), min(2047, 2^(rd−pd+12)−1)]` (manual 6.1.3).
+pub fn positioning_accel(a: u32, ramp_div: u32, pulse_div: u32) -> f64 {
+    let e = ramp_div as i32 - pulse_div as i32;
+    let lower = 2f64.powi(e - 1);
+    let upper = (2f64.powi(e + 12) - 1.0).min(2047.0);
+    (a as f64).clamp(lower.min(upper), upper)
+}
+
+/// AP 138.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RampMode {
+    Position = 0,
+    Soft = 1,
+    Velocity = 2,
+}
+
+impl RampMode {
+    pub fn from_code(v: i32) -> RampMode {
+        match v {
+            1 => RampMode::Soft,
+            2 => RampMode::Velocity,
+            _ => RampMode::Position,
+        }
+    }
+}
+
+/// The ramp settings of one axis, converted to µsteps and seconds.
+#[derive(Clone, Copy, Debug)]
+pub struct Ramp {
+    /// AP 4 in µsteps/s.
+    pub vmax: f64,
+    /// AP 130 in µsteps/s.
+    pub vmin: f64,
+    /// AP 5 clamped for positioning, in µsteps/s².
+    pub accel_position: f64,
+    /// AP 5 as is (velocity mode), in µsteps/s².
+    pub accel_velocity: f64,
+    /// AP 2 in µsteps/s.
+    pub target_velocity: f64,
+}
+
+/// What the stop switches allow right now.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Stops {
+    /// Positive motion is blocked (right switch active and enabled).
+    pub block_positive: bool,
+    /// Negative motion is blocked (left switch active and enabled).
+    pub block_negative: bool,
+    /// AP 149: decelerate instead of stopping at once.
+    pub soft: bool,
+}
+
+impl Stops {
+    fn blocks(&self, dir: f64) -> bool {
+        (dir > 0.0 && self.block_positive) || (dir < 0.0 && self.block_negative)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Shape {
+    /// Constant acceleration (µsteps/s²).
+    Accel(f64),
+    /// Soft-mode approach: `d(t) = d0·e^(−kt)` towards the target.
+    Exponential { k: f64 },
+    /// An immediate change of velocity (hard stop, stop-speed steps).
+    Jump(f64),
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Phase {
+    shape: Shape,
+    /// Seconds; `INFINITY` for "until something changes".
+    duration: f64,
+    /// At the end of the phase the motor stands on its target.
+    arrives: bool,
+}
+
+impl Phase {
+    fn accel(a: f64, duration: f64) -> Phase {
+        Phase { shape: Shape::Accel(a), duration: duration.max(0.0), arrives: false }
+    }
+
+    fn jump(v: f64) -> Phase {
+        Phase { shape: Shape::Jump(v), duration: 0.0, arrives: false }
+    }
+}
+
+const EPS_POS: f64 = 1e-6;
+const EPS_VEL: f64 = 1e-9;
+/// Phases one `advance` may walk through; a guard against float dust.
+const MAX_PHASES: usize = 64;
+
+/// One axis of the motion controller.
+#[derive(Clone, Debug)]
+pub struct Motion {
+    /// Actual position in µsteps (unwrapped).
+    pub x: f64,
+    /// Actual velocity in µsteps/s.
+    pub v: f64,
+    /// Acceleration in effect, µsteps/s² (for AP 135).
+    pub a: f64,
+    pub mode: RampMode,
+    /// Target position in the unwrapped space of `x`.
+    pub target: f64,
+    /// The motor was stopped by a stop switch and has not moved since.
+    pub stopped_by_switch: bool,
+}
+
+impl Default for Motion {
+    fn default() -> Self {
+        Motion { x: 0.0, v: 0.0, a: 0.0, mode: RampMode::Position, target: 0.0, stopped_by_switch: false }
+    }
+}
+
+impl Motion {
+    /// True when the motor does not move and nothing will make it move.
+    pub fn is_idle(&self, ramp: &Ramp, stops: &Stops) -> bool {
+        self.v == 0.0 && self.plan(ramp, stops).is_none()
+    }
+
+    /// Advances by `dt` seconds. `thresholds` are positions (in the space
+    /// of `x`) where a switch changes state; a phase ends there so that the
+    /// caller can re-evaluate the switches. Returns `true` when the motor
+    /// arrived on its target during this call.
+    pub fn advance(&mut self, mut dt: f64, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops, thresholds: &[f64]) -> bool {
+        let mut arrived = false;
+        for _ in 0..MAX_PHASES {
+            if dt <= 0.0 {
+                break;
+            }
+            let s = stops(self.x);
+            let Some(phase) = self.plan(ramp, &s) else {
+                self.a = 0.0;
+                break;
+            };
+            let mut t = phase.duration.min(dt);
+            let mut crossing = None;
+            for &th in thresholds {
+                if let Some(tc) = self.crossing(phase.shape, th, t) {
+                    if tc < t || crossing.is_none() && tc <= t {
+                        t = tc;
+                        crossing = Some(th);
+                    }
+                }
+            }
+            self.integrate(phase.shape, t);
+            dt -= t;
+            if let Some(th) = crossing {
+                self.x = th;
+                let s = stops(self.x);
+                if !s.soft && s.blocks(self.v.signum()) {
+                    self.v = 0.0;
+                    self.stopped_by_switch = true;
+                }
+            } else if t >= phase.duration && phase.arrives {
+                self.x = self.target;
+                self.v = 0.0;
+                self.a = 0.0;
+                arrived = true;
+            }
+        }
+        if self.v != 0.0 {
+            self.stopped_by_switch = false;
+        }
+        arrived
+    }
+
+    fn integrate(&mut self, shape: Shape, t: f64) {
+        match shape {
+            Shape::Accel(a) => {
+                self.x += self.v * t + 0.5 * a * t * t;
+                self.v += a * t;
+                self.a = a;
+                if self.v.abs() < EPS_VEL {
+                    self.v = 0.0;
+                }
+            }
+            Shape::Jump(v) => {
+                self.v = v;
+                self.a = 0.0;
+            }
+            Shape::Exponential { k } => {
+                let f = (-k * t).exp();
+                let d = self.target - self.x;
+                self.x = self.target - d * f;
+                self.v = k * d * f;
+                self.a = -k * self.v;
+            }
+        }
+    }
+
+    /// First time in `(0, limit]` at which the phase reaches `x = th`.
+    fn crossing(&self, shape: Shape, th: f64, limit: f64) -> Option<f64> {
+        let dx = th - self.x;
+        if dx.abs() < 1e-12 {
+            return None;
+        }
+        let t = match shape {
+            Shape::Accel(a) => {
+                if a.abs() < 1e-12 {
+                    if self.v.abs() < EPS_VEL {
+                        return None;
+                    }
+                    dx / self.v
+                } else {
+                    // x + v t + a t²/2 = th
+                    let disc = self.v * self.v + 2.0 * a * dx;
+                    if disc < 0.0 {
+                        return None;
+                    }
+                    let r = disc.sqrt();
+                    let t1 = (-self.v - r) / a;
+                    let t2 = (-self.v + r) / a;
+                    let (lo, hi) = if t1 < t2 { (t1, t2) } else { (t2, t1) };
+                    if lo > 1e-12 { lo } else { hi }
+                }
+            }
+            Shape::Jump(_) => return None,
+            Shape::Exponential { k } => {
+                let d0 = self.target - self.x;
+                let d1 = self.target - th;
+                if d0 == 0.0 || d1 / d0 <= 0.0 || d1.abs() >= d0.abs() {
+                    return None;
+                }
+                (d0 / d1).ln() / k
+            }
+        };
+        (t > 1e-12 && t <= limit).then_some(t)
+    }
+
+    /// The phase the ramp generator is in now; `None` when standing still
+    /// with nothing to do.
+    fn plan(&self, ramp: &Ramp, stops: &Stops) -> Option<Phase> {
+        match self.mode {
+            RampMode::Velocity => self.plan_velocity(ramp, stops),
+            RampMode::Position | RampMode::Soft => self.plan_position(ramp, stops),
+        }
+    }
+
+    fn plan_velocity(&self, ramp: &Ramp, stops: &Stops) -> Option<Phase> {
+        let a = ramp.accel_velocity;
+        let mut vt = ramp.target_velocity;
+        if stops.blocks(vt.signum()) || stops.blocks(self.v.signum()) {
+            if self.v != 0.0 && !stops.soft {
+                // A hard stop happens at the crossing; arriving here means
+                // the switch was already active: stop dead.
+                return Some(Phase::jump(0.0));
+            }
+            vt = 0.0;
+        }
+        let dv = vt - self.v;
+        if dv.abs() < EPS_VEL {
+            if self.v != vt {
+                return Some(Phase::jump(vt));
+            }
+            return if vt == 0.0 { None } else { Some(Phase::accel(0.0, f64::INFINITY)) };
+        }
+        Some(Phase::accel(a * dv.signum(), dv.abs() / a))
+    }
+
+    fn plan_position(&self, ramp: &Ramp, stops: &Stops) -> Option<Phase> {
+        let a = ramp.accel_position;
+        let vmax = ramp.vmax;
+        let vmin = ramp.vmin.min(vmax);
+        let delta = self.target - self.x;
+        let d = delta.abs();
+        if d < EPS_POS && self.v.abs() <= vmin + EPS_VEL {
+            if self.v == 0.0 && delta == 0.0 {
+                return None;
+            }
+            return Some(Phase { shape: Shape::Accel(0.0), duration: 0.0, arrives: true });
+        }
+        // Direction towards the target; at the target with speed, the
+        // motor overshoots and comes back.
+        let dir = if d < EPS_POS { -self.v.signum() } else { delta.signum() };
+        let u = self.v * dir;
+        if stops.blocks(dir) || stops.blocks(self.v.signum()) {
+            if self.v == 0.0 {
+                return None;
+            }
+            if !stops.soft {
+                return Some(Phase::jump(0.0));
+            }
+            return Some(Phase::accel(-self.v.signum() * a, self.v.abs() / a));
+        }
+        if u < -EPS_VEL {
+            // Moving away from the target: brake to zero first.
+            return Some(Phase::accel(dir * a, -u / a));
+        }
+        if self.mode == RampMode::Soft {
+            return Some(self.plan_soft(ramp, dir, u, d));
+        }
+        let brake = |s: f64| if s > vmin { (s * s - vmin * vmin) / (2.0 * a) } else { 0.0 };
+        let b = brake(u);
+        if d <= b + EPS_POS {
+            if u > vmin + EPS_VEL {
+                // Decelerate; if the target comes first (a target moved
+                // closer), pass it and come back.
+                let t_vmin = (u - vmin) / a;
+                let disc = u * u - 2.0 * a * d;
+                let t_target = if disc >= 0.0 { (u - disc.sqrt()) / a } else { f64::INFINITY };
+                if t_target < t_vmin - 1e-12 && disc > 1e-6 {
+                    return Some(Phase::accel(-dir * a, t_target));
+                }
+                return Some(Phase::accel(-dir * a, t_vmin));
+            }
+            // Creep at the stop speed for the last fraction of a step.
+            let speed = u.max(vmin);
+            if (self.v - dir * speed).abs() > EPS_VEL {
+                return Some(Phase::jump(dir * speed));
+            }
+            return Some(Phase { shape: Shape::Accel(0.0), duration: d / speed, arrives: true });
+        }
+        if u > vmax + EPS_VEL {
+            return Some(Phase::accel(-dir * a, (u - vmax) / a));
+        }
+        if u < vmax - EPS_VEL {
+            // Accelerate until vmax or the braking point, whichever first.
+            let b0 = (u * u - vmin * vmin) / (2.0 * a);
+            let s_cross = (d - b0) / 2.0;
+            let t_of = |s: f64| (-u + (u * u + 2.0 * a * s).max(0.0).sqrt()) / a;
+            if s_cross >= d {
+                return Some(Phase { shape: Shape::Accel(dir * a), duration: t_of(d), arrives: true });
+            }
+            let t = t_of(s_cross.max(0.0)).min((vmax - u) / a);
+            return Some(Phase::accel(dir * a, t));
+        }
+        // Cruise at vmax until the braking point.
+        if self.v != dir * vmax {
+            // Remove float dust from the acceleration phase.
+            return Some(Phase::jump(dir * vmax));
+        }
+        Some(Phase::accel(0.0, (d - brake(vmax)) / vmax))
+    }
+
+    /// Soft mode: ramp up with AP 5, then approach the target with a speed
+    /// proportional to the distance left (`v = k·d`, `k = a/vmax`), down
+    /// to the stop speed.
+    fn plan_soft(&self, ramp: &Ramp, dir: f64, u: f64, d: f64) -> Phase {
+        let a = ramp.accel_position;
+        let vmax = ramp.vmax;
+        let vmin = ramp.vmin.min(vmax).max(1e-3);
+        let k = a / vmax;
+        if u >= k * d - EPS_VEL {
+            if k * d <= vmin + EPS_VEL {
+                if (u - vmin).abs() > EPS_VEL {
+                    return Phase::jump(dir * vmin);
+                }
+                return Phase { shape: Shape::Accel(0.0), duration: d / vmin, arrives: true };
+            }
+            if (u - k * d).abs() > EPS_VEL {
+                return Phase::jump(dir * k * d);
+            }
+            return Phase { shape: Shape::Exponential { k }, duration: (k * d / vmin).ln() / k, arrives: false };
+        }
+        if u < vmax - EPS_VEL {
+            // u + a t = k (d − u t − a t²/2)
+            let qa = k * a / 2.0;
+            let qb = a + k * u;
+            let qc = u - k * d;
+            let t_meet = (-qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa);
+            return Phase::accel(dir * a, t_meet.min((vmax - u) / a));
+        }
+        Phase::accel(0.0, (d - vmax / k) / vmax)
+    }
+
+    /// Total time of a positioning move from rest, in closed form
+    /// (trapezoid or triangle from 0 to `vmax` and down to `vmin`).
+    pub fn closed_form_duration(distance: f64, ramp: &Ramp) -> f64 {
+        let a = ramp.accel_position;
+        let vmax = ramp.vmax;
+        let vmin = ramp.vmin.min(vmax);
+        let d = distance.abs();
+        let d_full = vmax * vmax / (2.0 * a) + (vmax * vmax - vmin * vmin) / (2.0 * a);
+        if d >= d_full {
+            vmax / a + (vmax - vmin) / a + (d - d_full) / vmax
+        } else {
+            let vp = ((2.0 * a * d + vmin * vmin) / 2.0).sqrt();
+            if vp <= vmin {
+                // The whole move is shorter than the stop-speed ramp.
+                (2.0 * d / a).sqrt()
+            } else {
+                vp / a + (vp - vmin) / a
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(vmax: f64, a: f64, vmin: f64) -> Ramp {
+        Ramp { vmax, vmin, accel_position: a, accel_velocity: a, target_velocity: 0.0 }
+    }
+
+    fn run_to_target(m: &mut Motion, r: &Ramp, step: f64) -> f64 {
+        let mut t = 0.0;
+        while !m.is_idle(r, &Stops::default()) {
+            m.advance(step, r, &mut |_| Stops::default(), &[]);
+            t += step;
+            assert!(t < 1e6, "never arrives");
+        }
+        t
+    }
+
+    #[test]
+    fn manual_unit_examples() {
+        // 6.1.1: v = 1678, pulse_div = 3 → about 51208.5 pps.
+        assert!((velocity_pps(1678.0, 3) - 51208.5).abs() < 0.1);
+        // 6.1.2: a = 100, ramp_div = 7, pulse_div = 3 → about 46566 pps².
+        assert!((accel_pps2(100.0, 7, 3) - 46566.1).abs() < 0.5);
+    }
+
+    #[test]
+    fn positioning_acceleration_is_clamped() {
+        assert_eq!(positioning_accel(1, 7, 3), 8.0); // 2^(4-1)
+        assert_eq!(positioning_accel(2047, 7, 3), 2047.0);
+        assert_eq!(positioning_accel(2047, 3, 3), 2047.0);
+        assert_eq!(positioning_accel(2047, 0, 3), 2f64.powi(9) - 1.0);
+    }
+
+    #[test]
+    fn trapezoid_duration_and_exact_arrival() {
+        let r = ramp(10_000.0, 20_000.0, 10.0);
+        let mut m = Motion { target: 51_200.0, ..Motion::default() };
+        let t = run_to_target(&mut m, &r, 0.001);
+        assert_eq!(m.x, 51_200.0);
+        let expect = Motion::closed_form_duration(51_200.0, &r);
+        assert!((t - expect).abs() <= (0.005 * expect).max(0.001) + 0.001, "{t} vs {expect}");
+    }
+
+    #[test]
+    fn triangle_and_negative_moves() {
+        let r = ramp(100_000.0, 1_000.0, 5.0);
+        let mut m = Motion { target: -300.0, ..Motion::default() };
+        let t = run_to_target(&mut m, &r, 0.0005);
+        assert_eq!(m.x, -300.0);
+        let expect = Motion::closed_form_duration(300.0, &r);
+        assert!((t - expect).abs() <= (0.005 * expect).max(0.001) + 0.0005, "{t} vs {expect}");
+    }
+
+    #[test]
+    fn one_big_advance_equals_many_small() {
+        let r = ramp(30_000.0, 50_000.0, 1.0);
+        let mut a = Motion { target: 1_000_000.0, ..Motion::default() };
+        let mut b = a.clone();
+        a.advance(12.0, &r, &mut |_| Stops::default(), &[]);
+        for _ in 0..12_000 {
+            b.advance(0.001, &r, &mut |_| Stops::default(), &[]);
+        }
+        assert!((a.x - b.x).abs() < 1e-3, "{} {}", a.x, b.x);
+        assert!((a.v - b.v).abs() < 1e-3);
+    }
+
+    #[test]
+    fn velocity_mode_ramps_to_target_speed() {
+        let mut r = ramp(1.0, 1_000.0, 1.0);
+        r.target_velocity = 5_000.0;
+        let mut m = Motion { mode: RampMode::Velocity, ..Motion::default() };
+        m.advance(2.5, &r, &mut |_| Stops::default(), &[]);
+        assert!((m.v - 2_500.0).abs() < 1e-6);
+        m.advance(10.0, &r, &mut |_| Stops::default(), &[]);
+        assert_eq!(m.v, 5_000.0);
+        r.target_velocity = 0.0;
+        m.advance(10.0, &r, &mut |_| Stops::default(), &[]);
+        assert_eq!(m.v, 0.0);
+    }
+
+    #[test]
+    fn hard_stop_at_switch_position() {
+        let mut r = ramp(1.0, 1_000.0, 1.0);
+        r.target_velocity = 2_000.0;
+        let mut m = Motion { mode: RampMode::Velocity, ..Motion::default() };
+        let mut stops = |x: f64| Stops { block_positive: x >= 5_000.0, block_negative: false, soft: false };
+        m.advance(100.0, &r, &mut stops, &[5_000.0]);
+        assert_eq!(m.x, 5_000.0);
+        assert_eq!(m.v, 0.0);
+        assert!(m.stopped_by_switch);
+    }
+
+    #[test]
+    fn soft_mode_reaches_target_exactly() {
+        let r = ramp(10_000.0, 20_000.0, 10.0);
+        let mut m = Motion { target: 40_000.0, mode: RampMode::Soft, ..Motion::default() };
+        let t = run_to_target(&mut m, &r, 0.01);
+        assert_eq!(m.x, 40_000.0);
+        // Slower than the linear ramp, but finite.
+        assert!(t > Motion::closed_form_duration(40_000.0, &r));
+    }
+}

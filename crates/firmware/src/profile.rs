@@ -1,0 +1,401 @@
+//! Module profiles: the data that makes a TMCM-1141 a TMCM-1141.
+//!
+//! A profile is loaded from a TOML file (`profiles/*.toml`, schema in
+//! `profiles/README.md`) and indexed for constant-time lookups by the
+//! executor. The built-in profiles are compiled into the binary.
+
+use serde::Deserialize;
+use std::sync::Arc;
+
+/// Access letters of the manuals' parameter tables.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Access {
+    /// R: GAP/GGP.
+    pub read: bool,
+    /// W: SAP/AAP, SGP/AGP.
+    pub write: bool,
+    /// E: STAP/RSAP, STGP/RSGP.
+    pub eeprom: bool,
+    /// A: stored in the EEPROM automatically by SGP.
+    pub auto: bool,
+}
+
+impl Access {
+    pub fn parse(text: &str) -> Result<Access, String> {
+        let mut a = Access::default();
+        for c in text.chars() {
+            match c {
+                'R' => a.read = true,
+                'W' => a.write = true,
+                'E' => a.eeprom = true,
+                'A' => a.auto = true,
+                _ => return Err(format!("unknown access letter '{c}' in \"{text}\"")),
+            }
+        }
+        Ok(a)
+    }
+}
+
+impl std::fmt::Display for Access {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (on, c) in [(self.read, 'R'), (self.write, 'W'), (self.eeprom, 'E'), (self.auto, 'A')] {
+            if on {
+                write!(f, "{c}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Whether a default value comes from the manual or was chosen by us.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DefaultSource {
+    Manual,
+    Assumed,
+}
+
+/// One axis or global parameter (or a run of them, for user variables).
+#[derive(Clone, Debug)]
+pub struct Parameter {
+    pub number: u8,
+    pub name: String,
+    pub access: Access,
+    pub min: i64,
+    pub max: i64,
+    pub default: i64,
+    pub default_source: DefaultSource,
+    pub unit: Option<String>,
+    pub note: Option<String>,
+}
+
+impl Parameter {
+    /// Checks a wire value against the range. Ranges above 2^31−1 (the
+    /// timer periods of bank 3) read the 32 bits as unsigned.
+    pub fn accepts(&self, value: i32) -> bool {
+        let v = if self.max > i32::MAX as i64 { value as u32 as i64 } else { value as i64 };
+        (self.min..=self.max).contains(&v)
+    }
+
+    /// The default as the 32-bit word the module holds.
+    pub fn default_word(&self) -> i32 {
+        self.default as i32
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PortDirection {
+    Input,
+    Output,
+    Pullup,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Port {
+    pub direction: PortDirection,
+    pub bank: u8,
+    pub number: u8,
+    pub name: String,
+    pub min: i64,
+    pub max: i64,
+    #[serde(default)]
+    pub default: i64,
+    #[serde(default)]
+    pub unit: Option<String>,
+    #[serde(default)]
+    pub note: Option<String>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Interrupt {
+    pub number: u8,
+    pub name: String,
+    pub symbol: String,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModuleInfo {
+    pub name: String,
+    pub type_number: u16,
+    pub firmware: [u8; 2],
+    pub axes: u8,
+    pub position_bits: u8,
+    pub motion_controller: String,
+    pub program_memory: u16,
+    #[serde(default)]
+    pub program_memory_source: Option<String>,
+    pub user_variables: u16,
+    pub user_variables_stored: u16,
+    pub coordinates: u8,
+    pub opcodes: Vec<u8>,
+    #[serde(default)]
+    pub ascii_opcodes: Vec<u8>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParameterRow {
+    #[serde(default)]
+    bank: Option<u8>,
+    number: u8,
+    #[serde(default)]
+    last: Option<u8>,
+    name: String,
+    access: String,
+    min: i64,
+    max: i64,
+    default: i64,
+    default_source: DefaultSource,
+    #[serde(default)]
+    unit: Option<String>,
+    #[serde(default)]
+    source: Option<String>,
+    #[serde(default)]
+    note: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProfileFile {
+    module: ModuleInfo,
+    axis_parameter: Vec<ParameterRow>,
+    global_parameter: Vec<ParameterRow>,
+    #[serde(default)]
+    port: Vec<Port>,
+    #[serde(default)]
+    interrupt: Vec<Interrupt>,
+}
+
+/// Number of global parameter banks (0…3).
+pub const BANKS: usize = 4;
+
+/// A loaded, indexed module profile.
+#[derive(Debug)]
+pub struct Profile {
+    pub module: ModuleInfo,
+    axis: Vec<Option<Parameter>>,
+    global: [Vec<Option<Parameter>>; BANKS],
+    pub ports: Vec<Port>,
+    pub interrupts: Vec<Interrupt>,
+    opcode_set: [bool; 256],
+    ascii_set: [bool; 256],
+}
+
+/// The profiles compiled into tmclsim: (name, TOML text).
+pub const BUILT_IN: &[(&str, &str)] = &[("tmcm-1141", include_str!("../../../profiles/tmcm-1141.toml"))];
+
+impl Profile {
+    /// Parses and checks a profile.
+    pub fn from_toml(text: &str) -> Result<Profile, String> {
+        let file: ProfileFile = toml::from_str(text).map_err(|e| e.to_string())?;
+        let mut axis: Vec<Option<Parameter>> = vec![None; 256];
+        let mut global: [Vec<Option<Parameter>>; BANKS] = std::array::from_fn(|_| vec![None; 256]);
+        let expand = |row: &ParameterRow, table: &mut Vec<Option<Parameter>>| -> Result<(), String> {
+            let access = Access::parse(&row.access)?;
+            if !(row.min..=row.max).contains(&row.default) {
+                return Err(format!("parameter {} ({}): default {} outside {}…{}", row.number, row.name, row.default, row.min, row.max));
+            }
+            let _ = &row.source;
+            for n in row.number..=row.last.unwrap_or(row.number) {
+                if table[n as usize].is_some() {
+                    return Err(format!("parameter {n} ({}) is defined twice", row.name));
+                }
+                table[n as usize] = Some(Parameter {
+                    number: n,
+                    name: row.name.clone(),
+                    access,
+                    min: row.min,
+                    max: row.max,
+                    default: row.default,
+                    default_source: row.default_source,
+                    unit: row.unit.clone(),
+                    note: row.note.clone(),
+                });
+            }
+            Ok(())
+        };
+        for row in &file.axis_parameter {
+            expand(row, &mut axis)?;
+        }
+        for row in &file.global_parameter {
+            let bank = row.bank.ok_or_else(|| format!("global parameter {} has no bank", row.number))? as usize;
+            if bank >= BANKS {
+                return Err(format!("global parameter {}: bank {bank} does not exist", row.number));
+            }
+            expand(row, &mut global[bank])?;
+        }
+        let mut opcode_set = [false; 256];
+        for &o in &file.module.opcodes {
+            opcode_set[o as usize] = true;
+        }
+        let mut ascii_set = [false; 256];
+        for &o in &file.module.ascii_opcodes {
+            ascii_set[o as usize] = true;
+        }
+        if file.module.axes == 0 {
+            return Err("a module has at least one axis".into());
+        }
+        Ok(Profile {
+            module: file.module,
+            axis,
+            global,
+            ports: file.port,
+            interrupts: file.interrupt,
+            opcode_set,
+            ascii_set,
+        })
+    }
+
+    /// A built-in profile by name (`tmcm-1141`, case-insensitive, the
+    /// `tmcm-` prefix optional).
+    pub fn built_in(name: &str) -> Result<Arc<Profile>, String> {
+        let key = name.to_ascii_lowercase();
+        let key = if key.starts_with("tmcm-") { key } else { format!("tmcm-{key}") };
+        let (_, text) = BUILT_IN
+            .iter()
+            .find(|(n, _)| *n == key)
+            .ok_or_else(|| format!("no built-in profile '{name}' (known: {})", Profile::names().join(", ")))?;
+        Profile::from_toml(text).map(Arc::new).map_err(|e| format!("profile {key}: {e}"))
+    }
+
+    pub fn names() -> Vec<&'static str> {
+        BUILT_IN.iter().map(|(n, _)| *n).collect()
+    }
+
+    pub fn axis_parameter(&self, number: u8) -> Option<&Parameter> {
+        self.axis[number as usize].as_ref()
+    }
+
+    pub fn global_parameter(&self, bank: u8, number: u8) -> Option<&Parameter> {
+        self.global.get(bank as usize)?[number as usize].as_ref()
+    }
+
+    pub fn axis_parameters(&self) -> impl Iterator<Item = &Parameter> {
+        self.axis.iter().flatten()
+    }
+
+    pub fn global_parameters(&self, bank: u8) -> impl Iterator<Item = &Parameter> {
+        self.global.get(bank as usize).into_iter().flatten().flatten()
+    }
+
+    /// Whether the bank exists on this module (has any parameter).
+    pub fn has_bank(&self, bank: u8) -> bool {
+        self.global_parameters(bank).next().is_some()
+    }
+
+    pub fn has_opcode(&self, opcode: u8) -> bool {
+        self.opcode_set[opcode as usize]
+    }
+
+    pub fn ascii_allows(&self, opcode: u8) -> bool {
+        self.ascii_set[opcode as usize]
+    }
+
+    pub fn port(&self, direction: PortDirection, bank: u8, number: u8) -> Option<&Port> {
+        self.ports.iter().find(|p| p.direction == direction && p.bank == bank && p.number == number)
+    }
+
+    pub fn interrupt(&self, number: u8) -> Option<&Interrupt> {
+        self.interrupts.iter().find(|i| i.number == number)
+    }
+
+    /// Looks an axis parameter up by name (case-insensitive).
+    pub fn axis_parameter_named(&self, name: &str) -> Option<&Parameter> {
+        self.axis_parameters().find(|p| p.name.eq_ignore_ascii_case(name))
+    }
+
+    /// `1141V146` style version text for 136 type 0.
+    pub fn version_text(&self) -> [u8; 8] {
+        let s = format!("{:04}V{}{:02}", self.module.type_number % 10000, self.module.firmware[0] % 10, self.module.firmware[1] % 100);
+        let mut out = [b'0'; 8];
+        out.copy_from_slice(&s.as_bytes()[..8]);
+        out
+    }
+
+    /// 136 type 1 value: `[type high][type low][major][minor]`.
+    pub fn version_word(&self) -> i32 {
+        ((self.module.type_number as u32) << 16 | (self.module.firmware[0] as u32) << 8 | self.module.firmware[1] as u32) as i32
+    }
+
+    /// Position counter mask for modules with 24-bit positions.
+    pub fn position_bits(&self) -> u32 {
+        self.module.position_bits as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tmcm_1141_profile_loads_with_every_table_row() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        assert_eq!(p.module.axes, 1);
+        // Table 16 has 59 rows.
+        assert_eq!(p.axis_parameters().count(), 59);
+        for n in [0u8, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 130, 135, 138, 140, 149, 150, 153, 154, 193, 194, 195, 196, 197, 200, 204, 206, 207, 208, 214, 254] {
+            assert!(p.axis_parameter(n).is_some(), "AP {n}");
+        }
+        for n in 160..=184 {
+            assert!(p.axis_parameter(n).is_some(), "AP {n}");
+        }
+        assert!(p.axis_parameter(14).is_none());
+        // Table 18.
+        for n in [65u8, 66, 67, 68, 75, 76, 77, 79, 81, 84, 85, 87, 90, 128, 129, 130, 132, 133, 255] {
+            assert!(p.global_parameter(0, n).is_some(), "GP {n}");
+        }
+        assert_eq!(p.global_parameters(2).count(), 256);
+        assert!(p.global_parameter(2, 55).unwrap().access.eeprom);
+        assert!(!p.global_parameter(2, 56).unwrap().access.eeprom);
+        for n in [0u8, 1, 2, 27, 28, 39, 40, 41, 42] {
+            assert!(p.global_parameter(3, n).is_some(), "bank 3 {n}");
+        }
+        assert!(!p.has_bank(1));
+        assert_eq!(p.interrupts.len(), 12);
+    }
+
+    #[test]
+    fn manual_defaults_and_access() {
+        let p = Profile::built_in("1141").unwrap();
+        let ap = |n| p.axis_parameter(n).unwrap();
+        assert_eq!(ap(130).default, 1);
+        assert_eq!(ap(214).default, 200);
+        assert_eq!(ap(140).default, 8);
+        assert_eq!(ap(140).default_source, DefaultSource::Manual);
+        assert_eq!(ap(4).access.to_string(), "RWE");
+        assert_eq!(ap(3).access.to_string(), "R");
+        assert_eq!(p.global_parameter(0, 66).unwrap().access.to_string(), "RWA");
+        assert_eq!(p.global_parameter(0, 65).unwrap().default, 0);
+        assert_eq!(p.global_parameter(0, 77).unwrap().default, 0);
+    }
+
+    #[test]
+    fn version_encodings() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        assert_eq!(&p.version_text(), b"1141V146");
+        assert_eq!(p.version_word(), 0x0475012E);
+    }
+
+    #[test]
+    fn unsigned_ranges() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        let timer = p.global_parameter(3, 0).unwrap();
+        assert!(timer.accepts(-1)); // 4294967295
+        let speed = p.axis_parameter(4).unwrap();
+        assert!(!speed.accepts(0));
+        assert!(speed.accepts(2047));
+        assert!(!speed.accepts(2048));
+    }
+
+    #[test]
+    fn bad_profiles_are_rejected_with_a_reason() {
+        assert!(Profile::from_toml("nonsense").is_err());
+        let base = BUILT_IN[0].1;
+        let dup = format!("{base}\n[[axis_parameter]]\nnumber = 4\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\ndefault_source = \"assumed\"\n");
+        assert!(Profile::from_toml(&dup).unwrap_err().contains("twice"));
+    }
+}

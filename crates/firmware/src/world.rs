@@ -1,0 +1,95 @@
+//! The simulated world around a module: stop and home switches along each
+//! axis, the module's inputs and its supply.
+//!
+//! Positions are mechanical: what the carriage sees. The motor position
+//! counter and the mechanical position differ by an offset that changes
+//! when the host overwrites the actual position or the module restarts
+//! (the carriage does not move when the counter is reset).
+
+/// Switches along one axis.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AxisWorld {
+    /// The left stop switch is pressed at or below this position.
+    pub left_switch: Option<f64>,
+    /// The right stop switch is pressed at or above this position.
+    pub right_switch: Option<f64>,
+    /// The home switch is pressed between these positions (inclusive).
+    pub home_switch: Option<(f64, f64)>,
+    /// Levels driven by hand; they override the positions above.
+    pub forced_left: Option<bool>,
+    pub forced_right: Option<bool>,
+    pub forced_home: Option<bool>,
+}
+
+impl AxisWorld {
+    pub fn left_pressed(&self, mech: f64) -> bool {
+        self.forced_left.unwrap_or_else(|| self.left_switch.is_some_and(|p| mech <= p))
+    }
+
+    pub fn right_pressed(&self, mech: f64) -> bool {
+        self.forced_right.unwrap_or_else(|| self.right_switch.is_some_and(|p| mech >= p))
+    }
+
+    pub fn home_pressed(&self, mech: f64) -> bool {
+        self.forced_home.unwrap_or_else(|| self.home_switch.is_some_and(|(a, b)| mech >= a && mech <= b))
+    }
+
+    /// Mechanical positions where a switch changes state.
+    pub fn thresholds(&self) -> impl Iterator<Item = f64> + '_ {
+        let home = self.home_switch.map(|(a, b)| [a, b]);
+        self.left_switch.into_iter().chain(self.right_switch).chain(home.into_iter().flatten())
+    }
+}
+
+/// Everything outside the module that it senses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct World {
+    pub axes: Vec<AxisWorld>,
+    /// Digital input levels, bit n = input n.
+    pub digital_inputs: u32,
+    /// ADC readings (0…4095) by analog input number.
+    pub analog_inputs: Vec<u16>,
+    /// Supply voltage in 0.1 V.
+    pub supply_decivolts: u16,
+}
+
+impl World {
+    /// A world with free axes (no switches), inputs low and 24 V supply.
+    pub fn free(axes: usize) -> World {
+        World { axes: vec![AxisWorld::default(); axes], digital_inputs: 0, analog_inputs: vec![0; 8], supply_decivolts: 240 }
+    }
+
+    pub fn digital(&self, n: u8) -> bool {
+        n < 32 && self.digital_inputs & (1 << n) != 0
+    }
+
+    /// Drives a digital input; an input that is also analog follows
+    /// (low = 0, high = 4095).
+    pub fn set_digital(&mut self, n: u8, high: bool) {
+        if n < 32 {
+            if high {
+                self.digital_inputs |= 1 << n;
+            } else {
+                self.digital_inputs &= !(1 << n);
+            }
+        }
+        if let Some(a) = self.analog_inputs.get_mut(n as usize) {
+            *a = if high { 4095 } else { 0 };
+        }
+    }
+
+    /// Sets an analog input; the same line read digitally is high from
+    /// half scale up.
+    pub fn set_analog(&mut self, n: u8, value: u16) {
+        if let Some(a) = self.analog_inputs.get_mut(n as usize) {
+            *a = value.min(4095);
+        }
+        if n < 32 {
+            if value >= 2048 {
+                self.digital_inputs |= 1 << n;
+            } else {
+                self.digital_inputs &= !(1 << n);
+            }
+        }
+    }
+}
