@@ -433,7 +433,7 @@ impl Module {
         let axis = &mut self.axes[m];
         axis.target_word = target;
         axis.params[ap::TARGET_POSITION as usize] = target;
-        axis.motion.target = axis.motion.x.round() + diff as f64;
+        axis.motion.target = axis.motion.position() as f64 + diff as f64;
     }
 
     /// Sign-extends to the module's position width (32 or 24 bits).
@@ -444,7 +444,7 @@ impl Module {
     }
 
     pub(crate) fn actual_position(&self, m: usize) -> i32 {
-        self.wrap_position(self.axes[m].motion.x.round() as i64)
+        self.wrap_position(self.axes[m].motion.position())
     }
 
     // ----- axis parameters ----------------------------------------------

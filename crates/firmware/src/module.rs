@@ -517,7 +517,7 @@ impl Module {
         let thresholds: Vec<f64> = self.world.axes[motor].thresholds().map(|m| (m - offset) * sign).collect();
         let was_moving = self.axes[motor].motion.v != 0.0;
         let mut motion = std::mem::take(&mut self.axes[motor].motion);
-        let arrived = {
+        let step = {
             let mut stops = |x: f64| self.stops_at(motor, x);
             motion.advance(dt_ns as f64 * 1e-9, &ramp, &mut stops, &thresholds)
         };
@@ -526,10 +526,12 @@ impl Module {
         axis.motion = motion;
         if moving {
             axis.standstill_since = None;
+        } else if let Some(t) = step.stopped_at {
+            axis.standstill_since = Some(self.now_ns + (t * 1e9) as u64);
         } else if was_moving || axis.standstill_since.is_none() {
-            axis.standstill_since = Some(self.now_ns + dt_ns);
+            axis.standstill_since = Some(self.now_ns);
         }
-        if arrived && axis.notify_on_arrival {
+        if step.arrived && axis.notify_on_arrival {
             axis.notify_on_arrival = false;
             self.push_event(1 << motor);
         }

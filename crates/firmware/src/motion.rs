@@ -41,6 +41,33 @@ pub fn positioning_accel(a: u32, ramp_div: u32, pulse_div: u32) -> f64 {
     (a as f64).clamp(lower.min(upper), upper)
 }
 
+/// Sign of a velocity or distance: −1, 0 or +1 (`f64::signum` gives +1
+/// for 0).
+trait Sgn {
+    fn sgn(self) -> f64;
+}
+
+impl Sgn for f64 {
+    fn sgn(self) -> f64 {
+        if self > 0.0 {
+            1.0
+        } else if self < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    }
+}
+
+/// What happened during one `advance`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Step {
+    /// The motor arrived on its target.
+    pub arrived: bool,
+    /// Seconds into the step at which the motor came to rest (if it did).
+    pub stopped_at: Option<f64>,
+}
+
 /// AP 138.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RampMode {
@@ -155,10 +182,10 @@ impl Motion {
 
     /// Advances by `dt` seconds. `thresholds` are positions (in the space
     /// of `x`) where a switch changes state; a phase ends there so that the
-    /// caller can re-evaluate the switches. Returns `true` when the motor
-    /// arrived on its target during this call.
-    pub fn advance(&mut self, mut dt: f64, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops, thresholds: &[f64]) -> bool {
-        let mut arrived = false;
+    /// caller can re-evaluate the switches.
+    pub fn advance(&mut self, mut dt: f64, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops, thresholds: &[f64]) -> Step {
+        let mut step = Step::default();
+        let mut elapsed = 0.0;
         for _ in 0..MAX_PHASES {
             if dt <= 0.0 {
                 break;
@@ -178,12 +205,14 @@ impl Motion {
                     }
                 }
             }
+            let was_moving = self.v != 0.0;
             self.integrate(phase.shape, t);
             dt -= t;
+            elapsed += t;
             if let Some(th) = crossing {
                 self.x = th;
                 let s = stops(self.x);
-                if !s.soft && s.blocks(self.v.signum()) {
+                if !s.soft && s.blocks(self.v.sgn()) {
                     self.v = 0.0;
                     self.stopped_by_switch = true;
                 }
@@ -191,13 +220,29 @@ impl Motion {
                 self.x = self.target;
                 self.v = 0.0;
                 self.a = 0.0;
-                arrived = true;
+                step.arrived = true;
+            }
+            if was_moving && self.v == 0.0 {
+                step.stopped_at = Some(elapsed);
             }
         }
         if self.v != 0.0 {
             self.stopped_by_switch = false;
+            step.stopped_at = None;
         }
-        arrived
+        step
+    }
+
+    /// The position counter: the steps made so far (rounded towards where
+    /// the motor comes from while it moves).
+    pub fn position(&self) -> i64 {
+        if self.v > 0.0 {
+            (self.x + 1e-9).floor() as i64
+        } else if self.v < 0.0 {
+            (self.x - 1e-9).ceil() as i64
+        } else {
+            self.x.round() as i64
+        }
     }
 
     fn integrate(&mut self, shape: Shape, t: f64) {
@@ -275,7 +320,7 @@ impl Motion {
     fn plan_velocity(&self, ramp: &Ramp, stops: &Stops) -> Option<Phase> {
         let a = ramp.accel_velocity;
         let mut vt = ramp.target_velocity;
-        if stops.blocks(vt.signum()) || stops.blocks(self.v.signum()) {
+        if stops.blocks(vt.sgn()) || stops.blocks(self.v.sgn()) {
             if self.v != 0.0 && !stops.soft {
                 // A hard stop happens at the crossing; arriving here means
                 // the switch was already active: stop dead.
@@ -290,7 +335,7 @@ impl Motion {
             }
             return if vt == 0.0 { None } else { Some(Phase::accel(0.0, f64::INFINITY)) };
         }
-        Some(Phase::accel(a * dv.signum(), dv.abs() / a))
+        Some(Phase::accel(a * dv.sgn(), dv.abs() / a))
     }
 
     fn plan_position(&self, ramp: &Ramp, stops: &Stops) -> Option<Phase> {
@@ -307,16 +352,16 @@ impl Motion {
         }
         // Direction towards the target; at the target with speed, the
         // motor overshoots and comes back.
-        let dir = if d < EPS_POS { -self.v.signum() } else { delta.signum() };
+        let dir = if d < EPS_POS { -self.v.sgn() } else { delta.sgn() };
         let u = self.v * dir;
-        if stops.blocks(dir) || stops.blocks(self.v.signum()) {
+        if stops.blocks(dir) || stops.blocks(self.v.sgn()) {
             if self.v == 0.0 {
                 return None;
             }
             if !stops.soft {
                 return Some(Phase::jump(0.0));
             }
-            return Some(Phase::accel(-self.v.signum() * a, self.v.abs() / a));
+            return Some(Phase::accel(-self.v.sgn() * a, self.v.abs() / a));
         }
         if u < -EPS_VEL {
             // Moving away from the target: brake to zero first.
