@@ -1,3 +1,128 @@
-fn main() {
-    println!("Hello, world!");
+//! `tmclsim`: serve virtual TMCL modules, talk to real or virtual ones.
+
+use clap::{Args, Parser, Subcommand};
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+mod send;
+mod serve;
+
+#[derive(Parser)]
+#[command(name = "tmclsim", version, about = "Virtual Trinamic TMCL modules and the open TMCL toolchain")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Serve a virtual module on TCP and/or a pty until interrupted.
+    Serve(ServeArgs),
+    /// Send one command to a TMCL module (real or virtual) and print the reply.
+    Send(SendArgs),
+    /// List a module profile: every parameter with access, range and default.
+    Profile(ProfileArgs),
+}
+
+#[derive(Args)]
+pub struct ServeArgs {
+    /// Module profile to serve.
+    #[arg(long, default_value = "tmcm-1141")]
+    pub module: String,
+    /// Listen for TCP clients on this address (loopback by default). Without
+    /// --tcp and --pty both are served, TCP on 127.0.0.1:1141.
+    #[arg(long, value_name = "ADDR")]
+    pub tcp: Option<SocketAddr>,
+    /// Create a pty and a symlink to it at PATH, opened like a serial port.
+    /// Without --tcp and --pty both are served, the pty at
+    /// $TMPDIR/tmclsim-<module>.
+    #[arg(long, value_name = "PATH")]
+    pub pty: Option<PathBuf>,
+    /// Keep the EEPROM in FILE across runs (created if missing; written
+    /// atomically). Without it the module starts from factory defaults.
+    #[arg(long, value_name = "FILE")]
+    pub eeprom: Option<PathBuf>,
+    /// Module address (GP 66) to start with.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=255))]
+    pub address: Option<u8>,
+    /// Drop a partial frame after this many milliseconds without a byte.
+    #[arg(long, value_name = "MS", default_value_t = 5)]
+    pub inter_byte_timeout: u64,
+    /// Most TCP clients served at once.
+    #[arg(long, value_name = "N", default_value_t = 64)]
+    pub max_connections: usize,
+}
+
+#[derive(Args)]
+pub struct SendArgs {
+    /// TCP address of the module (a tmclsim server or a serial-to-Ethernet bridge).
+    #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
+    pub tcp: Option<String>,
+    /// Serial port of the module (e.g. /dev/ttyACM0, or a tmclsim pty).
+    #[arg(long, value_name = "DEV")]
+    pub port: Option<String>,
+    /// Baud rate for --port.
+    #[arg(long, default_value_t = 9600)]
+    pub baud: u32,
+    /// Module address.
+    #[arg(long, default_value_t = 1)]
+    pub address: u8,
+    /// How long to wait for the reply, in milliseconds.
+    #[arg(long, value_name = "MS", default_value_t = 1000)]
+    pub timeout: u64,
+    /// The command: a mnemonic (`GAP 1, 0`, `MVP ABS, 0, 51200`) or a raw
+    /// instruction `#OPCODE TYPE MOTOR VALUE` (e.g. `#136 0 0 0`).
+    #[arg(required = true, num_args = 1.., value_name = "COMMAND")]
+    pub command: Vec<String>,
+}
+
+#[derive(Args)]
+struct ProfileArgs {
+    /// Module profile name (tmcm-1141).
+    #[arg(default_value = "tmcm-1141")]
+    module: String,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Serve(a) => serve::run(a),
+        Command::Send(a) => send::run(a),
+        Command::Profile(a) => profile(&a.module),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("tmclsim: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn profile(name: &str) -> Result<ExitCode, String> {
+    let p = tmclsim_firmware::Profile::built_in(name)?;
+    println!("{}: {} axis(es), {} program words, firmware V{}.{:02}", p.module.name, p.module.axes, p.module.program_memory, p.module.firmware[0], p.module.firmware[1]);
+    println!("\nAxis parameters (* = default assumed, not stated by the manual)");
+    for q in p.axis_parameters() {
+        let mark = if q.default_source == tmclsim_firmware::profile::DefaultSource::Assumed { "*" } else { " " };
+        println!("  {:>3}  {:<4} {:>11}…{:<11} {:>11}{mark} {}", q.number, q.access.to_string(), q.min, q.max, q.default, q.name);
+    }
+    for bank in 0..4u8 {
+        let rows: Vec<_> = p.global_parameters(bank).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        println!("\nGlobal parameters, bank {bank}");
+        for q in rows {
+            let mark = if q.default_source == tmclsim_firmware::profile::DefaultSource::Assumed { "*" } else { " " };
+            println!("  {:>3}  {:<4} {:>11}…{:<11} {:>11}{mark} {}", q.number, q.access.to_string(), q.min, q.max, q.default, q.name);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+pub(crate) fn millis(ms: u64) -> Duration {
+    Duration::from_millis(ms)
 }

@@ -492,21 +492,9 @@ impl Module {
     }
 
     fn time_to_rest(&self, motor: usize) -> Option<f64> {
-        let mut probe = self.axes[motor].motion.clone();
         let ramp = self.ramp(motor);
-        let mut total = 0.0;
-        // Walk in growing steps; the motion model is exact for any step.
-        let mut step = 0.001;
-        for _ in 0..60 {
-            if probe.is_idle(&ramp, &self.stops_at(motor, probe.x)) {
-                return Some(total);
-            }
-            let mut stops = |x: f64| self.stops_at(motor, x);
-            probe.advance(step, &ramp, &mut stops, &[]);
-            total += step;
-            step *= 1.5;
-        }
-        None
+        let mut stops = |x: f64| self.stops_at(motor, x);
+        self.axes[motor].motion.time_to_rest(&ramp, &mut stops)
     }
 
     fn advance_axis(&mut self, motor: usize, dt_ns: u64) {

@@ -233,6 +233,28 @@ impl Motion {
         step
     }
 
+    /// Seconds until the motor comes to rest (on its target, or stopped
+    /// for good), if it will; walks the planned phases without moving.
+    pub fn time_to_rest(&self, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops) -> Option<f64> {
+        let mut probe = self.clone();
+        let mut total = 0.0;
+        for _ in 0..MAX_PHASES {
+            let s = stops(probe.x);
+            let Some(phase) = probe.plan(ramp, &s) else {
+                return Some(total);
+            };
+            if !phase.duration.is_finite() {
+                return None;
+            }
+            probe.integrate(phase.shape, phase.duration);
+            total += phase.duration;
+            if phase.arrives {
+                return Some(total);
+            }
+        }
+        None
+    }
+
     /// The position counter: the steps made so far (rounded towards where
     /// the motor comes from while it moves).
     pub fn position(&self) -> i64 {

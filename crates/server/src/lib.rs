@@ -1,14 +1,172 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
+//! Serving virtual modules on real links: TCP and a pty that host software
+//! opens like the module's serial port.
+//!
+//! A server is request → response: bytes arrive on a link, the serial
+//! framing turns them into frames, the module answers, the reply goes back
+//! on the same link. Virtual time is paced by the wall clock; a clock task
+//! wakes only when the module has something to do on its own (a 138 event,
+//! a heartbeat stop), so an idle server uses no CPU.
+
+mod clock;
+mod link;
+mod pty;
+mod shared;
+mod tcp;
+
+pub use shared::SharedModule;
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+use tmclsim_firmware::Module;
+use tokio::sync::watch;
+
+/// What to serve and where.
+#[derive(Clone, Debug)]
+pub struct ServerConfig {
+    /// TCP address to listen on (loopback by default).
+    pub tcp: Option<SocketAddr>,
+    /// Path of the symlink to the pty's serial device.
+    pub pty: Option<PathBuf>,
+    /// EEPROM file; written atomically on every EEPROM change.
+    pub eeprom: Option<PathBuf>,
+    /// A partial frame is dropped after this gap between two bytes.
+    pub inter_byte_timeout: Duration,
+    /// Most TCP clients at once; more are refused with a log line.
+    pub max_connections: usize,
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
+impl Default for ServerConfig {
+    fn default() -> Self {
+        ServerConfig {
+            tcp: None,
+            pty: None,
+            eeprom: None,
+            inter_byte_timeout: Duration::from_millis(5),
+            max_connections: 64,
+        }
     }
+}
+
+/// The endpoints a running server listens on.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Endpoints {
+    pub tcp: Option<SocketAddr>,
+    /// The symlink a host opens, and the pty device it points to.
+    pub pty: Option<(PathBuf, PathBuf)>,
+}
+
+impl Endpoints {
+    /// A PyTrinamic `ConnectionManager` argument string for the first
+    /// endpoint (TCP preferred).
+    pub fn pytrinamic_args(&self) -> Option<String> {
+        if let Some(addr) = self.tcp {
+            return Some(format!("--interface socket_serial_tmcl --port {addr}"));
+        }
+        self.pty.as_ref().map(|(link, _)| format!("--interface serial_tmcl --port {}", link.display()))
+    }
+}
+
+/// A server running on its own thread; dropping it stops it.
+pub struct ServerHandle {
+    endpoints: Endpoints,
+    module: Arc<SharedModule>,
+    stop: watch::Sender<bool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl ServerHandle {
+    pub fn endpoints(&self) -> &Endpoints {
+        &self.endpoints
+    }
+
+    /// The served module (lock it to inspect or change the world).
+    pub fn module(&self) -> &Arc<SharedModule> {
+        &self.module
+    }
+
+    /// Stops serving, closes the links and removes the pty symlink.
+    pub fn stop(mut self) {
+        self.shutdown();
+    }
+
+    fn shutdown(&mut self) {
+        let _ = self.stop.send(true);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+        if let Some((link, _)) = &self.endpoints.pty {
+            let _ = std::fs::remove_file(link);
+        }
+    }
+
+    /// Blocks until the server stops (it runs until stopped).
+    pub fn wait(mut self) {
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Drop for ServerHandle {
+    fn drop(&mut self) {
+        self.shutdown();
+    }
+}
+
+/// Starts serving `module` in a background thread.
+pub fn start(module: Module, config: ServerConfig) -> std::io::Result<ServerHandle> {
+    let shared = Arc::new(SharedModule::new(module, config.eeprom.clone()));
+    let (stop_tx, stop_rx) = watch::channel(false);
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel::<std::io::Result<Endpoints>>();
+    let thread_shared = shared.clone();
+    let thread = std::thread::Builder::new().name("tmclsim-server".into()).spawn(move || {
+        let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
+            Ok(rt) => rt,
+            Err(e) => {
+                let _ = ready_tx.send(Err(e));
+                return;
+            }
+        };
+        rt.block_on(async move {
+            let setup = async {
+                let tcp = match config.tcp {
+                    Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
+                    None => None,
+                };
+                let pty = match &config.pty {
+                    Some(path) => Some(pty::Pty::open(path)?),
+                    None => None,
+                };
+                Ok::<_, std::io::Error>((tcp, pty))
+            };
+            let (tcp, pty) = match setup.await {
+                Ok(v) => v,
+                Err(e) => {
+                    let _ = ready_tx.send(Err(e));
+                    return;
+                }
+            };
+            let endpoints = Endpoints {
+                tcp: tcp.as_ref().and_then(|l| l.local_addr().ok()),
+                pty: pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
+            };
+            let _ = ready_tx.send(Ok(endpoints));
+            let mut tasks = tokio::task::JoinSet::new();
+            tasks.spawn(clock::run(thread_shared.clone(), stop_rx.clone()));
+            if let Some(listener) = tcp {
+                tasks.spawn(tcp::run(listener, thread_shared.clone(), config.clone(), stop_rx.clone()));
+            }
+            if let Some(p) = pty {
+                tasks.spawn(pty::run(p, thread_shared.clone(), config.clone(), stop_rx.clone()));
+            }
+            let mut stop = stop_rx.clone();
+            let _ = stop.wait_for(|s| *s).await;
+            tasks.abort_all();
+            while tasks.join_next().await.is_some() {}
+        });
+    })?;
+    let endpoints = ready_rx.recv().map_err(|_| std::io::Error::other("server thread ended early"))??;
+    Ok(ServerHandle { endpoints, module: shared, stop: stop_tx, thread: Some(thread) })
 }

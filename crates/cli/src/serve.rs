@@ -1,0 +1,86 @@
+//! `tmclsim serve`.
+
+use crate::ServeArgs;
+use std::process::ExitCode;
+use tmclsim_firmware::{Eeprom, Module, Profile};
+use tmclsim_server::ServerConfig;
+
+pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
+    let profile = Profile::built_in(&args.module)?;
+    let key = profile.module.name.to_ascii_lowercase();
+    let (tcp, pty) = match (args.tcp, args.pty) {
+        (None, None) => (Some("127.0.0.1:1141".parse().unwrap()), Some(std::env::temp_dir().join(format!("tmclsim-{key}")))),
+        other => other,
+    };
+    let (module, eeprom_note) = match &args.eeprom {
+        Some(path) => match Eeprom::load(path)? {
+            Some(image) => {
+                if image.module != profile.module.name {
+                    return Err(format!("{} holds the EEPROM of a {}, not of a {}", path.display(), image.module, profile.module.name));
+                }
+                (Module::with_eeprom(profile.clone(), image), format!("restored from {}", path.display()))
+            }
+            None => (Module::new(profile.clone()), format!("factory defaults; changes are kept in {} (new)", path.display())),
+        },
+        None => (Module::new(profile.clone()), "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
+    };
+    let mut module = module;
+    if let Some(a) = args.address {
+        module.set_address(a);
+    }
+    let address = module.address();
+    let config = ServerConfig {
+        tcp,
+        pty,
+        eeprom: args.eeprom.clone(),
+        inter_byte_timeout: crate::millis(args.inter_byte_timeout),
+        max_connections: args.max_connections,
+    };
+    if let Some(path) = &config.eeprom {
+        // Write the file at once so a fresh one exists from the start.
+        if !path.exists() {
+            tmclsim_firmware::eeprom::save_atomic(path, module.eeprom()).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+    }
+    let server = tmclsim_server::start(module, config).map_err(|e| format!("cannot serve: {e}"))?;
+    let ep = server.endpoints().clone();
+    println!("tmclsim: virtual {} (address {address}) is serving", profile.module.name);
+    println!("  EEPROM: {eeprom_note}");
+    if let Some(addr) = ep.tcp {
+        println!("  tcp: {addr}");
+    }
+    if let Some((link, device)) = &ep.pty {
+        println!("  pty: {} -> {}", link.display(), device.display());
+    }
+    if let Some(a) = ep.pytrinamic_args() {
+        println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));
+    }
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    wait_for_signal();
+    println!("tmclsim: stopping");
+    server.stop();
+    Ok(ExitCode::SUCCESS)
+}
+
+fn send_target(ep: &tmclsim_server::Endpoints) -> String {
+    match (&ep.tcp, &ep.pty) {
+        (Some(a), _) => format!("--tcp {a}"),
+        (None, Some((link, _))) => format!("--port {}", link.display()),
+        _ => String::new(),
+    }
+}
+
+fn wait_for_signal() {
+    let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().expect("signal runtime");
+    rt.block_on(async {
+        use tokio::signal::unix::{signal, SignalKind};
+        let mut term = signal(SignalKind::terminate()).expect("SIGTERM handler");
+        let mut hup = signal(SignalKind::hangup()).expect("SIGHUP handler");
+        tokio::select! {
+            _ = tokio::signal::ctrl_c() => {}
+            _ = term.recv() => {}
+            _ = hup.recv() => {}
+        }
+    });
+}

@@ -1,0 +1,23 @@
+//! The clock task: wakes when the module has something due on its own.
+
+use crate::shared::SharedModule;
+use std::sync::Arc;
+use tokio::sync::watch;
+use tokio::time::Instant;
+
+pub(crate) async fn run(module: Arc<SharedModule>, mut stop: watch::Receiver<bool>) {
+    loop {
+        let due = module.with(|m| m.next_event_ns());
+        let sleep = async {
+            match due {
+                Some(ns) => tokio::time::sleep_until(Instant::from_std(module.instant_of(ns))).await,
+                None => std::future::pending::<()>().await,
+            }
+        };
+        tokio::select! {
+            _ = sleep => module.tick(),
+            _ = module.changed() => {}
+            _ = stop.changed() => return,
+        }
+    }
+}

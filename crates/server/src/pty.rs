@@ -1,0 +1,146 @@
+//! A pseudo-terminal that host software opens like the module's serial
+//! port, behind a stable symlink.
+//!
+//! The server keeps the slave side open itself, so the pty survives the
+//! host closing and reopening the port. The slave is put in raw mode (no
+//! echo, no line editing) as a USB/RS485 serial port behaves.
+
+use crate::shared::SharedModule;
+use crate::ServerConfig;
+use std::io;
+use std::os::fd::{AsRawFd, FromRawFd, OwnedFd, RawFd};
+use std::path::{Path, PathBuf};
+use std::pin::Pin;
+use std::sync::Arc;
+use std::task::{ready, Context, Poll};
+use tokio::io::unix::AsyncFd;
+use tokio::io::{AsyncRead, AsyncWrite, ReadBuf};
+use tokio::sync::watch;
+
+pub(crate) struct Pty {
+    master: OwnedFd,
+    /// Held open so the master never sees a hang-up.
+    _slave: OwnedFd,
+    pub link: PathBuf,
+    pub device: PathBuf,
+}
+
+fn check(r: libc::c_int) -> io::Result<libc::c_int> {
+    if r < 0 { Err(io::Error::last_os_error()) } else { Ok(r) }
+}
+
+impl Pty {
+    /// Opens a pty and points `link` at its serial device.
+    pub fn open(link: &Path) -> io::Result<Pty> {
+        // SAFETY: plain libc calls on descriptors this function owns.
+        unsafe {
+            let master = check(libc::posix_openpt(libc::O_RDWR | libc::O_NOCTTY))?;
+            let master = OwnedFd::from_raw_fd(master);
+            check(libc::grantpt(master.as_raw_fd()))?;
+            check(libc::unlockpt(master.as_raw_fd()))?;
+            let mut name = [0 as libc::c_char; 128];
+            check(libc::ptsname_r(master.as_raw_fd(), name.as_mut_ptr(), name.len()))?;
+            let device = PathBuf::from(std::ffi::CStr::from_ptr(name.as_ptr()).to_string_lossy().into_owned());
+            let cpath = std::ffi::CString::new(device.as_os_str().as_encoded_bytes()).map_err(io::Error::other)?;
+            let slave = check(libc::open(cpath.as_ptr(), libc::O_RDWR | libc::O_NOCTTY))?;
+            let slave = OwnedFd::from_raw_fd(slave);
+            let mut tio: libc::termios = std::mem::zeroed();
+            check(libc::tcgetattr(slave.as_raw_fd(), &mut tio))?;
+            libc::cfmakeraw(&mut tio);
+            check(libc::tcsetattr(slave.as_raw_fd(), libc::TCSANOW, &tio))?;
+            let flags = check(libc::fcntl(master.as_raw_fd(), libc::F_GETFL))?;
+            check(libc::fcntl(master.as_raw_fd(), libc::F_SETFL, flags | libc::O_NONBLOCK))?;
+            match std::fs::symlink_metadata(link) {
+                Ok(meta) if meta.file_type().is_symlink() => std::fs::remove_file(link)?,
+                Ok(_) => {
+                    return Err(io::Error::new(
+                        io::ErrorKind::AlreadyExists,
+                        format!("{} exists and is not a symlink; not replacing it", link.display()),
+                    ))
+                }
+                Err(_) => {}
+            }
+            std::os::unix::fs::symlink(&device, link)?;
+            Ok(Pty { master, _slave: slave, link: link.to_path_buf(), device })
+        }
+    }
+}
+
+/// The master side as an async byte stream.
+#[derive(Clone)]
+struct Master(Arc<AsyncFd<OwnedFd>>);
+
+fn raw(fd: &AsyncFd<OwnedFd>) -> RawFd {
+    fd.get_ref().as_raw_fd()
+}
+
+impl AsyncRead for Master {
+    fn poll_read(self: Pin<&mut Self>, cx: &mut Context<'_>, buf: &mut ReadBuf<'_>) -> Poll<io::Result<()>> {
+        loop {
+            let mut guard = ready!(self.0.poll_read_ready(cx))?;
+            let unfilled = buf.initialize_unfilled();
+            let result = guard.try_io(|fd| {
+                // SAFETY: reading into a buffer we own, of its length.
+                let n = unsafe { libc::read(raw(fd), unfilled.as_mut_ptr().cast(), unfilled.len()) };
+                if n < 0 { Err(io::Error::last_os_error()) } else { Ok(n as usize) }
+            });
+            match result {
+                Ok(Ok(n)) => {
+                    buf.advance(n);
+                    return Poll::Ready(Ok(()));
+                }
+                Ok(Err(e)) => return Poll::Ready(Err(e)),
+                Err(_would_block) => continue,
+            }
+        }
+    }
+}
+
+impl AsyncWrite for Master {
+    fn poll_write(self: Pin<&mut Self>, cx: &mut Context<'_>, data: &[u8]) -> Poll<io::Result<usize>> {
+        loop {
+            let mut guard = ready!(self.0.poll_write_ready(cx))?;
+            let result = guard.try_io(|fd| {
+                // SAFETY: writing from a slice we borrow, of its length.
+                let n = unsafe { libc::write(raw(fd), data.as_ptr().cast(), data.len()) };
+                if n < 0 { Err(io::Error::last_os_error()) } else { Ok(n as usize) }
+            });
+            match result {
+                Ok(r) => return Poll::Ready(r),
+                Err(_would_block) => continue,
+            }
+        }
+    }
+
+    fn poll_flush(self: Pin<&mut Self>, _: &mut Context<'_>) -> Poll<io::Result<()>> {
+        Poll::Ready(Ok(()))
+    }
+
+    fn poll_shutdown(self: Pin<&mut Self>, _: &mut Context<'_>) -> Poll<io::Result<()>> {
+        Poll::Ready(Ok(()))
+    }
+}
+
+pub(crate) async fn run(pty: Pty, module: Arc<SharedModule>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
+    let Pty { master, _slave, .. } = pty;
+    // SAFETY: the AsyncFd owns the descriptor for its whole life.
+    let master = match unsafe { AsyncFd::register(master) } {
+        Ok(fd) => Master(Arc::new(fd)),
+        Err(e) => {
+            eprintln!("tmclsim: pty: {}", e.into_parts().1);
+            return;
+        }
+    };
+    loop {
+        let served = crate::link::serve(master.clone(), master.clone(), module.clone(), config.inter_byte_timeout);
+        tokio::select! {
+            r = served => {
+                if let Err(e) = r {
+                    eprintln!("tmclsim: pty: {e}");
+                    tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+                }
+            }
+            _ = stop.changed() => return,
+        }
+    }
+}

@@ -1,0 +1,113 @@
+//! A module shared by the links of a server, paced by the wall clock.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+use tmclsim_firmware::eeprom::save_atomic;
+use tmclsim_firmware::Module;
+use tmclsim_protocol::FRAME_LEN;
+use tokio::sync::{mpsc, Notify};
+
+/// Where unsolicited frames (138 events) go: the link that spoke last.
+type EventSink = mpsc::UnboundedSender<[u8; FRAME_LEN]>;
+
+struct State {
+    module: Module,
+    saved_generation: u64,
+    sink: Option<(u64, EventSink)>,
+}
+
+/// The served module behind a lock, with its clock and EEPROM file.
+pub struct SharedModule {
+    state: Mutex<State>,
+    origin: Instant,
+    /// Virtual time at `origin`.
+    origin_ns: u64,
+    eeprom: Option<PathBuf>,
+    changed: Notify,
+}
+
+impl SharedModule {
+    pub fn new(module: Module, eeprom: Option<PathBuf>) -> SharedModule {
+        let origin_ns = module.now_ns();
+        let saved_generation = module.eeprom_generation();
+        SharedModule {
+            state: Mutex::new(State { module, saved_generation, sink: None }),
+            origin: Instant::now(),
+            origin_ns,
+            eeprom,
+            changed: Notify::new(),
+        }
+    }
+
+    /// Virtual time now, by the wall clock.
+    pub fn now_ns(&self) -> u64 {
+        self.origin_ns + self.origin.elapsed().as_nanos() as u64
+    }
+
+    /// The wall-clock instant of a virtual time.
+    pub fn instant_of(&self, ns: u64) -> Instant {
+        self.origin + Duration::from_nanos(ns.saturating_sub(self.origin_ns))
+    }
+
+    /// Runs `f` on the module, brought up to the current time.
+    pub fn with<R>(&self, f: impl FnOnce(&mut Module) -> R) -> R {
+        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let now = self.now_ns();
+        s.module.advance_to(now);
+        let r = f(&mut s.module);
+        self.after_change(&mut s);
+        r
+    }
+
+    /// Handles one frame from link `link`, whose events go to `sink`.
+    /// Returns the reply and how long to wait before sending it (GP 75).
+    pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Option<[u8; FRAME_LEN]>, Duration) {
+        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let now = self.now_ns();
+        s.module.advance_to(now);
+        let reply = s.module.handle_frame(frame);
+        if reply.is_some() || s.module.has_events() {
+            if s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
+                s.sink = Some((link, sink.clone()));
+            }
+        }
+        let delay = Duration::from_nanos(s.module.reply_delay_ns());
+        self.after_change(&mut s);
+        drop(s);
+        self.changed.notify_one();
+        (reply, delay)
+    }
+
+    /// Advances to now and dispatches what became due.
+    pub(crate) fn tick(&self) {
+        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let now = self.now_ns();
+        s.module.advance_to(now);
+        self.after_change(&mut s);
+    }
+
+    /// Resolves when a frame changed the module's plans.
+    pub(crate) async fn changed(&self) {
+        self.changed.notified().await
+    }
+
+    fn after_change(&self, s: &mut State) {
+        if s.module.has_events() {
+            let events = s.module.take_events();
+            if let Some((_, sink)) = &s.sink {
+                for e in events {
+                    let _ = sink.send(e);
+                }
+            }
+        }
+        if s.module.eeprom_generation() != s.saved_generation {
+            if let Some(path) = &self.eeprom {
+                if let Err(e) = save_atomic(path, s.module.eeprom()) {
+                    eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
+                }
+            }
+            s.saved_generation = s.module.eeprom_generation();
+        }
+    }
+}
