@@ -1,0 +1,76 @@
+"""Fixtures: a `tmclsim serve` process on loopback TCP and a pty."""
+
+import os
+import pathlib
+import re
+import subprocess
+import time
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def tmclsim_binary():
+    path = os.environ.get("TMCLSIM_BIN")
+    if path:
+        return path
+    built = ROOT / "target" / "release" / "tmclsim"
+    if not built.exists():
+        subprocess.run(["cargo", "build", "--release", "-p", "tmclsim"], cwd=ROOT, check=True)
+    return str(built)
+
+
+class Served:
+    """A running `tmclsim serve`; stopped by the fixture."""
+
+    def __init__(self, args, tmp_path):
+        self.pty_link = str(tmp_path / "tmcm-1141")
+        cmd = [tmclsim_binary(), "serve", "--tcp", "127.0.0.1:0", "--pty", self.pty_link, *args]
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.banner = []
+        deadline = time.monotonic() + 30
+        while True:
+            line = self.proc.stdout.readline()
+            if not line:
+                raise RuntimeError("tmclsim serve exited: " + "".join(self.banner))
+            self.banner.append(line)
+            if line.startswith("connect with:"):
+                break
+            if time.monotonic() > deadline:
+                raise RuntimeError("tmclsim serve did not start")
+        text = "".join(self.banner)
+        self.tcp = re.search(r"tcp: (\S+)", text).group(1)
+        self.connect_hint = self.banner[-1]
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self.proc.stdout.close()
+
+
+@pytest.fixture
+def served(tmp_path):
+    s = Served([], tmp_path)
+    yield s
+    s.stop()
+
+
+@pytest.fixture
+def serve(tmp_path):
+    """Start servers with extra arguments; all are stopped at teardown."""
+    started = []
+
+    def start(*args):
+        s = Served(list(args), tmp_path)
+        started.append(s)
+        return s
+
+    yield start
+    for s in started:
+        s.stop()
