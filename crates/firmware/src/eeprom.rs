@@ -100,7 +100,9 @@ pub fn save_atomic(path: &Path, image: &Eeprom) -> std::io::Result<()> {
         _ => Path::new("."),
     };
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "eeprom".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    // One writer per file: a temporary left by a killed process is simply
+    // overwritten by the next save.
+    let tmp = dir.join(format!(".{name}.tmp"));
     {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(image.to_json().as_bytes())?;
