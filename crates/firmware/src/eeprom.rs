@@ -65,10 +65,13 @@ impl Eeprom {
         self.coordinates.insert(key(motor, n), value);
     }
 
-    /// Forgets every cell (137: restore factory settings).
+    /// Forgets every setting (137: restore factory settings). The TMCL
+    /// program stays: it is not a setting.
     pub fn clear(&mut self) {
         let module = std::mem::take(&mut self.module);
+        let program = std::mem::take(&mut self.program);
         *self = Eeprom::new(&module);
+        self.program = program;
     }
 
     pub fn to_json(&self) -> String {

@@ -31,6 +31,16 @@ impl Module {
             Command::FirmwareVersion { binary: false } => {
                 return Outcome { status: Status::Ok, value: 0, special: Special::Frame(self.special_version()) };
             }
+            Command::StopApplication
+            | Command::RunApplication { .. }
+            | Command::StepApplication
+            | Command::ResetApplication
+            | Command::EnterDownload { .. }
+            | Command::ExitDownload
+            | Command::ReadMemory { .. }
+            | Command::ApplicationStatus { .. } => {
+                return self.control(cmd).unwrap_or_else(|status| Outcome::error(status, ins.value));
+            }
             Command::FactoryDefaults { key } => {
                 if key != MAGIC_KEY {
                     return Outcome::error(Status::InvalidValue, key);
@@ -259,10 +269,10 @@ impl Module {
                 Ok(echo)
             }
             UserFunction { .. } => Err(Status::NotAvailable),
-            // Reference search and the control commands of standalone
-            // programs and ASCII mode are not part of this firmware yet.
-            Rfs { .. } | StopApplication | RunApplication { .. } | StepApplication | ResetApplication | EnterDownload { .. }
-            | ExitDownload | ReadMemory { .. } | ApplicationStatus { .. } | AsciiMode => Err(Status::NotAvailable),
+            StopApplication | RunApplication { .. } | StepApplication | ResetApplication | EnterDownload { .. } | ExitDownload
+            | ReadMemory { .. } | ApplicationStatus { .. } => unreachable!("handled in execute"),
+            // Reference search and ASCII mode are not part of this firmware yet.
+            Rfs { .. } | AsciiMode => Err(Status::NotAvailable),
             Sac { .. } => Err(Status::InvalidCommand),
             FirmwareVersion { binary: false } | FactoryDefaults { .. } => unreachable!("handled in execute"),
             Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti => {
@@ -443,6 +453,11 @@ impl Module {
         ((v << shift) >> shift) as i32
     }
 
+    /// A reference search is running on this axis.
+    pub(crate) fn reference_search_active(&self, _m: usize) -> bool {
+        false
+    }
+
     pub(crate) fn actual_position(&self, m: usize) -> i32 {
         self.wrap_position(self.axes[m].motion.position())
     }
@@ -561,6 +576,26 @@ impl Module {
                 self.tick_offset_ms = value as i64;
             }
             (0, gp::RANDOM) => self.rng = value as u32 | 1,
+            (0, gp::CODE_PROTECTION) => {
+                let old = self.globals[0][param as usize];
+                if matches!(old, 1 | 3) && matches!(value, 0 | 2) {
+                    // Lifting the protection against reading erases the program.
+                    for w in self.program.memory.iter_mut() {
+                        *w = Instruction::default();
+                    }
+                    self.program.reset();
+                    self.eeprom.program.clear();
+                    self.eeprom_generation += 1;
+                }
+                self.globals[0][param as usize] = value;
+            }
+            (3, _) => {
+                self.globals[3][param as usize] = value;
+                // A new period restarts the timer.
+                if let Some(t) = self.program.timers.get_mut(param as usize) {
+                    *t = None;
+                }
+            }
             _ => self.globals[bank as usize][param as usize] = value,
         }
         if auto {
@@ -577,6 +612,9 @@ impl Module {
                 let ms = (self.now_ns - self.tick_base_ns) / 1_000_000;
                 (self.tick_offset_ms + ms as i64) as i32 & i32::MAX
             }
+            (0, gp::APPLICATION_STATUS) => self.program.mode as i32,
+            (0, gp::DOWNLOAD_MODE) => self.program.download.is_some() as i32,
+            (0, gp::PROGRAM_COUNTER) => self.program.pc as i32,
             (0, gp::RANDOM) => {
                 // xorshift32, 31 bits.
                 let mut x = self.rng;
@@ -639,19 +677,19 @@ impl Module {
     }
 
     fn get_input(&mut self, port: u8, bank: u8) -> Exec {
-        let in_bank: Vec<_> = self.profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup).collect();
-        if in_bank.is_empty() {
+        let profile = self.profile.clone();
+        let mut in_bank = profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup);
+        let Some(first) = in_bank.clone().next() else {
             return Err(Status::InvalidValue);
-        }
-        let outputs = in_bank.iter().all(|p| p.direction == PortDirection::Output);
+        };
         if port == 255 {
-            return Ok(if outputs {
+            return Ok(if first.direction == PortDirection::Output {
                 (self.outputs & self.output_mask(bank)) as i32
             } else {
-                in_bank.iter().filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | (self.world.digital(p.number) as i32) << p.number)
+                in_bank.filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | (self.world.digital(p.number) as i32) << p.number)
             });
         }
-        let p = in_bank.iter().find(|p| p.number == port).ok_or(Status::WrongType)?;
+        let p = in_bank.find(|p| p.number == port).ok_or(Status::WrongType)?;
         Ok(match p.direction {
             PortDirection::Output => (self.outputs >> port & 1) as i32,
             _ if p.max == 1 => self.world.digital(port) as i32,

@@ -6,9 +6,11 @@
 
 pub mod eeprom;
 pub mod executor;
+mod interpreter;
 pub mod module;
 pub mod motion;
 pub mod profile;
+pub mod program;
 pub mod world;
 
 pub use eeprom::Eeprom;

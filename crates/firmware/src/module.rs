@@ -4,6 +4,7 @@
 use crate::eeprom::Eeprom;
 use crate::motion::{self, Motion, RampMode};
 use crate::profile::Profile;
+use crate::program::{Program, RunMode, Source};
 use crate::world::World;
 use std::sync::Arc;
 use tmclsim_protocol::frame::version_string_reply;
@@ -43,6 +44,8 @@ pub mod ap {
 pub mod gp {
     pub const SERIAL_ADDRESS: u8 = 66;
     pub const HEARTBEAT: u8 = 68;
+    pub const AUTOSTART: u8 = 77;
+    pub const CODE_PROTECTION: u8 = 81;
     pub const TELEGRAM_PAUSE: u8 = 75;
     pub const HOST_ADDRESS: u8 = 76;
     pub const END_SWITCH_POLARITY: u8 = 79;
@@ -183,6 +186,11 @@ pub struct Module {
     pub(crate) rng: u32,
     pub(crate) restored_from_eeprom: bool,
     pub(crate) resets: u32,
+    pub(crate) program: Program,
+    /// Digital inputs and stop switches at the last look, for input-change
+    /// and switch interrupts.
+    pub(crate) last_inputs: u32,
+    pub(crate) last_switches: Vec<(bool, bool)>,
 }
 
 impl Module {
@@ -217,6 +225,9 @@ impl Module {
             rng: 0x2545_F491,
             restored_from_eeprom: false,
             resets: 0,
+            program: Program::new(profile.module.program_memory as usize),
+            last_inputs: 0,
+            last_switches: Vec::new(),
             now_ns: 0,
             eeprom,
             profile,
@@ -365,6 +376,28 @@ impl Module {
         self.heartbeat_tripped = false;
         self.tick_base_ns = self.now_ns;
         self.tick_offset_ms = 0;
+        // Program memory from the EEPROM; the interpreter starts afresh.
+        let words = self.program.memory.len();
+        let (trace, breakpoints, instruction_ns) = (self.program.trace.take(), std::mem::take(&mut self.program.breakpoints), self.program.instruction_ns);
+        self.program = Program::new(words);
+        self.program.trace = trace.map(|_| Vec::new());
+        self.program.breakpoints = breakpoints;
+        self.program.instruction_ns = instruction_ns;
+        for (&a, bytes) in &self.eeprom.program {
+            if let Some(w) = self.program.memory.get_mut(a as usize) {
+                *w = tmclsim_protocol::Instruction::from_bytes(bytes);
+            }
+        }
+        self.program.download_pointer = self.program.length() as u16;
+        self.program.next_ns = self.now_ns;
+        self.last_inputs = self.world.digital_inputs;
+        self.last_switches = (0..self.axes.len()).map(|m| {
+            let (l, r, _) = self.switches(m);
+            (l, r)
+        }).collect();
+        if self.globals[0][gp::AUTOSTART as usize] == 1 && self.program.length() > 0 {
+            self.program.mode = RunMode::Run;
+        }
     }
 
     /// Handles one 9-byte frame from a serial-type link: address filter,
@@ -388,7 +421,11 @@ impl Module {
             return Some(Reply::new(host, request.address, Status::WrongChecksum, 0, 0).encode());
         }
         let ins = request.instruction;
-        let outcome = self.execute(ins);
+        let outcome = if self.program.download.is_some() && !opcode::is_control(ins.opcode) {
+            self.download_word(ins)
+        } else {
+            self.execute(ins)
+        };
         let reply = match outcome.special {
             Special::Silent => return None,
             Special::Frame(f) => f,
@@ -438,29 +475,107 @@ impl Module {
 
     // ----- time -------------------------------------------------------
 
-    /// Advances virtual time by `dt_ns` nanoseconds.
+    /// Advances virtual time by `dt_ns` nanoseconds: the program runs its
+    /// instructions, the motors move, interrupts and events fire, each at
+    /// its own moment.
     pub fn advance(&mut self, dt_ns: u64) {
         let end = self.now_ns.saturating_add(dt_ns);
-        while self.now_ns < end {
-            let mut step_end = end;
-            if let Some(deadline) = self.heartbeat_deadline() {
-                if deadline > self.now_ns && deadline < step_end {
-                    step_end = deadline;
+        self.look_at_inputs();
+        loop {
+            let timer = self.run_timers();
+            if self.program.is_running() {
+                if self.program.wait.is_some() {
+                    self.check_wait();
+                }
+                if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
+                    let soon = self.motion_interrupts_armed().then_some(self.now_ns + 1_000_000);
+                    let limit = [Some(end), timer, self.heartbeat_deadline(), soon].into_iter().flatten().min().unwrap_or(end);
+                    self.run_batch(limit);
+                    continue;
                 }
             }
-            let dt = step_end - self.now_ns;
-            for motor in 0..self.axes.len() {
-                self.advance_axis(motor, dt);
+            if self.now_ns >= end {
+                break;
             }
-            self.now_ns = step_end;
-            if let Some(deadline) = self.heartbeat_deadline() {
-                if self.now_ns >= deadline {
-                    self.heartbeat_tripped = true;
-                    for motor in 0..self.axes.len() {
-                        self.motor_stop(motor);
+            // The next moment something happens on its own.
+            let mut t = end;
+            let mut at = |x: Option<u64>| {
+                if let Some(x) = x {
+                    if x > self.now_ns {
+                        t = t.min(x);
                     }
                 }
+            };
+            at(self.heartbeat_deadline());
+            at(timer);
+            if self.program.is_running() {
+                if self.program.wait.is_none() {
+                    at(Some(self.program.next_ns));
+                } else {
+                    at(self.wait_horizon());
+                }
+                if self.motion_interrupts_armed() {
+                    at(Some(self.now_ns + 1_000_000));
+                }
             }
+            self.step_world(t);
+        }
+    }
+
+    /// Moves the motors to `t` and looks at what changed.
+    fn step_world(&mut self, t: u64) {
+        let dt = t - self.now_ns;
+        for motor in 0..self.axes.len() {
+            self.advance_axis(motor, dt);
+        }
+        self.now_ns = t;
+        if let Some(deadline) = self.heartbeat_deadline() {
+            if self.now_ns >= deadline {
+                self.heartbeat_tripped = true;
+                for motor in 0..self.axes.len() {
+                    self.motor_stop(motor);
+                }
+            }
+        }
+        self.look_at_inputs();
+    }
+
+    /// Raises input-change and stop-switch interrupts for the transitions
+    /// their bank 3 trigger setting selects.
+    fn look_at_inputs(&mut self) {
+        let inputs = self.world.digital_inputs;
+        let changed = inputs ^ self.last_inputs;
+        if changed != 0 {
+            for n in 0..8u8 {
+                if changed & (1 << n) != 0 {
+                    let rising = inputs & (1 << n) != 0;
+                    self.trigger(Source::InputChange(n), rising);
+                }
+            }
+            self.last_inputs = inputs;
+        }
+        for m in 0..self.axes.len() {
+            let (l, r, _) = self.switches(m);
+            let (pl, pr) = self.last_switches.get(m).copied().unwrap_or((l, r));
+            if l != pl {
+                self.trigger(Source::StopLeft(m as u8), l);
+            }
+            if r != pr {
+                self.trigger(Source::StopRight(m as u8), r);
+            }
+            if let Some(s) = self.last_switches.get_mut(m) {
+                *s = (l, r);
+            }
+        }
+    }
+
+    /// An edge on an input: raise its interrupt if bank 3 selects the edge
+    /// (0 off, 1 low→high, 2 high→low, 3 both).
+    fn trigger(&mut self, source: Source, rising: bool) {
+        let Some(n) = self.profile.interrupt_for(source) else { return };
+        let mode = self.globals[3][n as usize];
+        if mode == 3 || (mode == 1 && rising) || (mode == 2 && !rising) {
+            self.raise(source);
         }
     }
 
@@ -471,7 +586,7 @@ impl Module {
         }
     }
 
-    fn heartbeat_deadline(&self) -> Option<u64> {
+    pub(crate) fn heartbeat_deadline(&self) -> Option<u64> {
         let hb = self.globals[0][gp::HEARTBEAT as usize];
         (hb > 0 && !self.heartbeat_tripped).then(|| self.last_frame_ns + hb as u64 * 1_000_000)
     }
@@ -479,6 +594,11 @@ impl Module {
     /// The next virtual time at which something observable happens on its
     /// own (a heartbeat stop, a 138 event); `None` if nothing is pending.
     pub fn next_event_ns(&self) -> Option<u64> {
+        if self.program.is_running() {
+            // A running program does something every instruction; a
+            // server lets it run in steps of a millisecond.
+            return Some(self.now_ns + 1_000_000);
+        }
         let mut next = self.heartbeat_deadline();
         for (motor, axis) in self.axes.iter().enumerate() {
             if axis.notify_on_arrival {
@@ -502,12 +622,18 @@ impl Module {
         let offset = self.axes[motor].mech_offset;
         let sign = self.shaft_sign();
         // Switch thresholds in motor coordinates.
-        let thresholds: Vec<f64> = self.world.axes[motor].thresholds().map(|m| (m - offset) * sign).collect();
+        let mut thresholds = [0.0f64; 4];
+        let mut count = 0;
+        for m in self.world.axes[motor].thresholds().take(4) {
+            thresholds[count] = (m - offset) * sign;
+            count += 1;
+        }
+        let thresholds = &thresholds[..count];
         let was_moving = self.axes[motor].motion.v != 0.0;
         let mut motion = std::mem::take(&mut self.axes[motor].motion);
         let step = {
             let mut stops = |x: f64| self.stops_at(motor, x);
-            motion.advance(dt_ns as f64 * 1e-9, &ramp, &mut stops, &thresholds)
+            motion.advance(dt_ns as f64 * 1e-9, &ramp, &mut stops, thresholds)
         };
         let moving = motion.v != 0.0;
         let axis = &mut self.axes[motor];
@@ -522,6 +648,9 @@ impl Module {
         if step.arrived && axis.notify_on_arrival {
             axis.notify_on_arrival = false;
             self.push_event(1 << motor);
+        }
+        if step.arrived {
+            self.raise(Source::TargetReached(motor as u8));
         }
     }
 
@@ -546,7 +675,7 @@ impl Module {
         (w.left_pressed(m) ^ invert, w.right_pressed(m) ^ invert, w.home_pressed(m))
     }
 
-    fn stops_at(&self, motor: usize, x: f64) -> motion::Stops {
+    pub(crate) fn stops_at(&self, motor: usize, x: f64) -> motion::Stops {
         let (left, right, _) = self.switches_at(motor, x);
         let p = &self.axes[motor].params;
         motion::Stops {

@@ -303,6 +303,12 @@ impl Profile {
         self.interrupts.iter().find(|i| i.number == number)
     }
 
+    /// The interrupt number of a source, by the symbols of the interrupt
+    /// table.
+    pub fn interrupt_for(&self, source: crate::program::Source) -> Option<u8> {
+        self.interrupts.iter().find(|i| crate::program::Source::from_symbol(&i.symbol) == Some(source)).map(|i| i.number)
+    }
+
     /// Looks an axis parameter up by name (case-insensitive).
     pub fn axis_parameter_named(&self, name: &str) -> Option<&Parameter> {
         self.axis_parameters().find(|p| p.name.eq_ignore_ascii_case(name))

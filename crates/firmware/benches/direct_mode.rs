@@ -1,0 +1,41 @@
+//! Direct-mode commands through `Module::handle_frame`, in-process.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use std::hint::black_box;
+use tmclsim_firmware::Module;
+use tmclsim_protocol::mnemonic::parse_line;
+use tmclsim_protocol::Request;
+
+fn frames(lines: &[&str]) -> Vec<[u8; 9]> {
+    lines.iter().map(|l| Request::new(1, parse_line(l).unwrap()).encode()).collect()
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("direct_mode");
+    g.throughput(Throughput::Elements(1));
+    for (name, lines) in [
+        ("GAP actual position", &["GAP 1, 0"][..]),
+        ("SAP max speed", &["SAP 4, 0, 1000"][..]),
+        ("mix GAP/SAP/GGP/GIO/MVP", &["GAP 1, 0", "SAP 4, 0, 1500", "GGP 66, 0", "GIO 0, 0", "MVP ABS, 0, 5000", "GAP 8, 0"][..]),
+    ] {
+        let fs = frames(lines);
+        let mut m = Module::built_in("tmcm-1141").unwrap();
+        let mut i = 0;
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let f = &fs[i % fs.len()];
+                i += 1;
+                black_box(m.handle_frame(black_box(f)))
+            })
+        });
+    }
+    g.finish();
+    c.bench_function("advance 1 ms while moving", |b| {
+        let mut m = Module::built_in("tmcm-1141").unwrap();
+        m.handle_frame(&frames(&["ROR 0, 1000"])[0]);
+        b.iter(|| m.advance(black_box(1_000_000)))
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,214 @@
+//! Standalone TMCL programs: program memory, the interpreter's state,
+//! interrupts and the trace.
+//!
+//! The interpreter itself lives in `interpreter.rs`; this file holds the
+//! data it works on, so that a reader sees the machine before the loop.
+
+use crate::module::Registers;
+use tmclsim_protocol::{Instruction, WaitCondition};
+
+/// Subroutine stack depth (manual 3.7.20, 3.7.44).
+pub const STACK_DEPTH: usize = 8;
+
+/// Virtual time one program instruction takes by default: 25 µs, i.e.
+/// 40 000 instructions per second (decisions.md rule 20).
+pub const DEFAULT_INSTRUCTION_NS: u64 = 25_000;
+
+/// GP 128 / 135: what the interpreter is doing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RunMode {
+    #[default]
+    Stop = 0,
+    Run = 1,
+    Step = 2,
+    Reset = 3,
+}
+
+/// A WAIT in progress.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Wait {
+    pub condition: WaitCondition,
+    pub motor: u8,
+    /// WAIT TICKS: when it ends; the others: when they time out (`None`:
+    /// no timeout).
+    pub until_ns: Option<u64>,
+}
+
+/// What an interrupt saves and RETI restores.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Context {
+    pub registers: Registers,
+    pub pc: u16,
+    pub wait: Option<Wait>,
+}
+
+/// What raises an interrupt, derived from the profile's interrupt table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    Timer(u8),
+    TargetReached(u8),
+    Stall(u8),
+    StopLeft(u8),
+    StopRight(u8),
+    InputChange(u8),
+    Deviation(u8),
+}
+
+impl Source {
+    /// Reads the interrupt's source from its symbol (`TI_TIMER0`,
+    /// `TI_TARGET0`, `TI_STALL0`, `TI_STOPLEFT0`, `TI_STOPRIGHT0`,
+    /// `TI_INPUTCHANGE3`, `TI_DEVIATION0`).
+    pub fn from_symbol(symbol: &str) -> Option<Source> {
+        let s = symbol.strip_prefix("TI_")?;
+        let digits = s.trim_start_matches(|c: char| c.is_ascii_alphabetic());
+        let name = &s[..s.len() - digits.len()];
+        let n: u8 = digits.parse().ok()?;
+        Some(match name {
+            "TIMER" => Source::Timer(n),
+            "TARGET" => Source::TargetReached(n),
+            "STALL" => Source::Stall(n),
+            "STOPLEFT" => Source::StopLeft(n),
+            "STOPRIGHT" => Source::StopRight(n),
+            "INPUTCHANGE" => Source::InputChange(n),
+            "DEVIATION" => Source::Deviation(n),
+            _ => return None,
+        })
+    }
+}
+
+/// One executed instruction, for `--trace` and the debugger.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceRecord {
+    /// Virtual time at which the instruction ran.
+    pub time_ns: u64,
+    pub pc: u16,
+    pub instruction: Instruction,
+    /// Registers after the instruction.
+    pub registers: Registers,
+    /// Status when the command failed and was skipped (decisions.md rule 21).
+    pub failed: Option<u8>,
+}
+
+/// The interpreter's state.
+#[derive(Clone, Debug)]
+pub struct Program {
+    pub memory: Vec<Instruction>,
+    pub mode: RunMode,
+    pub pc: u16,
+    pub stack: Vec<u16>,
+    pub wait: Option<Wait>,
+    /// In an interrupt handler: the interrupted context.
+    pub handler: Option<Context>,
+    /// Pending interrupts, one bit per interrupt number.
+    pub pending: [u64; 4],
+    /// Virtual time at which the next instruction runs.
+    pub next_ns: u64,
+    pub instruction_ns: u64,
+    /// Download mode: the address the next stored word goes to.
+    pub download: Option<u16>,
+    /// Address after the last downloaded word (135 type 0).
+    pub download_pointer: u16,
+    /// Next firing time of timers 0…2.
+    pub timers: [Option<u64>; 3],
+    pub breakpoints: Vec<u16>,
+    /// Set when execution stopped at a breakpoint.
+    pub hit_breakpoint: Option<u16>,
+    pub trace: Option<Vec<TraceRecord>>,
+    /// Instructions executed since power-up.
+    pub executed: u64,
+}
+
+impl Program {
+    pub fn new(words: usize) -> Program {
+        Program {
+            memory: vec![Instruction::default(); words],
+            mode: RunMode::Stop,
+            pc: 0,
+            stack: Vec::with_capacity(STACK_DEPTH),
+            wait: None,
+            handler: None,
+            pending: [0; 4],
+            next_ns: 0,
+            instruction_ns: DEFAULT_INSTRUCTION_NS,
+            download: None,
+            download_pointer: 0,
+            timers: [None; 3],
+            breakpoints: Vec::new(),
+            hit_breakpoint: None,
+            trace: None,
+            executed: 0,
+        }
+    }
+
+    pub fn is_running(&self) -> bool {
+        matches!(self.mode, RunMode::Run)
+    }
+
+    pub fn set_pending(&mut self, n: u8) {
+        self.pending[n as usize / 64] |= 1 << (n % 64);
+    }
+
+    pub fn clear_pending(&mut self, n: u8) {
+        self.pending[n as usize / 64] &= !(1 << (n % 64));
+    }
+
+    pub fn is_pending(&self, n: u8) -> bool {
+        self.pending[n as usize / 64] & (1 << (n % 64)) != 0
+    }
+
+    /// Lowest pending interrupt number for which `ready` holds.
+    pub fn first_pending(&self, ready: impl Fn(u8) -> bool) -> Option<u8> {
+        for (w, bits) in self.pending.iter().enumerate() {
+            let mut b = *bits;
+            while b != 0 {
+                let n = (w * 64) as u8 + b.trailing_zeros() as u8;
+                if ready(n) {
+                    return Some(n);
+                }
+                b &= b - 1;
+            }
+        }
+        None
+    }
+
+    /// 131: stop, program counter and stack to zero, registers cleared.
+    pub fn reset(&mut self) {
+        self.mode = RunMode::Stop;
+        self.pc = 0;
+        self.stack.clear();
+        self.wait = None;
+        self.handler = None;
+        self.pending = [0; 4];
+        self.hit_breakpoint = None;
+    }
+
+    /// Length of the program: up to the last word that is not empty.
+    pub fn length(&self) -> usize {
+        self.memory.iter().rposition(|i| *i != Instruction::default()).map_or(0, |p| p + 1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interrupt_sources_from_symbols() {
+        assert_eq!(Source::from_symbol("TI_TIMER2"), Some(Source::Timer(2)));
+        assert_eq!(Source::from_symbol("TI_INPUTCHANGE3"), Some(Source::InputChange(3)));
+        assert_eq!(Source::from_symbol("TI_STOPRIGHT0"), Some(Source::StopRight(0)));
+        assert_eq!(Source::from_symbol("TI_GLOBAL"), None);
+    }
+
+    #[test]
+    fn pending_interrupts_by_priority() {
+        let mut p = Program::new(16);
+        p.set_pending(40);
+        p.set_pending(3);
+        p.set_pending(200);
+        assert_eq!(p.first_pending(|_| true), Some(3));
+        assert_eq!(p.first_pending(|n| n > 3), Some(40));
+        p.clear_pending(40);
+        assert_eq!(p.first_pending(|n| n > 3), Some(200));
+    }
+}
