@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
+mod bench;
 mod send;
 mod serve;
 
@@ -24,6 +25,18 @@ enum Command {
     Send(SendArgs),
     /// List a module profile: every parameter with access, range and default.
     Profile(ProfileArgs),
+    /// Measure commands per second in-process and round trips over TCP and the pty.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Commands for the in-process measurement.
+    #[arg(long, default_value_t = 20_000_000)]
+    pub in_process: usize,
+    /// Round trips per link.
+    #[arg(long, default_value_t = 20_000)]
+    pub round_trips: usize,
 }
 
 #[derive(Args)]
@@ -91,6 +104,7 @@ fn main() -> ExitCode {
         Command::Serve(a) => serve::run(a),
         Command::Send(a) => send::run(a),
         Command::Profile(a) => profile(&a.module),
+        Command::Bench(a) => bench::run(a),
     };
     match result {
         Ok(code) => code,

@@ -7,7 +7,7 @@ use tokio::time::Instant;
 
 pub(crate) async fn run(module: Arc<SharedModule>, mut stop: watch::Receiver<bool>) {
     loop {
-        let due = module.with(|m| m.next_event_ns());
+        let due = module.schedule();
         let sleep = async {
             match due {
                 Some(ns) => tokio::time::sleep_until(Instant::from_std(module.instant_of(ns))).await,

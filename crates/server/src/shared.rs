@@ -15,6 +15,8 @@ struct State {
     module: Module,
     saved_generation: u64,
     sink: Option<(u64, EventSink)>,
+    /// What the clock task sleeps until (`None`: nothing).
+    scheduled: Option<u64>,
 }
 
 /// The served module behind a lock, with its clock and EEPROM file.
@@ -32,7 +34,7 @@ impl SharedModule {
         let origin_ns = module.now_ns();
         let saved_generation = module.eeprom_generation();
         SharedModule {
-            state: Mutex::new(State { module, saved_generation, sink: None }),
+            state: Mutex::new(State { module, saved_generation, sink: None, scheduled: None }),
             origin: Instant::now(),
             origin_ns,
             eeprom,
@@ -74,9 +76,27 @@ impl SharedModule {
         }
         let delay = Duration::from_nanos(s.module.reply_delay_ns());
         self.after_change(&mut s);
+        // Wake the clock task only when something is due sooner than what
+        // it sleeps for.
+        let due = s.module.next_event_ns();
+        let wake = due.is_some_and(|d| s.scheduled.is_none_or(|sch| d < sch));
         drop(s);
-        self.changed.notify_one();
+        if wake {
+            self.changed.notify_one();
+        }
         (reply, delay)
+    }
+
+    /// The clock task's next wake-up: what is due, remembered so that
+    /// frames know whether to wake it earlier.
+    pub(crate) fn schedule(&self) -> Option<u64> {
+        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let now = self.now_ns();
+        s.module.advance_to(now);
+        self.after_change(&mut s);
+        let due = s.module.next_event_ns();
+        s.scheduled = due;
+        due
     }
 
     /// Advances to now and dispatches what became due.

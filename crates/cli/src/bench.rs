@@ -1,0 +1,159 @@
+//! `tmclsim bench`: commands per second in-process, round trips over TCP
+//! and the pty with a Rust client, and the server's CPU time per command.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+use tmclsim_firmware::Module;
+use tmclsim_protocol::mnemonic::parse_line;
+use tmclsim_protocol::Request;
+
+/// The command mix every measurement uses.
+const MIX: &[&str] = &["GAP 1, 0", "SAP 4, 0, 1500", "GGP 66, 0", "GIO 0, 0", "MVP ABS, 0, 5000", "GAP 8, 0"];
+
+pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
+    let frames: Vec<[u8; 9]> = MIX.iter().map(|l| Request::new(1, parse_line(l).unwrap()).encode()).collect();
+    println!("tmclsim bench: command mix {MIX:?}, {} cores", std::thread::available_parallelism().map_or(1, |n| n.get()));
+    println!();
+    println!("| measurement | commands | result |");
+    println!("|---|---:|---|");
+
+    // In-process, one core.
+    let mut m = Module::built_in("tmcm-1141")?;
+    let n = args.in_process;
+    let t = Instant::now();
+    let mut sink = 0u64;
+    for i in 0..n {
+        if let Some(r) = m.handle_frame(&frames[i % frames.len()]) {
+            sink = sink.wrapping_add(r[7] as u64);
+        }
+    }
+    let dt = t.elapsed();
+    std::hint::black_box(sink);
+    println!("| in-process `handle_frame` | {n} | {:.1} M commands/s ({:.1} ns each) |", n as f64 / dt.as_secs_f64() / 1e6, dt.as_nanos() as f64 / n as f64);
+
+    // Over the links of a `tmclsim serve` process.
+    let dir = std::env::temp_dir().join(format!("tmclsim-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let pty = dir.join("pty");
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let mut child = Command::new(exe)
+        .args(["serve", "--tcp", "127.0.0.1:0", "--pty"])
+        .arg(&pty)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .map_err(|e| e.to_string())?;
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut tcp = None;
+    loop {
+        let mut line = String::new();
+        if out.read_line(&mut line).map_err(|e| e.to_string())? == 0 {
+            return Err("the server did not start".into());
+        }
+        if let Some(a) = line.trim().strip_prefix("tcp: ") {
+            tcp = Some(a.to_string());
+        }
+        if line.starts_with("connect with:") {
+            break;
+        }
+    }
+    let tcp = tcp.ok_or("no tcp endpoint")?;
+    let pid = child.id();
+    let result = (|| -> Result<(), String> {
+        let mut s = std::net::TcpStream::connect(&tcp).map_err(|e| e.to_string())?;
+        s.set_nodelay(true).ok();
+        report("TCP round trip, Rust client", &mut s, &frames, args.round_trips, Some(pid))?;
+        let mut port = std::fs::OpenOptions::new().read(true).write(true).open(&pty).map_err(|e| e.to_string())?;
+        report("pty round trip, Rust client", &mut port, &frames, args.round_trips, Some(pid))?;
+        Ok(())
+    })();
+    echo_baseline(&frames, args.round_trips)?;
+    let _ = child.kill();
+    let _ = child.wait();
+    let _ = std::fs::remove_dir_all(&dir);
+    result?;
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+fn report(name: &str, link: &mut (impl Read + Write), frames: &[[u8; 9]], n: usize, pid: Option<u32>) -> Result<(), String> {
+    let mut buf = [0u8; 9];
+    for f in frames.iter().cycle().take(200) {
+        link.write_all(f).map_err(|e| e.to_string())?;
+        link.read_exact(&mut buf).map_err(|e| e.to_string())?;
+    }
+    let cpu0 = pid.map(process_cpu).transpose()?;
+    let mut samples = Vec::with_capacity(n);
+    for f in frames.iter().cycle().take(n) {
+        let t = Instant::now();
+        link.write_all(f).map_err(|e| e.to_string())?;
+        link.read_exact(&mut buf).map_err(|e| e.to_string())?;
+        samples.push(t.elapsed());
+        if buf[3] != f[1] || buf[2] != 100 {
+            return Err(format!("{name}: reply {buf:02X?} does not answer {f:02X?}"));
+        }
+    }
+    let cpu = match (pid, cpu0) {
+        (Some(pid), Some(c0)) => {
+            let c1 = process_cpu(pid)?;
+            let (user, system) = (c1.0 - c0.0, c1.1 - c0.1);
+            format!(
+                "; server CPU {:.1} µs/command ({:.1} user + {:.1} kernel)",
+                us(user + system) / n as f64,
+                us(user) / n as f64,
+                us(system) / n as f64
+            )
+        }
+        _ => String::new(),
+    };
+    samples.sort();
+    let pct = |p: f64| samples[((samples.len() as f64 * p) as usize).min(samples.len() - 1)];
+    println!(
+        "| {name} | {n} | p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs{cpu} |",
+        us(pct(0.50)),
+        us(pct(0.99)),
+        us(*samples.last().unwrap()),
+    );
+    Ok(())
+}
+
+/// The machine's floor: a blocking echo thread over loopback TCP in this
+/// process, with the same frames.
+fn echo_baseline(frames: &[[u8; 9]], n: usize) -> Result<(), String> {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").map_err(|e| e.to_string())?;
+    let addr = listener.local_addr().map_err(|e| e.to_string())?;
+    let echo = std::thread::spawn(move || {
+        let Ok((mut c, _)) = listener.accept() else { return };
+        c.set_nodelay(true).ok();
+        let mut b = [0u8; 9];
+        while c.read_exact(&mut b).is_ok() {
+            // Answer like a module would: status 100, same opcode.
+            let reply = [2, 1, 100, b[1], b[4], b[5], b[6], b[7], 0];
+            if c.write_all(&reply).is_err() {
+                break;
+            }
+        }
+    });
+    let mut s = std::net::TcpStream::connect(addr).map_err(|e| e.to_string())?;
+    s.set_nodelay(true).ok();
+    report("baseline: blocking echo thread, loopback TCP", &mut s, frames, n, None)?;
+    drop(s);
+    let _ = echo.join();
+    Ok(())
+}
+
+fn us(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e6
+}
+
+/// User and system CPU time of a process, from /proc.
+fn process_cpu(pid: u32) -> Result<(Duration, Duration), String> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).map_err(|e| e.to_string())?;
+    let after = stat.rsplit_once(')').ok_or("bad /proc stat")?.1;
+    let fields: Vec<&str> = after.split_whitespace().collect();
+    let field = |i: usize| fields[i].parse::<u64>().map_err(|e| e.to_string());
+    // SAFETY: sysconf has no preconditions.
+    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) }.max(1) as u64;
+    let time = |ticks: u64| Duration::from_nanos(ticks * 1_000_000_000 / hz);
+    Ok((time(field(11)?), time(field(12)?)))
+}
