@@ -6,8 +6,9 @@
 
 use crate::module::{ap, error_flag, gp, Compare, Module, Origin, Outcome, Special};
 use crate::motion::RampMode;
+use crate::reference_search::{ReferenceSearch, Switch};
 use crate::profile::{Parameter, PortDirection};
-use tmclsim_protocol::{opcode, CalcOp, Command, ErrorFlag, Instruction, MoveMode, Status};
+use tmclsim_protocol::{opcode, CalcOp, Command, ErrorFlag, Instruction, MoveMode, RfsAction, Status};
 
 type Exec = Result<i32, Status>;
 
@@ -271,8 +272,21 @@ impl Module {
             UserFunction { .. } => Err(Status::NotAvailable),
             StopApplication | RunApplication { .. } | StepApplication | ResetApplication | EnterDownload { .. } | ExitDownload
             | ReadMemory { .. } | ApplicationStatus { .. } => unreachable!("handled in execute"),
-            // Reference search and ASCII mode are not part of this firmware yet.
-            Rfs { .. } | AsciiMode => Err(Status::NotAvailable),
+            Rfs { action, motor } => {
+                let m = self.motor(motor)?;
+                match action {
+                    RfsAction::Start => self.start_reference_search(m)?,
+                    RfsAction::Stop => {
+                        if self.axes[m].rfs.take().is_some() {
+                            self.motor_stop(m);
+                        }
+                    }
+                    RfsAction::Status => return Ok(self.reference_search_active(m) as i32),
+                }
+                Ok(echo)
+            }
+            // ASCII mode is not part of this firmware yet.
+            AsciiMode => Err(Status::NotAvailable),
             Sac { .. } => Err(Status::InvalidCommand),
             FirmwareVersion { binary: false } | FactoryDefaults { .. } => unreachable!("handled in execute"),
             Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti => {
@@ -381,6 +395,7 @@ impl Module {
         }
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
+        axis.rfs = None;
         axis.params[ap::TARGET_SPEED as usize] = velocity * sign;
         axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
         axis.motion.mode = RampMode::Velocity;
@@ -391,6 +406,7 @@ impl Module {
     /// MST: velocity mode with target speed 0.
     pub(crate) fn motor_stop(&mut self, m: usize) {
         let axis = &mut self.axes[m];
+        axis.rfs = None;
         axis.params[ap::TARGET_SPEED as usize] = 0;
         axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
         axis.motion.mode = RampMode::Velocity;
@@ -409,6 +425,7 @@ impl Module {
         };
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
+        axis.rfs = None;
         // MVP selects position mode; soft mode, once chosen, stays.
         if axis.motion.mode != RampMode::Soft {
             axis.motion.mode = RampMode::Position;
@@ -454,8 +471,77 @@ impl Module {
     }
 
     /// A reference search is running on this axis.
-    pub(crate) fn reference_search_active(&self, _m: usize) -> bool {
-        false
+    pub(crate) fn reference_search_active(&self, m: usize) -> bool {
+        self.axes[m].rfs.is_some()
+    }
+
+    /// RFS START with the mode of AP 193.
+    fn start_reference_search(&mut self, m: usize) -> Result<(), Status> {
+        let mode = self.axes[m].params[ap::REFERENCE_SEARCH_MODE as usize];
+        let rfs = ReferenceSearch::new(mode).ok_or(Status::InvalidValue)?;
+        self.clear_motion_errors(m);
+        let axis = &mut self.axes[m];
+        axis.notify_on_arrival = false;
+        axis.motion.mode = RampMode::Velocity;
+        axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
+        axis.rfs = Some(rfs);
+        self.reference_search_step(m, true, false);
+        Ok(())
+    }
+
+    /// Lets the reference search look at the switches after a step of
+    /// motion: next seek, final positioning, zeroing.
+    pub(crate) fn reference_search_step(&mut self, m: usize, crossed: bool, arrived: bool) {
+        let Some(mut rfs) = self.axes[m].rfs.take() else { return };
+        let motion = &self.axes[m].motion;
+        if rfs.finish.is_none() && crossed {
+            let x = motion.x;
+            let invert_home = rfs.invert_home;
+            let changed = rfs.look(x, |s, probe| {
+                let (l, r, h) = self.switches_at(m, probe);
+                match s {
+                    Switch::Left => l,
+                    Switch::Right => r,
+                    Switch::Home => h ^ invert_home,
+                }
+            });
+            if changed {
+                // The switch stops the motor at once; the next seek starts
+                // from standstill.
+                self.axes[m].motion.v = 0.0;
+            }
+            if let Some((reference, distance)) = rfs.finish {
+                // Move to the reference point at the switch speed.
+                let axis = &mut self.axes[m];
+                axis.motion.mode = RampMode::Position;
+                axis.params[ap::RAMP_MODE as usize] = RampMode::Position as i32;
+                axis.motion.target = reference.round();
+                if axis.motion.x != axis.motion.target || axis.motion.v != 0.0 {
+                    self.axes[m].rfs = Some(rfs);
+                } else {
+                    self.finish_reference_search(m, distance);
+                }
+                return;
+            }
+        } else if let (Some((_, distance)), true) = (rfs.finish, arrived) {
+            self.finish_reference_search(m, distance);
+            return;
+        }
+        self.axes[m].rfs = Some(rfs);
+    }
+
+    /// At the reference point: AP 197 keeps the old count, the counter
+    /// becomes 0 here, AP 196 gets the switch distance.
+    fn finish_reference_search(&mut self, m: usize, distance: Option<f64>) {
+        {
+            let last = self.actual_position(m);
+            self.axes[m].params[ap::LAST_REFERENCE_POSITION as usize] = last;
+            if let Some(d) = distance {
+                self.axes[m].params[ap::END_SWITCH_DISTANCE as usize] = d.round() as i32;
+            }
+            self.write_axis_parameter(m, ap::ACTUAL_POSITION, 0);
+            self.set_target(m, 0);
+        }
     }
 
     pub(crate) fn actual_position(&self, m: usize) -> i32 {

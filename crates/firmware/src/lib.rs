@@ -11,6 +11,7 @@ pub mod module;
 pub mod motion;
 pub mod profile;
 pub mod program;
+pub mod reference_search;
 pub mod world;
 
 pub use eeprom::Eeprom;

@@ -5,6 +5,7 @@ use crate::eeprom::Eeprom;
 use crate::motion::{self, Motion, RampMode};
 use crate::profile::Profile;
 use crate::program::{Program, RunMode, Source};
+use crate::reference_search::ReferenceSearch;
 use crate::world::World;
 use std::sync::Arc;
 use tmclsim_protocol::frame::version_string_reply;
@@ -32,6 +33,11 @@ pub mod ap {
     pub const SOFT_STOP: u8 = 149;
     pub const END_SWITCH_POWER_DOWN: u8 = 150;
     pub const RAMP_DIVISOR: u8 = 153;
+    pub const REFERENCE_SEARCH_MODE: u8 = 193;
+    pub const REFERENCE_SEARCH_SPEED: u8 = 194;
+    pub const REFERENCE_SWITCH_SPEED: u8 = 195;
+    pub const END_SWITCH_DISTANCE: u8 = 196;
+    pub const LAST_REFERENCE_POSITION: u8 = 197;
     pub const PULSE_DIVISOR: u8 = 154;
     pub const ACTUAL_CURRENT: u8 = 180;
     pub const BOOST_CURRENT: u8 = 200;
@@ -78,6 +84,8 @@ pub struct Axis {
     pub standstill_since: Option<u64>,
     /// A 138 event is due when this axis reaches its target.
     pub notify_on_arrival: bool,
+    /// The reference search in progress.
+    pub rfs: Option<ReferenceSearch>,
 }
 
 /// Result of the last comparison (or of an accumulator load against 0).
@@ -361,6 +369,7 @@ impl Module {
                 mech_offset: mech,
                 standstill_since: Some(self.now_ns),
                 notify_on_arrival: false,
+                rfs: None,
             });
         }
         self.restored_from_eeprom = restored;
@@ -618,38 +627,59 @@ impl Module {
     }
 
     fn advance_axis(&mut self, motor: usize, dt_ns: u64) {
-        let ramp = self.ramp(motor);
         let offset = self.axes[motor].mech_offset;
         let sign = self.shaft_sign();
-        // Switch thresholds in motor coordinates.
-        let mut thresholds = [0.0f64; 4];
+        // Switch edges in motor coordinates.
+        let mut edges = [0.0f64; 8];
         let mut count = 0;
-        for m in self.world.axes[motor].thresholds().take(4) {
-            thresholds[count] = (m - offset) * sign;
+        for m in self.world.axes[motor].thresholds().take(edges.len()) {
+            edges[count] = (m - offset) * sign;
             count += 1;
         }
-        let thresholds = &thresholds[..count];
+        let edges = &edges[..count];
         let was_moving = self.axes[motor].motion.v != 0.0;
-        let mut motion = std::mem::take(&mut self.axes[motor].motion);
-        let step = {
-            let mut stops = |x: f64| self.stops_at(motor, x);
-            motion.advance(dt_ns as f64 * 1e-9, &ramp, &mut stops, thresholds)
-        };
-        let moving = motion.v != 0.0;
+        let searching = self.axes[motor].rfs.is_some();
+        let mut left = dt_ns as f64 * 1e-9;
+        let mut stopped_at = None;
+        let mut arrived = false;
+        let mut elapsed = 0.0;
+        // A reference search looks at every switch edge it passes; plain
+        // motion goes through the whole step at once.
+        for _ in 0..64 {
+            let ramp = self.ramp(motor);
+            let mut motion = std::mem::take(&mut self.axes[motor].motion);
+            let step = {
+                let mut stops = |x: f64| self.stops_at(motor, x);
+                motion.advance(left, &ramp, &mut stops, edges, searching)
+            };
+            self.axes[motor].motion = motion;
+            if let Some(t) = step.stopped_at {
+                stopped_at = Some(elapsed + t);
+            }
+            elapsed += step.elapsed;
+            left -= step.elapsed;
+            arrived |= step.arrived;
+            if searching {
+                self.reference_search_step(motor, step.crossed.is_some(), step.arrived);
+            }
+            if !searching || step.crossed.is_none() || left <= 0.0 {
+                break;
+            }
+        }
+        let moving = self.axes[motor].motion.v != 0.0;
         let axis = &mut self.axes[motor];
-        axis.motion = motion;
         if moving {
             axis.standstill_since = None;
-        } else if let Some(t) = step.stopped_at {
+        } else if let Some(t) = stopped_at {
             axis.standstill_since = Some(self.now_ns + (t * 1e9) as u64);
         } else if was_moving || axis.standstill_since.is_none() {
             axis.standstill_since = Some(self.now_ns);
         }
-        if step.arrived && axis.notify_on_arrival {
+        if arrived && axis.notify_on_arrival {
             axis.notify_on_arrival = false;
             self.push_event(1 << motor);
         }
-        if step.arrived {
+        if arrived && !searching {
             self.raise(Source::TargetReached(motor as u8));
         }
     }
@@ -663,12 +693,17 @@ impl Module {
         x * self.shaft_sign() + self.axes[motor].mech_offset
     }
 
+    /// Where the carriage of an axis is, in the world's coordinates.
+    pub fn mechanical_position(&self, motor: usize) -> f64 {
+        self.mech(motor, self.axes[motor].motion.x)
+    }
+
     /// Logical switch states (after GP 79 polarity): (left, right, home).
     pub fn switches(&self, motor: usize) -> (bool, bool, bool) {
         self.switches_at(motor, self.axes[motor].motion.x)
     }
 
-    fn switches_at(&self, motor: usize, x: f64) -> (bool, bool, bool) {
+    pub(crate) fn switches_at(&self, motor: usize, x: f64) -> (bool, bool, bool) {
         let w = &self.world.axes[motor];
         let m = self.mech(motor, x);
         let invert = self.globals[0][gp::END_SWITCH_POLARITY as usize] == 1;
@@ -676,6 +711,10 @@ impl Module {
     }
 
     pub(crate) fn stops_at(&self, motor: usize, x: f64) -> motion::Stops {
+        if self.axes[motor].rfs.is_some() {
+            // AP 12/13 do not influence the reference search.
+            return motion::Stops::default();
+        }
         let (left, right, _) = self.switches_at(motor, x);
         let p = &self.axes[motor].params;
         motion::Stops {
@@ -691,12 +730,24 @@ impl Module {
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
         let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
+        let mut vmax = p[ap::MAX_SPEED as usize].clamp(0, 2047) as f64;
+        let mut target_velocity = p[ap::TARGET_SPEED as usize] as f64;
+        if let Some(rfs) = &self.axes[motor].rfs {
+            let slow = p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047) as f64;
+            match rfs.current() {
+                Some(seek) => {
+                    let fast = p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047) as f64;
+                    target_velocity = seek.dir * if seek.fast { fast } else { slow };
+                }
+                None => vmax = slow.max(1.0),
+            }
+        }
         motion::Ramp {
-            vmax: motion::velocity_pps(p[ap::MAX_SPEED as usize].clamp(0, 2047) as f64, pd),
+            vmax: motion::velocity_pps(vmax, pd),
             vmin: motion::velocity_pps(p[ap::MIN_SPEED as usize].clamp(0, 2047) as f64, pd),
             accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
             accel_velocity: motion::accel_pps2(a.max(1) as f64, rd, pd),
-            target_velocity: motion::velocity_pps(p[ap::TARGET_SPEED as usize] as f64, pd),
+            target_velocity: motion::velocity_pps(target_velocity, pd),
         }
     }
 }

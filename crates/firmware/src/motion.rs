@@ -66,6 +66,10 @@ pub struct Step {
     pub arrived: bool,
     /// Seconds into the step at which the motor came to rest (if it did).
     pub stopped_at: Option<f64>,
+    /// With `until_crossing`: the threshold reached, where the step ended.
+    pub crossed: Option<f64>,
+    /// Seconds the step covered (less than asked when it ended at a crossing).
+    pub elapsed: f64,
 }
 
 /// AP 138.
@@ -182,8 +186,9 @@ impl Motion {
 
     /// Advances by `dt` seconds. `thresholds` are positions (in the space
     /// of `x`) where a switch changes state; a phase ends there so that the
-    /// caller can re-evaluate the switches.
-    pub fn advance(&mut self, mut dt: f64, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops, thresholds: &[f64]) -> Step {
+    /// caller can re-evaluate the switches. With `until_crossing` the step
+    /// ends at the first threshold reached.
+    pub fn advance(&mut self, mut dt: f64, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops, thresholds: &[f64], until_crossing: bool) -> Step {
         let mut step = Step::default();
         let mut elapsed = 0.0;
         for _ in 0..MAX_PHASES {
@@ -216,6 +221,13 @@ impl Motion {
                     self.v = 0.0;
                     self.stopped_by_switch = true;
                 }
+                if until_crossing {
+                    step.crossed = Some(th);
+                    if was_moving && self.v == 0.0 {
+                        step.stopped_at = Some(elapsed);
+                    }
+                    break;
+                }
             } else if t >= phase.duration && phase.arrives {
                 self.x = self.target;
                 self.v = 0.0;
@@ -230,6 +242,7 @@ impl Motion {
             self.stopped_by_switch = false;
             step.stopped_at = None;
         }
+        step.elapsed = elapsed;
         step
     }
 
@@ -499,7 +512,7 @@ mod tests {
     fn run_to_target(m: &mut Motion, r: &Ramp, step: f64) -> f64 {
         let mut t = 0.0;
         while !m.is_idle(r, &Stops::default()) {
-            m.advance(step, r, &mut |_| Stops::default(), &[]);
+            m.advance(step, r, &mut |_| Stops::default(), &[], false);
             t += step;
             assert!(t < 1e6, "never arrives");
         }
@@ -547,9 +560,9 @@ mod tests {
         let r = ramp(30_000.0, 50_000.0, 1.0);
         let mut a = Motion { target: 1_000_000.0, ..Motion::default() };
         let mut b = a.clone();
-        a.advance(12.0, &r, &mut |_| Stops::default(), &[]);
+        a.advance(12.0, &r, &mut |_| Stops::default(), &[], false);
         for _ in 0..12_000 {
-            b.advance(0.001, &r, &mut |_| Stops::default(), &[]);
+            b.advance(0.001, &r, &mut |_| Stops::default(), &[], false);
         }
         assert!((a.x - b.x).abs() < 1e-3, "{} {}", a.x, b.x);
         assert!((a.v - b.v).abs() < 1e-3);
@@ -560,12 +573,12 @@ mod tests {
         let mut r = ramp(1.0, 1_000.0, 1.0);
         r.target_velocity = 5_000.0;
         let mut m = Motion { mode: RampMode::Velocity, ..Motion::default() };
-        m.advance(2.5, &r, &mut |_| Stops::default(), &[]);
+        m.advance(2.5, &r, &mut |_| Stops::default(), &[], false);
         assert!((m.v - 2_500.0).abs() < 1e-6);
-        m.advance(10.0, &r, &mut |_| Stops::default(), &[]);
+        m.advance(10.0, &r, &mut |_| Stops::default(), &[], false);
         assert_eq!(m.v, 5_000.0);
         r.target_velocity = 0.0;
-        m.advance(10.0, &r, &mut |_| Stops::default(), &[]);
+        m.advance(10.0, &r, &mut |_| Stops::default(), &[], false);
         assert_eq!(m.v, 0.0);
     }
 
@@ -575,7 +588,7 @@ mod tests {
         r.target_velocity = 2_000.0;
         let mut m = Motion { mode: RampMode::Velocity, ..Motion::default() };
         let mut stops = |x: f64| Stops { block_positive: x >= 5_000.0, block_negative: false, soft: false };
-        m.advance(100.0, &r, &mut stops, &[5_000.0]);
+        m.advance(100.0, &r, &mut stops, &[5_000.0], false);
         assert_eq!(m.x, 5_000.0);
         assert_eq!(m.v, 0.0);
         assert!(m.stopped_by_switch);

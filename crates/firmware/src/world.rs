@@ -9,10 +9,14 @@
 /// Switches along one axis.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AxisWorld {
-    /// The left stop switch is pressed at or below this position.
+    /// The left stop switch is pressed at or below this position…
     pub left_switch: Option<f64>,
-    /// The right stop switch is pressed at or above this position.
+    /// …down to this far below it (`None`: all the way).
+    pub left_width: Option<f64>,
+    /// The right stop switch is pressed at or above this position…
     pub right_switch: Option<f64>,
+    /// …up to this far above it (`None`: all the way).
+    pub right_width: Option<f64>,
     /// The home switch is pressed between these positions (inclusive).
     pub home_switch: Option<(f64, f64)>,
     /// Levels driven by hand; they override the positions above.
@@ -23,11 +27,11 @@ pub struct AxisWorld {
 
 impl AxisWorld {
     pub fn left_pressed(&self, mech: f64) -> bool {
-        self.forced_left.unwrap_or_else(|| self.left_switch.is_some_and(|p| mech <= p))
+        self.forced_left.unwrap_or_else(|| self.left_switch.is_some_and(|p| mech <= p && self.left_width.is_none_or(|w| mech >= p - w)))
     }
 
     pub fn right_pressed(&self, mech: f64) -> bool {
-        self.forced_right.unwrap_or_else(|| self.right_switch.is_some_and(|p| mech >= p))
+        self.forced_right.unwrap_or_else(|| self.right_switch.is_some_and(|p| mech >= p && self.right_width.is_none_or(|w| mech <= p + w)))
     }
 
     pub fn home_pressed(&self, mech: f64) -> bool {
@@ -37,7 +41,9 @@ impl AxisWorld {
     /// Mechanical positions where a switch changes state.
     pub fn thresholds(&self) -> impl Iterator<Item = f64> + '_ {
         let home = self.home_switch.map(|(a, b)| [a, b]);
-        self.left_switch.into_iter().chain(self.right_switch).chain(home.into_iter().flatten())
+        let left_end = self.left_switch.zip(self.left_width).map(|(p, w)| p - w);
+        let right_end = self.right_switch.zip(self.right_width).map(|(p, w)| p + w);
+        self.left_switch.into_iter().chain(left_end).chain(self.right_switch).chain(right_end).chain(home.into_iter().flatten())
     }
 }
 

@@ -1,0 +1,69 @@
+//! The binary program format: 8 bytes per instruction — opcode, type,
+//! motor/bank, value (4 bytes, MSB first) and a checksum, the 8-bit sum of
+//! the seven bytes before it. It is a TMCL request frame without the
+//! address byte, so a host can download it word by word.
+
+use tmclsim_protocol::{checksum, Instruction};
+
+/// Bytes per instruction in a binary file.
+pub const WORD_LEN: usize = 8;
+
+/// The binary image of a list of instructions.
+pub fn encode(instructions: &[Instruction]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(instructions.len() * WORD_LEN);
+    for ins in instructions {
+        let bytes = ins.to_bytes();
+        out.extend_from_slice(&bytes);
+        out.push(checksum(&bytes));
+    }
+    out
+}
+
+/// Reads a binary image; the length must be a multiple of 8 and every
+/// checksum must match.
+pub fn decode(bytes: &[u8]) -> Result<Vec<Instruction>, String> {
+    let trailing = bytes.len() % WORD_LEN;
+    if trailing != 0 {
+        return Err(format!(
+            "binary length {} is not a multiple of {WORD_LEN} bytes ({trailing} trailing byte(s) after address {})",
+            bytes.len(),
+            bytes.len() / WORD_LEN
+        ));
+    }
+    let mut out = Vec::with_capacity(bytes.len() / WORD_LEN);
+    for (address, word) in bytes.chunks_exact(WORD_LEN).enumerate() {
+        let seven: &[u8; 7] = word[..7].try_into().map_err(|_| "internal: short word".to_string())?;
+        let expected = checksum(seven);
+        if word[7] != expected {
+            return Err(format!(
+                "bad checksum at address {address} (byte offset {}): stored 0x{:02X}, expected 0x{expected:02X}",
+                address * WORD_LEN,
+                word[7]
+            ));
+        }
+        out.push(Instruction::from_bytes(seven));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_are_frames_without_address() {
+        let bytes = encode(&[Instruction::new(1, 0, 0, 1000), Instruction::new(4, 1, 0, -10000)]);
+        assert_eq!(bytes, [0x01, 0x00, 0x00, 0x00, 0x00, 0x03, 0xE8, 0xEC, 0x04, 0x01, 0x00, 0xFF, 0xFF, 0xD8, 0xF0, 0xCB]);
+        assert_eq!(decode(&bytes).unwrap()[1].value, -10000);
+    }
+
+    #[test]
+    fn errors_name_the_address() {
+        let mut bytes = encode(&[Instruction::new(1, 0, 0, 1), Instruction::new(2, 0, 0, 2)]);
+        bytes[15] ^= 0xFF;
+        let e = decode(&bytes).unwrap_err();
+        assert!(e.starts_with("bad checksum at address 1 (byte offset 8)"), "{e}");
+        assert!(decode(&bytes[..13]).unwrap_err().contains("not a multiple of 8"));
+        assert_eq!(decode(&[]).unwrap(), vec![]);
+    }
+}

@@ -1,0 +1,178 @@
+//! Finding the files that `#include` names.
+//!
+//! A resolver turns the name written after `#include` into the file's text.
+//! Names are relative to the including file. When a resolver cannot find a
+//! file, the assembler falls back to the include files shipped with
+//! tmclsim (`include/Interrupts.inc`, `include/Parameters.inc`), so that
+//! `#include Interrupts.inc` works everywhere, as it does in the TMCL-IDE.
+
+use std::collections::BTreeMap;
+use std::path::{Component, Path, PathBuf};
+
+/// A file found for an `#include`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IncludedFile {
+    /// Identifies the file: two includes with the same key are the same
+    /// file (used to include a file only once and to find cycles).
+    pub key: String,
+    /// The name diagnostics use for the file.
+    pub name: String,
+    pub text: String,
+}
+
+/// Finds included files.
+pub trait IncludeResolver {
+    /// Resolves `name` as written in `#include` in the file `from` (the
+    /// `name` of an earlier [`IncludedFile`], or the file name given to
+    /// `assemble`). The error is a message for the user.
+    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, String>;
+
+    /// The key of the file given to `assemble` (so that a file including
+    /// the main file is found to be a cycle).
+    fn key(&self, file: &str) -> String {
+        file.to_string()
+    }
+}
+
+/// The include files shipped with tmclsim, by file name.
+pub const BUILT_IN: &[(&str, &str)] = &[
+    ("Interrupts.inc", include_str!("../../../include/Interrupts.inc")),
+    ("Parameters.inc", include_str!("../../../include/Parameters.inc")),
+];
+
+/// A shipped include file by name (case-insensitive, directories ignored).
+pub fn built_in(name: &str) -> Option<IncludedFile> {
+    let base = name.rsplit(['/', '\\']).next().unwrap_or(name);
+    BUILT_IN.iter().find(|(n, _)| n.eq_ignore_ascii_case(base)).map(|(n, text)| IncludedFile {
+        key: format!("<built-in>/{n}"),
+        name: n.to_string(),
+        text: text.to_string(),
+    })
+}
+
+/// Reads included files from disk, relative to the including file, then
+/// from extra search directories in order.
+#[derive(Clone, Debug, Default)]
+pub struct FileResolver {
+    pub search_path: Vec<PathBuf>,
+}
+
+impl FileResolver {
+    pub fn new() -> FileResolver {
+        FileResolver::default()
+    }
+
+    /// Adds a directory searched after the including file's directory.
+    pub fn with_search_dir(mut self, dir: impl Into<PathBuf>) -> FileResolver {
+        self.search_path.push(dir.into());
+        self
+    }
+}
+
+impl IncludeResolver for FileResolver {
+    fn key(&self, file: &str) -> String {
+        std::fs::canonicalize(file).map_or_else(|_| file.to_string(), |p| p.to_string_lossy().into_owned())
+    }
+
+    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, String> {
+        let base = Path::new(from).parent().unwrap_or(Path::new(""));
+        let written = Path::new(name);
+        let mut candidates = vec![base.join(written)];
+        if written.is_relative() {
+            candidates.extend(self.search_path.iter().map(|d| d.join(written)));
+        }
+        for path in &candidates {
+            if !path.is_file() {
+                continue;
+            }
+            let text = std::fs::read(path).map_err(|e| format!("cannot read include file '{}': {e}", path.display()))?;
+            let key = std::fs::canonicalize(path).unwrap_or_else(|_| normalize(path));
+            return Ok(IncludedFile {
+                key: key.to_string_lossy().into_owned(),
+                name: normalize(path).to_string_lossy().into_owned(),
+                text: String::from_utf8_lossy(&text).into_owned(),
+            });
+        }
+        let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
+        Err(format!("cannot find include file '{name}' (looked for {})", looked.join(", ")))
+    }
+}
+
+/// Include files held in memory: a map from path to text. Names are looked
+/// up relative to the including file's directory first, then as written.
+#[derive(Clone, Debug, Default)]
+pub struct MemoryResolver {
+    pub files: BTreeMap<String, String>,
+}
+
+impl MemoryResolver {
+    pub fn new() -> MemoryResolver {
+        MemoryResolver::default()
+    }
+
+    pub fn with(mut self, name: &str, text: &str) -> MemoryResolver {
+        self.files.insert(name.to_string(), text.to_string());
+        self
+    }
+}
+
+impl IncludeResolver for MemoryResolver {
+    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, String> {
+        let base = Path::new(from).parent().unwrap_or(Path::new(""));
+        let relative = normalize(&base.join(name)).to_string_lossy().replace('\\', "/");
+        for candidate in [relative.as_str(), name] {
+            if let Some(text) = self.files.get(candidate) {
+                return Ok(IncludedFile { key: candidate.to_string(), name: candidate.to_string(), text: text.clone() });
+            }
+        }
+        Err(format!("cannot find include file '{name}'"))
+    }
+}
+
+/// Never finds a file (only the shipped include files are available).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoIncludes;
+
+impl IncludeResolver for NoIncludes {
+    fn resolve(&self, _from: &str, name: &str) -> Result<IncludedFile, String> {
+        Err(format!("cannot find include file '{name}'"))
+    }
+}
+
+/// Removes `.` and resolves `..` textually.
+fn normalize(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !out.pop() {
+                    out.push("..");
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_resolver_is_relative_to_the_includer() {
+        let r = MemoryResolver::new().with("lib/a.inc", "X = 1").with("b.inc", "Y = 2");
+        assert_eq!(r.resolve("lib/main.tmc", "a.inc").unwrap().name, "lib/a.inc");
+        assert_eq!(r.resolve("lib/main.tmc", "../b.inc").unwrap().name, "b.inc");
+        assert_eq!(r.resolve("main.tmc", "b.inc").unwrap().name, "b.inc");
+        assert!(r.resolve("main.tmc", "c.inc").is_err());
+    }
+
+    #[test]
+    fn shipped_files_by_name() {
+        assert!(built_in("interrupts.inc").is_some());
+        assert!(built_in("some/dir/Parameters.inc").is_some());
+        assert!(built_in("TMCLParam.tmc").is_none());
+    }
+}
