@@ -6,9 +6,14 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
+mod asm;
 mod bench;
+mod client;
+mod plot;
+mod run;
 mod send;
 mod serve;
+mod upload;
 
 #[derive(Parser)]
 #[command(name = "tmclsim", version, about = "Virtual Trinamic TMCL modules and the open TMCL toolchain")]
@@ -27,6 +32,14 @@ enum Command {
     Profile(ProfileArgs),
     /// Measure commands per second in-process and round trips over TCP and the pty.
     Bench(BenchArgs),
+    /// Assemble TMCL source into a binary and a symbol file.
+    Asm(asm::AsmArgs),
+    /// Disassemble a binary back into TMCL source.
+    Disasm(asm::DisasmArgs),
+    /// Run a TMCL program on a virtual module in virtual time.
+    Run(run::RunArgs),
+    /// Download a program to a module (real or virtual), verify it, start it.
+    Upload(upload::UploadArgs),
 }
 
 #[derive(Args)]
@@ -105,6 +118,10 @@ fn main() -> ExitCode {
         Command::Send(a) => send::run(a),
         Command::Profile(a) => profile(&a.module),
         Command::Bench(a) => bench::run(a),
+        Command::Asm(a) => asm::asm(a),
+        Command::Disasm(a) => asm::disasm(a),
+        Command::Run(a) => run::run(a),
+        Command::Upload(a) => upload::run(a),
     };
     match result {
         Ok(code) => code,

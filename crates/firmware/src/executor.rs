@@ -374,6 +374,11 @@ impl Module {
         if (0..self.profile.module.user_variables as i32).contains(&i) { Ok(i as usize) } else { Err(Status::InvalidValue) }
     }
 
+    /// A user variable (bank 2), for tools.
+    pub fn user_variable_value(&self, i: usize) -> i32 {
+        self.globals[2].get(i).copied().unwrap_or(0)
+    }
+
     pub(crate) fn user_variable(&self, i: usize) -> i32 {
         self.globals[2][i]
     }
@@ -544,7 +549,13 @@ impl Module {
         }
     }
 
-    pub(crate) fn actual_position(&self, m: usize) -> i32 {
+    /// AP 3: the actual speed in internal units.
+    pub fn actual_speed(&self, m: usize) -> i32 {
+        let pd = self.axes[m].params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        crate::motion::velocity_internal(self.axes[m].motion.v, pd).trunc() as i32
+    }
+
+    pub fn actual_position(&self, m: usize) -> i32 {
         self.wrap_position(self.axes[m].motion.position())
     }
 
@@ -602,7 +613,7 @@ impl Module {
         match param {
             ap::TARGET_POSITION => self.axes[m].target_word,
             ap::ACTUAL_POSITION => self.actual_position(m),
-            ap::ACTUAL_SPEED => crate::motion::velocity_internal(motion.v, pd).trunc() as i32,
+            ap::ACTUAL_SPEED => self.actual_speed(m),
             ap::ACTUAL_ACCELERATION => crate::motion::accel_internal(motion.a, rd, pd).round().clamp(-2047.0, 2047.0) as i32,
             ap::POSITION_REACHED => (self.actual_position(m) == self.axes[m].target_word) as i32,
             ap::LEFT_SWITCH => self.switches(m).0 as i32,

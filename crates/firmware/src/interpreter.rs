@@ -124,6 +124,29 @@ impl Module {
         Ok(())
     }
 
+    /// Pauses the program (step mode), as a debugger does.
+    pub fn pause_program(&mut self) {
+        if self.program.mode == RunMode::Run {
+            self.program.mode = RunMode::Step;
+        }
+    }
+
+    /// Runs until one more instruction has executed (a WAIT in progress
+    /// first ends), then pauses; time stops at most `slice_ns` after it.
+    /// Returns false when `limit_ns` came first.
+    pub fn step_instruction(&mut self, limit_ns: u64, slice_ns: u64) -> bool {
+        let before = self.program.executed;
+        self.program.single_step = true;
+        self.start_program();
+        while self.program.executed == before && self.now_ns < limit_ns && self.program.mode == RunMode::Run {
+            let next = if self.program.wait.is_some() { self.now_ns + slice_ns } else { self.program.next_ns.max(self.now_ns + 1) };
+            self.advance_to(next.min(limit_ns));
+        }
+        self.program.single_step = false;
+        self.pause_program();
+        self.program.executed != before
+    }
+
     /// Starts (or continues) the program as 129 does.
     pub fn start_program(&mut self) {
         // A program paused at a breakpoint resumes with that instruction.
@@ -187,7 +210,9 @@ impl Module {
                 self.program.mode = RunMode::Stop;
                 return;
             };
-            let pure = is_pure(ins);
+            // With the trace on, every instruction sees the world of its
+            // own moment (positions in the trace are exact).
+            let pure = is_pure(ins) && self.program.trace.is_none();
             if !pure && self.program.next_ns > self.now_ns {
                 return;
             }
@@ -213,14 +238,18 @@ impl Module {
             Ok(()) => None,
             Err(status) => Some(status.code()),
         };
-        if let Some(trace) = &mut self.program.trace {
-            trace.push(TraceRecord { time_ns: at, pc, instruction: ins, registers: self.registers, failed });
-        }
-        if self.program.mode == RunMode::Step && self.program.wait.is_none() {
-            // A single step leaves the program stopped after one word.
+        if self.program.trace.is_some() {
+            let axes = (0..self.axes.len()).map(|m| (self.actual_position(m), self.actual_speed(m))).collect();
+            let record = TraceRecord { time_ns: at, pc, instruction: ins, registers: self.registers, failed, axes };
+            if let Some(trace) = &mut self.program.trace {
+                trace.push(record);
+            }
         }
         if self.program.pc as usize >= self.program.memory.len() && self.program.mode == RunMode::Run {
             self.program.mode = RunMode::Stop;
+        }
+        if std::mem::take(&mut self.program.single_step) && self.program.mode == RunMode::Run {
+            self.program.mode = RunMode::Step;
         }
     }
 
@@ -375,7 +404,15 @@ impl Module {
 
     /// Enters the handler of the most urgent pending interrupt, if the
     /// program may take one now (decisions.md rule 22).
-    fn take_interrupt(&mut self) {
+    /// An enabled interrupt with a vector is pending and may be taken.
+    pub(crate) fn interrupt_ready(&self) -> bool {
+        self.interrupts_global
+            && self.program.handler.is_none()
+            && self.program.pending != [0; 4]
+            && self.program.first_pending(|n| self.interrupts_enabled[n as usize] && self.interrupt_vectors[n as usize].is_some()).is_some()
+    }
+
+    pub(crate) fn take_interrupt(&mut self) {
         if !self.interrupts_global || self.program.handler.is_some() || self.program.pending == [0; 4] {
             return;
         }

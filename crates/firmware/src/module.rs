@@ -496,6 +496,10 @@ impl Module {
                 if self.program.wait.is_some() {
                     self.check_wait();
                 }
+                if self.program.wait.is_some() && self.interrupt_ready() {
+                    // An interrupt is served during a WAIT; RETI resumes it.
+                    self.take_interrupt();
+                }
                 if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
                     let soon = self.motion_interrupts_armed().then_some(self.now_ns + 1_000_000);
                     let limit = [Some(end), timer, self.heartbeat_deadline(), soon].into_iter().flatten().min().unwrap_or(end);

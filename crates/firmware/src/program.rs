@@ -87,6 +87,9 @@ pub struct TraceRecord {
     pub registers: Registers,
     /// Status when the command failed and was skipped (decisions.md rule 21).
     pub failed: Option<u8>,
+    /// Per axis after the instruction: actual position and actual speed
+    /// (internal units).
+    pub axes: Vec<(i32, i32)>,
 }
 
 /// The interpreter's state.
@@ -116,6 +119,8 @@ pub struct Program {
     pub trace: Option<Vec<TraceRecord>>,
     /// Instructions executed since power-up.
     pub executed: u64,
+    /// Pause (step mode) after the next instruction.
+    pub single_step: bool,
 }
 
 impl Program {
@@ -137,6 +142,7 @@ impl Program {
             hit_breakpoint: None,
             trace: None,
             executed: 0,
+            single_step: false,
         }
     }
 

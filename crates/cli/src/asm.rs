@@ -1,0 +1,84 @@
+//! `tmclsim asm` and `tmclsim disasm`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use tmclsim_asm::{assemble_file, disassemble, render, Program};
+use tmclsim_firmware::Profile;
+
+#[derive(clap::Args)]
+pub struct AsmArgs {
+    /// TMCL source file.
+    pub source: PathBuf,
+    /// Binary output (default: SOURCE with .bin); the symbol file goes
+    /// beside it with .sym.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Check the program against this module's profile.
+    #[arg(long, default_value = "tmcm-1141")]
+    pub module: String,
+    /// Print a listing (address, bytes, source) instead of writing files.
+    #[arg(long)]
+    pub list: bool,
+}
+
+#[derive(clap::Args)]
+pub struct DisasmArgs {
+    /// Binary file (8 bytes per instruction).
+    pub binary: PathBuf,
+    /// Symbol file for label names (default: BINARY with .sym, if present).
+    #[arg(long)]
+    pub symbols: Option<PathBuf>,
+    /// Output file (default: standard output).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+/// Assembles a file against a module profile; diagnostics go to stderr.
+pub fn assemble(source: &Path, module: &str) -> Result<(Program, std::sync::Arc<Profile>), String> {
+    let profile = Profile::built_in(module)?;
+    match assemble_file(source, Some(&profile)) {
+        Ok(p) => Ok((p, profile)),
+        Err(diagnostics) => {
+            eprint!("{}", render(&diagnostics));
+            Err(format!("{}: {} error(s)", source.display(), diagnostics.len()))
+        }
+    }
+}
+
+pub fn asm(args: AsmArgs) -> Result<ExitCode, String> {
+    let (program, _) = assemble(&args.source, &args.module)?;
+    if args.list {
+        let by_address: std::collections::BTreeMap<u32, &str> = program.symbols.iter().map(|(k, v)| (*v, k.as_str())).collect();
+        for (a, ins) in program.instructions.iter().enumerate() {
+            if let Some(label) = by_address.get(&(a as u32)) {
+                println!("{label}:");
+            }
+            let b = ins.to_bytes();
+            println!("{a:5}  {}  {}", crate::client::hex(&b), tmclsim_protocol::mnemonic::format(*ins));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let out = args.output.unwrap_or_else(|| args.source.with_extension("bin"));
+    std::fs::write(&out, program.to_binary()).map_err(|e| format!("{}: {e}", out.display()))?;
+    let sym = out.with_extension("sym");
+    std::fs::write(&sym, program.symbol_file()).map_err(|e| format!("{}: {e}", sym.display()))?;
+    println!("{}: {} instructions → {} and {}", args.source.display(), program.instructions.len(), out.display(), sym.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn disasm(args: DisasmArgs) -> Result<ExitCode, String> {
+    let bytes = std::fs::read(&args.binary).map_err(|e| format!("{}: {e}", args.binary.display()))?;
+    let words = Program::from_binary(&bytes).map_err(|e| format!("{}: {e}", args.binary.display()))?;
+    let sym_path = args.symbols.clone().unwrap_or_else(|| args.binary.with_extension("sym"));
+    let symbols = match std::fs::read_to_string(&sym_path) {
+        Ok(text) => Some(Program::parse_symbol_file(&text).map_err(|e| format!("{}: {e}", sym_path.display()))?),
+        Err(_) if args.symbols.is_none() => None,
+        Err(e) => return Err(format!("{}: {e}", sym_path.display())),
+    };
+    let text = disassemble(&words, symbols.as_ref());
+    match args.output {
+        Some(out) => std::fs::write(&out, text).map_err(|e| format!("{}: {e}", out.display()))?,
+        None => print!("{text}"),
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,256 @@
+//! `tmclsim run`: a TMCL program on a virtual module in virtual time, with
+//! a trace, a plot, breakpoints and an interactive debugger.
+
+use crate::asm::assemble;
+use std::collections::BTreeMap;
+use std::io::{BufRead, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+use tmclsim_firmware::program::RunMode;
+use tmclsim_firmware::Module;
+use tmclsim_protocol::mnemonic;
+
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// TMCL source file.
+    pub source: PathBuf,
+    /// Module profile to run on.
+    #[arg(long, default_value = "tmcm-1141")]
+    pub module: String,
+    /// Virtual time to run: 500ms, 10s, 5m, 1h (a plain number is seconds).
+    #[arg(long = "for", value_name = "DURATION", default_value = "10s", value_parser = parse_duration)]
+    pub duration: u64,
+    /// Write every executed instruction to a CSV file (time, PC,
+    /// instruction, accumulator, X, position and speed per axis).
+    #[arg(long, value_name = "FILE.csv")]
+    pub trace: Option<PathBuf>,
+    /// Draw position and velocity over time per axis into a PNG file.
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<PathBuf>,
+    /// Stop at a label or address and enter the debugger (repeatable).
+    #[arg(long = "break", value_name = "LABEL|ADDR")]
+    pub breakpoints: Vec<String>,
+    /// Start in the interactive debugger (step, continue, inspect).
+    #[arg(long)]
+    pub debug: bool,
+}
+
+/// Parses `500ms`, `10s`, `5m`, `1h`, `2.5` (seconds) into nanoseconds.
+pub fn parse_duration(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let (number, scale) = if let Some(n) = t.strip_suffix("ms") {
+        (n, 1e6)
+    } else if let Some(n) = t.strip_suffix("us") {
+        (n, 1e3)
+    } else if let Some(n) = t.strip_suffix('s') {
+        (n, 1e9)
+    } else if let Some(n) = t.strip_suffix('m') {
+        (n, 60e9)
+    } else if let Some(n) = t.strip_suffix('h') {
+        (n, 3600e9)
+    } else {
+        (t, 1e9)
+    };
+    let v: f64 = number.trim().parse().map_err(|_| format!("'{text}' is not a duration (use e.g. 500ms, 10s, 5m, 1h)"))?;
+    if !(v >= 0.0 && v.is_finite()) {
+        return Err(format!("'{text}' is not a duration"));
+    }
+    Ok((v * scale) as u64)
+}
+
+pub fn run(args: RunArgs) -> Result<ExitCode, String> {
+    let (program, profile) = assemble(&args.source, &args.module)?;
+    let mut module = Module::new(profile.clone());
+    module.load_program(&program.instructions).map_err(|s| format!("the program does not fit the module: {s}"))?;
+    let mut breakpoints = Vec::new();
+    for b in &args.breakpoints {
+        breakpoints.push(resolve(b, &program.symbols)?);
+    }
+    module.set_breakpoints(&breakpoints);
+    let mut trace = match &args.trace {
+        Some(path) => {
+            module.set_trace(true);
+            let f = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let mut w = std::io::BufWriter::new(f);
+            let mut header = "time_s,pc,instruction,accumulator,x,failed_status".to_string();
+            for m in 0..profile.module.axes {
+                header.push_str(&format!(",position_{m},speed_{m}"));
+            }
+            writeln!(w, "{header}").map_err(|e| e.to_string())?;
+            Some(w)
+        }
+        None => None,
+    };
+    let mut samples = args.plot.as_ref().map(|_| crate::plot::Samples::new(profile.module.axes as usize));
+    module.start_program();
+    let started = Instant::now();
+    let end = args.duration;
+    // The run goes in slices: a plot gets 2000 samples, a trace is written
+    // as it comes, the debugger takes over at breakpoints.
+    let slice = if breakpoints.is_empty() { (end / 2000).max(1_000_000) } else { 1_000_000 };
+    let mut debugging = args.debug;
+    let stdin = std::io::stdin();
+    let mut lines = stdin.lock().lines();
+    while module.now_ns() < end {
+        if debugging || module.program().hit_breakpoint.is_some() {
+            if let Some(pc) = module.program().hit_breakpoint {
+                println!("breakpoint at {pc}");
+            }
+            match debugger(&mut module, &program, &mut lines, end)? {
+                Debug::Continue => debugging = false,
+                Debug::Quit => break,
+            }
+            continue;
+        }
+        let next = (module.now_ns() + slice).min(end);
+        module.advance_to(next);
+        if let Some(w) = &mut trace {
+            write_trace(w, &mut module)?;
+        }
+        if let Some(s) = &mut samples {
+            s.take(&module);
+        }
+        if module.program().mode != RunMode::Run && module.program().hit_breakpoint.is_none() && trace.is_none() && samples.is_none() {
+            // Stopped for good: the rest is motion only.
+            module.advance_to(end);
+        }
+    }
+    if let Some(mut w) = trace {
+        write_trace(&mut w, &mut module)?;
+        w.flush().map_err(|e| e.to_string())?;
+    }
+    let wall = started.elapsed();
+    summary(&module, &program.symbols, wall);
+    if let (Some(path), Some(s)) = (&args.plot, &samples) {
+        s.write_png(path)?;
+        println!("plot: {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn resolve(at: &str, symbols: &BTreeMap<String, u32>) -> Result<u16, String> {
+    if let Some(a) = symbols.get(at) {
+        return Ok(*a as u16);
+    }
+    mnemonic::parse_number(at)
+        .and_then(|n| u16::try_from(n).ok())
+        .ok_or_else(|| format!("'{at}' is neither a label of the program nor an address"))
+}
+
+fn write_trace(w: &mut impl Write, module: &mut Module) -> Result<(), String> {
+    for r in module.take_trace() {
+        let mut line = format!(
+            "{:.6},{},{},{},{},{}",
+            r.time_ns as f64 * 1e-9,
+            r.pc,
+            mnemonic::format(r.instruction).replace(',', ""),
+            r.registers.accumulator,
+            r.registers.x,
+            r.failed.map_or(String::new(), |s| s.to_string())
+        );
+        for (p, v) in &r.axes {
+            line.push_str(&format!(",{p},{v}"));
+        }
+        writeln!(w, "{line}").map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+fn summary(m: &Module, symbols: &BTreeMap<String, u32>, wall: std::time::Duration) {
+    let p = m.program();
+    let t = m.now_ns() as f64 * 1e-9;
+    println!(
+        "ran {:.3} s of virtual time in {:.3} s ({:.0}× real time); {} instructions",
+        t,
+        wall.as_secs_f64(),
+        t / wall.as_secs_f64().max(1e-9),
+        p.executed
+    );
+    let label = symbols.iter().find(|(_, a)| **a == p.pc as u32).map(|(l, _)| format!(" ({l})")).unwrap_or_default();
+    println!("program: {:?} at {}{label}{}", p.mode, p.pc, if p.wait.is_some() { ", waiting" } else { "" });
+    inspect(m);
+}
+
+fn inspect(m: &Module) {
+    let r = m.registers();
+    let p = m.program();
+    println!("  accumulator {}  X {}  compare {:?}  error flags {:#04x}", r.accumulator, r.x, r.compare, r.errors);
+    println!("  stack {:?}  interrupt handler {}", p.stack, if p.handler.is_some() { "active" } else { "none" });
+    for a in 0..m.profile().module.axes as usize {
+        let axis = m.axis(a);
+        println!("  axis {a}: position {} speed {} target {} mode {:?}", m.actual_position(a), m.actual_speed(a), axis.target_word, axis.motion.mode);
+    }
+    println!("  outputs {:#b}", m.outputs());
+    let vars: Vec<String> = (0..m.profile().module.user_variables as usize).filter_map(|i| {
+        let v = m.user_variable_value(i);
+        (v != 0).then(|| format!("{i}={v}"))
+    }).collect();
+    if !vars.is_empty() {
+        println!("  user variables {}", vars.join(" "));
+    }
+}
+
+enum Debug {
+    Continue,
+    Quit,
+}
+
+/// The interactive debugger: one command per line.
+fn debugger(m: &mut Module, program: &tmclsim_asm::Program, lines: &mut impl Iterator<Item = std::io::Result<String>>, end: u64) -> Result<Debug, String> {
+    m.pause_program();
+    println!("debugger: s[tep] [N], c[ontinue], i[nspect], l[ist], b[reak] LABEL|ADDR, d[elete] LABEL|ADDR, q[uit]");
+    loop {
+        let pc = m.program().pc;
+        let here = program.instructions.get(pc as usize).map_or("(end of program)".into(), |i| mnemonic::format(*i));
+        let waiting = if m.program().wait.is_some() { " (waiting)" } else { "" };
+        print!("[{:.3} s] {pc}: {here}{waiting} > ", m.now_ns() as f64 * 1e-9);
+        std::io::stdout().flush().ok();
+        let Some(line) = lines.next() else { return Ok(Debug::Quit) };
+        let line = line.map_err(|e| e.to_string())?;
+        let mut words = line.split_whitespace();
+        match words.next().unwrap_or("") {
+            "s" | "step" => {
+                let n: u64 = words.next().and_then(|w| w.parse().ok()).unwrap_or(1);
+                for _ in 0..n {
+                    step_one(m, end);
+                }
+            }
+            "c" | "continue" => {
+                m.start_program();
+                return Ok(Debug::Continue);
+            }
+            "i" | "inspect" => inspect(m),
+            "l" | "list" => {
+                let from = pc.saturating_sub(3) as usize;
+                for a in from..(from + 8).min(program.instructions.len()) {
+                    let mark = if a == pc as usize { "=>" } else { "  " };
+                    println!("{mark} {a:5}  {}", mnemonic::format(program.instructions[a]));
+                }
+            }
+            cmd @ ("b" | "break" | "d" | "delete") => match words.next().map(|w| resolve(w, &program.symbols)) {
+                Some(Ok(a)) => {
+                    let mut bps = m.program().breakpoints.clone();
+                    bps.retain(|b| *b != a);
+                    if cmd.starts_with('b') {
+                        bps.push(a);
+                    }
+                    m.set_breakpoints(&bps);
+                    println!("breakpoints: {bps:?}");
+                }
+                Some(Err(e)) => println!("{e}"),
+                None => println!("breakpoints: {:?}", m.program().breakpoints),
+            },
+            "q" | "quit" => return Ok(Debug::Quit),
+            "" => {}
+            other => println!("unknown command '{other}'"),
+        }
+    }
+}
+
+fn step_one(m: &mut Module, end: u64) {
+    let bps = m.program().breakpoints.clone();
+    m.set_breakpoints(&[]);
+    m.step_instruction(end, 10_000_000);
+    m.set_breakpoints(&bps);
+}

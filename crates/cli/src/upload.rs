@@ -1,0 +1,85 @@
+//! `tmclsim upload`: download a program to any TMCL module, real or
+//! virtual, verify it by reading it back with 134, optionally start it.
+
+use crate::client::{hex, Client};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use tmclsim_asm::Program;
+use tmclsim_protocol::{opcode, Instruction, Status};
+
+#[derive(clap::Args)]
+pub struct UploadArgs {
+    /// TMCL source (.tmc) or binary (.bin, 8 bytes per instruction).
+    pub program: PathBuf,
+    /// TCP address of the module.
+    #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
+    pub tcp: Option<String>,
+    /// Serial port of the module.
+    #[arg(long, value_name = "DEV")]
+    pub port: Option<String>,
+    #[arg(long, default_value_t = 9600)]
+    pub baud: u32,
+    /// Module address.
+    #[arg(long, default_value_t = 1)]
+    pub address: u8,
+    /// Profile to check the source against.
+    #[arg(long, default_value = "tmcm-1141")]
+    pub module: String,
+    /// Start the program after the upload (129 from address 0).
+    #[arg(long)]
+    pub run: bool,
+    /// Make the program start at power-up (GP 77 = 1).
+    #[arg(long)]
+    pub autostart: bool,
+    /// Reply timeout in milliseconds.
+    #[arg(long, value_name = "MS", default_value_t = 2000)]
+    pub timeout: u64,
+}
+
+pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
+    let words: Vec<Instruction> = if args.program.extension().is_some_and(|e| e == "bin") {
+        let bytes = std::fs::read(&args.program).map_err(|e| format!("{}: {e}", args.program.display()))?;
+        Program::from_binary(&bytes)?
+    } else {
+        crate::asm::assemble(&args.program, &args.module)?.0.instructions
+    };
+    let mut c = Client::open(args.tcp.as_deref(), args.port.as_deref(), args.baud, args.address, crate::millis(args.timeout))?;
+    let ok = |r: tmclsim_protocol::Reply, what: &str| -> Result<(), String> {
+        if r.status < 100 {
+            let s = Status::from_code(r.status).map_or(r.status.to_string(), |s| s.to_string());
+            return Err(format!("{what}: the module answered status {s}"));
+        }
+        Ok(())
+    };
+    ok(c.request(Instruction::new(opcode::STOP_APPLICATION, 0, 0, 0))?, "stop")?;
+    ok(c.request(Instruction::new(opcode::ENTER_DOWNLOAD, 0, 0, 0))?, "enter download mode")?;
+    for (a, w) in words.iter().enumerate() {
+        let r = c.request(*w)?;
+        if r.status != Status::Loaded.code() {
+            let _ = c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
+            return Err(format!("word {a} ({}) was not stored: status {}", tmclsim_protocol::mnemonic::format(*w), r.status));
+        }
+    }
+    ok(c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0))?, "exit download mode")?;
+    // Verify by reading every word back.
+    for (a, w) in words.iter().enumerate() {
+        let raw = c.exchange(Instruction::new(opcode::READ_MEMORY, 0, 0, a as i32))?;
+        if raw[1] == args.address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
+            return Err(format!("read-back of word {a}: status {} (code protection?)", raw[2]));
+        }
+        let stored = Instruction::from_bytes(raw[1..8].try_into().unwrap());
+        if stored != *w {
+            return Err(format!("word {a} reads back as {} ({}), not {}", tmclsim_protocol::mnemonic::format(stored), hex(&raw), tmclsim_protocol::mnemonic::format(*w)));
+        }
+    }
+    println!("uploaded and verified {} instructions", words.len());
+    if args.autostart {
+        ok(c.request(Instruction::new(opcode::SGP, 77, 0, 1))?, "autostart (GP 77)")?;
+        println!("autostart on");
+    }
+    if args.run {
+        ok(c.request(Instruction::new(opcode::RUN_APPLICATION, 1, 0, 0))?, "run")?;
+        println!("running");
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,151 @@
+//! `tmclsim asm`, `disasm`, `run` and `upload` as a user runs them.
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+
+fn tmclsim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tmclsim")).args(args).output().unwrap()
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tmclsim-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../asm/tests/programs").join(name)
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+#[test]
+fn asm_disasm_asm_is_byte_identical() {
+    let d = dir("asm");
+    let bin = d.join("prog.bin");
+    let o = tmclsim(&["asm", example("timer_interrupt_3_6_6.tmc").to_str().unwrap(), "-o", bin.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(d.join("prog.sym").exists());
+    let src = d.join("back.tmc");
+    let o = tmclsim(&["disasm", bin.to_str().unwrap(), "-o", src.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(std::fs::read_to_string(&src).unwrap().contains("Timer0Irq:"), "labels from the symbol file");
+    let bin2 = d.join("back.bin");
+    let o = tmclsim(&["asm", src.to_str().unwrap(), "-o", bin2.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(std::fs::read(&bin).unwrap(), std::fs::read(&bin2).unwrap());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn asm_reports_every_error_with_line_and_column() {
+    let d = dir("errors");
+    let src = d.join("bad.tmc");
+    std::fs::write(&src, "Loop:\n  MVP ABS, 0, 1000\n  FOO 1\n  JA Lop\n  SAP 4, 0, 99999\n").unwrap();
+    let o = tmclsim(&["asm", src.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let t = text(&o);
+    assert!(t.contains("bad.tmc:3:3:"), "{t}");
+    assert!(t.contains("bad.tmc:4:6:"), "{t}");
+    assert!(t.contains("bad.tmc:5:"), "{t}");
+    assert!(t.contains("3 error(s)"), "{t}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn run_prints_a_summary_and_writes_trace_and_plot() {
+    let d = dir("run");
+    let csv = d.join("t.csv");
+    let png = d.join("p.png");
+    let o = tmclsim(&[
+        "run",
+        example("djnz_3_7_43.tmc").to_str().unwrap(),
+        "--for",
+        "30s",
+        "--trace",
+        csv.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("ran 30.000 s of virtual time"), "{t}");
+    let trace = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = trace.lines();
+    assert_eq!(lines.next(), Some("time_s,pc,instruction,accumulator,x,failed_status,position_0,speed_0"));
+    assert_eq!(lines.next().unwrap(), "0.000000,0,SGP 42 2 100,0,0,,0,0");
+    assert!(trace.lines().any(|l| l.contains("DJNZ 42 1")));
+    let image = std::fs::read(&png).unwrap();
+    assert_eq!(&image[..8], &[0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1A, b'\n']);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn run_with_breakpoint_and_scripted_debugger() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["run", example("djnz_3_7_43.tmc").to_str().unwrap(), "--for", "60s", "--break", "Loop"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write;
+    child.stdin.as_mut().unwrap().write_all(b"i\ns\ns\ni\nq\n").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let t = String::from_utf8_lossy(&out.stdout);
+    assert!(t.contains("breakpoint at 1"), "{t}");
+    assert!(t.contains("1: MVP REL, 0, 51200"), "{t}");
+    assert!(t.contains("user variables 42=100"), "{t}");
+}
+
+fn serve(d: &Path) -> (Child, String, PathBuf) {
+    let pty = d.join("pty");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["serve", "--tcp", "127.0.0.1:0", "--pty", pty.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut tcp = String::new();
+    loop {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "server ended");
+        if let Some(a) = line.trim().strip_prefix("tcp: ") {
+            tcp = a.to_string();
+        }
+        if line.starts_with("connect with:") {
+            break;
+        }
+    }
+    std::thread::spawn(move || {
+        let mut sink = vec![];
+        let _ = out.read_to_end(&mut sink);
+    });
+    (child, tcp, pty)
+}
+
+#[test]
+fn upload_over_tcp_and_pty_verifies_and_runs() {
+    let d = dir("upload");
+    let (mut server, tcp, pty) = serve(&d);
+    let prog = example("djnz_3_7_43.tmc");
+    let o = tmclsim(&["upload", prog.to_str().unwrap(), "--tcp", &tcp, "--run"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("uploaded and verified 5 instructions"), "{}", text(&o));
+    let o = tmclsim(&["send", "--tcp", &tcp, "GGP", "128,", "0"]);
+    assert!(text(&o).contains("value 1"), "running: {}", text(&o));
+    // Over the pty, a binary this time, with autostart.
+    let bin = d.join("p.bin");
+    assert!(tmclsim(&["asm", example("call_3_7_44.tmc").to_str().unwrap(), "-o", bin.to_str().unwrap()]).status.success());
+    let o = tmclsim(&["upload", bin.to_str().unwrap(), "--port", pty.to_str().unwrap(), "--autostart"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let o = tmclsim(&["send", "--port", pty.to_str().unwrap(), "GGP", "77,", "0"]);
+    assert!(text(&o).contains("value 1"), "{}", text(&o));
+    let o = tmclsim(&["send", "--port", pty.to_str().unwrap(), "#134", "0", "0", "0"]);
+    assert!(text(&o).contains("memory:  GIO 0, 1"), "{}", text(&o));
+    server.kill().unwrap();
+    server.wait().unwrap();
+    std::fs::remove_dir_all(&d).unwrap();
+}
