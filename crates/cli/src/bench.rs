@@ -32,6 +32,8 @@ pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
     std::hint::black_box(sink);
     println!("| in-process `handle_frame` | {n} | {:.1} M commands/s ({:.1} ns each) |", n as f64 / dt.as_secs_f64() / 1e6, dt.as_nanos() as f64 / n as f64);
 
+    programs()?;
+
     // Over the links of a `tmclsim serve` process.
     let dir = std::env::temp_dir().join(format!("tmclsim-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
@@ -116,6 +118,55 @@ fn report(name: &str, link: &mut (impl Read + Write), frames: &[[u8; 9]], n: usi
     );
     Ok(())
 }
+
+/// The program interpreter and the assembler.
+fn programs() -> Result<(), String> {
+    let profile = tmclsim_firmware::Profile::built_in("tmcm-1141")?;
+    let asm = |src: &str| tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d));
+    // A compute-only loop: 3 instructions per turn, never ending.
+    let compute = asm("Loop:\n  CALC ADD, 1\n  COMP 2000000000\n  JC LT, Loop\n  STOP\n")?;
+    let mut m = Module::new(profile.clone());
+    m.load_program(&compute.instructions).map_err(|s| s.to_string())?;
+    m.start_program();
+    let t = Instant::now();
+    m.advance(3_600_000_000_000);
+    let wall = t.elapsed().as_secs_f64();
+    let n = m.program().executed;
+    println!("| VM, compute-only loop, 1 h of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |", n as f64 / wall / 1e6, 3600.0 / wall);
+    // The manual's 2.4 program (moves and WAIT POS) for an hour.
+    let motion = asm(FIRST_STEPS)?;
+    let mut m = Module::new(profile.clone());
+    m.load_program(&motion.instructions).map_err(|s| s.to_string())?;
+    m.start_program();
+    let t = Instant::now();
+    m.advance(3_600_000_000_000);
+    let wall = t.elapsed().as_secs_f64();
+    let n = m.program().executed;
+    println!("| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |", 3600.0 / wall, wall * 1e3);
+    // A busy motion loop: GAP/COMP/JC polling while the motor moves.
+    let polling = asm("Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n")?;
+    let mut m = Module::new(profile.clone());
+    m.load_program(&polling.instructions).map_err(|s| s.to_string())?;
+    m.start_program();
+    let t = Instant::now();
+    m.advance(600_000_000_000);
+    let wall = t.elapsed().as_secs_f64();
+    let n = m.program().executed;
+    println!("| VM, polling motion loop (GAP 8/JC), 10 min of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |", n as f64 / wall / 1e6, 600.0 / wall);
+    // The assembler.
+    let mut src = String::from("Speed = 1000\nAccel = Speed / 2 + 3\n");
+    let lines = 50_000;
+    for i in 0..lines / 5 {
+        src.push_str(&format!("L{i}:\n  SAP 4, 0, Speed\n  MVP ABS, 0, {i} * 100 + Accel\n  WAIT POS, 0, 0\n  JC NZ, L{}\n", i / 2));
+    }
+    let t = Instant::now();
+    let p = tmclsim_asm::assemble(&src, "bench.tmc", &tmclsim_asm::NoIncludes, None).map_err(|d| tmclsim_asm::render(&d))?;
+    let wall = t.elapsed().as_secs_f64();
+    println!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), lines as f64 / wall / 1e6);
+    Ok(())
+}
+
+const FIRST_STEPS: &str = "  ROL 0, 1000\n  WAIT TICKS, 0, 500\n  MST 0\n  ROR 0, 100\n  WAIT TICKS, 0, 500\n  MST 0\n  SAP 4, 0, 100\n  SAP 5, 0, 100\nLoop:\n  MVP ABS, 0, 512000\n  WAIT POS, 0, 0\n  MVP ABS, 0, -512000\n  WAIT POS, 0, 0\n  JA Loop\n";
 
 /// The machine's floor: a blocking echo thread over loopback TCP in this
 /// process, with the same frames.

@@ -30,6 +30,14 @@ fn bench(c: &mut Criterion) {
         });
     }
     g.finish();
+    c.bench_function("program: 1000 instructions of a compute loop", |b| {
+        // CALC ADD 1; COMP 2^31-1; JC LT 0
+        let words = ["CALC ADD, 1", "COMP 2147483647", "JC LT, 0"].map(|l| parse_line(l).unwrap());
+        let mut m = Module::built_in("tmcm-1141").unwrap();
+        m.load_program(&words).unwrap();
+        m.start_program();
+        b.iter(|| m.advance(black_box(25_000_000)))
+    });
     c.bench_function("advance 1 ms while moving", |b| {
         let mut m = Module::built_in("tmcm-1141").unwrap();
         m.handle_frame(&frames(&["ROR 0, 1000"])[0]);
