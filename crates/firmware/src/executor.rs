@@ -619,7 +619,9 @@ impl Module {
             ap::LEFT_SWITCH => self.switches(m).0 as i32,
             ap::RIGHT_SWITCH => self.switches(m).1 as i32,
             ap::HOME_SWITCH => self.switches(m).2 as i32,
-            ap::ACTUAL_CURRENT => (self.motor_current(m) >> 3) as i32,
+            ap::ACTUAL_CURRENT => self.current_scale(m).round() as i32,
+            ap::LOAD_VALUE => self.axes[m].driver.load_value,
+            ap::DRIVER_ERROR_FLAGS => self.driver_flags(m),
             ap::EXTENDED_ERROR_FLAGS => {
                 // Cleared by reading.
                 std::mem::take(&mut self.axes[m].params[param as usize])
@@ -634,6 +636,10 @@ impl Module {
         let p = &axis.params;
         let run = p[ap::MAX_CURRENT as usize].clamp(0, 255) as u32;
         if axis.motion.v != 0.0 {
+            let slow = p[ap::SMART_ENERGY_SLOW_RUN_CURRENT as usize].clamp(0, 255) as u32;
+            if p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0 && slow > 0 && self.actual_speed(m).abs() < p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize] {
+                return slow;
+            }
             let boost = p[ap::BOOST_CURRENT as usize].clamp(0, 255) as u32;
             return if axis.motion.a != 0.0 && boost > 0 { boost } else { run };
         }

@@ -4,6 +4,7 @@
 //! Pure and deterministic: a [`Module`] changes only through
 //! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
 
+pub mod driver;
 pub mod eeprom;
 pub mod executor;
 mod interpreter;
@@ -13,6 +14,7 @@ pub mod profile;
 pub mod program;
 pub mod reference_search;
 pub mod world;
+pub mod world_file;
 
 pub use eeprom::Eeprom;
 pub use module::{Module, Outcome, Special};

@@ -5,6 +5,7 @@ use crate::eeprom::Eeprom;
 use crate::motion::{self, Motion, RampMode};
 use crate::profile::Profile;
 use crate::program::{Program, RunMode, Source};
+use crate::driver::Driver;
 use crate::reference_search::ReferenceSearch;
 use crate::world::World;
 use std::sync::Arc;
@@ -32,6 +33,20 @@ pub mod ap {
     pub const RAMP_MODE: u8 = 138;
     pub const SOFT_STOP: u8 = 149;
     pub const END_SWITCH_POWER_DOWN: u8 = 150;
+    pub const MICROSTEP_RESOLUTION: u8 = 140;
+    pub const CHOPPER_OFF_TIME: u8 = 167;
+    pub const SMART_ENERGY_CURRENT_MINIMUM: u8 = 168;
+    pub const SMART_ENERGY_CURRENT_DOWN_STEP: u8 = 169;
+    pub const SMART_ENERGY_HYSTERESIS: u8 = 170;
+    pub const SMART_ENERGY_CURRENT_UP_STEP: u8 = 171;
+    pub const SMART_ENERGY_HYSTERESIS_START: u8 = 172;
+    pub const STALLGUARD_FILTER: u8 = 173;
+    pub const STALLGUARD_THRESHOLD: u8 = 174;
+    pub const STOP_ON_STALL: u8 = 181;
+    pub const SMART_ENERGY_THRESHOLD_SPEED: u8 = 182;
+    pub const SMART_ENERGY_SLOW_RUN_CURRENT: u8 = 183;
+    pub const LOAD_VALUE: u8 = 206;
+    pub const DRIVER_ERROR_FLAGS: u8 = 208;
     pub const RAMP_DIVISOR: u8 = 153;
     pub const REFERENCE_SEARCH_MODE: u8 = 193;
     pub const REFERENCE_SEARCH_SPEED: u8 = 194;
@@ -86,6 +101,7 @@ pub struct Axis {
     pub notify_on_arrival: bool,
     /// The reference search in progress.
     pub rfs: Option<ReferenceSearch>,
+    pub driver: Driver,
 }
 
 /// Result of the last comparison (or of an accumulator load against 0).
@@ -359,7 +375,8 @@ impl Module {
                 }
             }
             // The carriage stays where it is; the position counter restarts at 0.
-            let mech = old_axes.get(motor as usize).map_or(0.0, |a| a.motion.x + a.mech_offset);
+            let sign = self.shaft_sign();
+            let mech = old_axes.get(motor as usize).map_or(self.world.axes[motor as usize].start, |a| a.motion.x * sign + a.mech_offset);
             let mode = RampMode::from_code(params[ap::RAMP_MODE as usize]);
             self.axes.push(Axis {
                 params,
@@ -370,6 +387,7 @@ impl Module {
                 standstill_since: Some(self.now_ns),
                 notify_on_arrival: false,
                 rfs: None,
+                driver: Driver::default(),
             });
         }
         self.restored_from_eeprom = restored;
@@ -651,12 +669,14 @@ impl Module {
         // motion goes through the whole step at once.
         for _ in 0..64 {
             let ramp = self.ramp(motor);
+            let x_before = self.axes[motor].motion.x;
             let mut motion = std::mem::take(&mut self.axes[motor].motion);
             let step = {
                 let mut stops = |x: f64| self.stops_at(motor, x);
                 motion.advance(left, &ramp, &mut stops, edges, searching)
             };
             self.axes[motor].motion = motion;
+            self.drive(motor, x_before, step.elapsed);
             if let Some(t) = step.stopped_at {
                 stopped_at = Some(elapsed + t);
             }

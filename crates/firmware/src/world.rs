@@ -23,6 +23,47 @@ pub struct AxisWorld {
     pub forced_left: Option<bool>,
     pub forced_right: Option<bool>,
     pub forced_home: Option<bool>,
+    /// Mechanical end stops: the carriage cannot leave this range (the
+    /// motor loses steps against them).
+    pub travel: Option<(f64, f64)>,
+    /// Mechanical loads, in % of the motor's rated torque.
+    pub loads: Vec<Load>,
+    /// Where the carriage stands at the first power-up.
+    pub start: f64,
+    /// Driver faults injected by hand.
+    pub faults: DriverFaults,
+}
+
+/// A load on an axis: a torque demand in % of what the motor gives at
+/// full current and standstill, optionally only in a position range and/or
+/// a time window.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Load {
+    pub torque: f64,
+    /// Mechanical position range (inclusive).
+    pub from: Option<f64>,
+    pub to: Option<f64>,
+    /// Virtual time window in seconds.
+    pub after: Option<f64>,
+    pub until: Option<f64>,
+}
+
+impl Load {
+    pub fn applies(&self, mech: f64, t_s: f64) -> bool {
+        self.from.is_none_or(|a| mech >= a)
+            && self.to.is_none_or(|b| mech <= b)
+            && self.after.is_none_or(|a| t_s >= a)
+            && self.until.is_none_or(|u| t_s < u)
+    }
+}
+
+/// Motor driver faults (TMC262 flags of AP 208).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DriverFaults {
+    pub short_a: bool,
+    pub short_b: bool,
+    pub open_a: bool,
+    pub open_b: bool,
 }
 
 impl AxisWorld {
@@ -36,6 +77,12 @@ impl AxisWorld {
 
     pub fn home_pressed(&self, mech: f64) -> bool {
         self.forced_home.unwrap_or_else(|| self.home_switch.is_some_and(|(a, b)| mech >= a && mech <= b))
+    }
+
+    /// The torque demand at a mechanical position and time (sum of the
+    /// loads that apply).
+    pub fn load_at(&self, mech: f64, t_s: f64) -> f64 {
+        self.loads.iter().filter(|l| l.applies(mech, t_s)).map(|l| l.torque).sum()
     }
 
     /// Mechanical positions where a switch changes state.
@@ -57,12 +104,33 @@ pub struct World {
     pub analog_inputs: Vec<u16>,
     /// Supply voltage in 0.1 V.
     pub supply_decivolts: u16,
+    /// Driver temperature in °C.
+    pub temperature: f64,
 }
 
 impl World {
-    /// A world with free axes (no switches), inputs low and 24 V supply.
+    /// A world with free axes (no switches), inputs low, 24 V supply,
+    /// 40 °C.
     pub fn free(axes: usize) -> World {
-        World { axes: vec![AxisWorld::default(); axes], digital_inputs: 0, analog_inputs: vec![0; 8], supply_decivolts: 240 }
+        World { axes: vec![AxisWorld::default(); axes], digital_inputs: 0, analog_inputs: vec![0; 8], supply_decivolts: 240, temperature: 40.0 }
+    }
+
+    /// The built-in world: every axis a linear stage of ±1 050 000 µsteps
+    /// (about ±20 revolutions at 256 microsteps) with a left stop switch
+    /// pressed from −1 000 000 for 20 000 µsteps, a right one from
+    /// +1 000 000, a home switch between 100 000 and 110 000, no load; the
+    /// carriage starts at 0.
+    pub fn stage(axes: usize) -> World {
+        let mut w = World::free(axes);
+        for a in &mut w.axes {
+            a.left_switch = Some(-1_000_000.0);
+            a.left_width = Some(20_000.0);
+            a.right_switch = Some(1_000_000.0);
+            a.right_width = Some(20_000.0);
+            a.home_switch = Some((100_000.0, 110_000.0));
+            a.travel = Some((-1_050_000.0, 1_050_000.0));
+        }
+        w
     }
 
     pub fn digital(&self, n: u8) -> bool {

@@ -1,0 +1,171 @@
+//! The motor driver (TMC262 on the TMCM-1141) and the motor: torque,
+//! stallGuard2, coolStep, error flags, and the steps a motor loses when it
+//! cannot follow.
+//!
+//! The load model (docs/world.md):
+//! - The motor gives `current/255 × (1 − fullsteps_per_s / 2000)` of its
+//!   rated torque: full torque at standstill and full current, falling
+//!   linearly to nothing at 2000 full steps per second (10 rps for a
+//!   200-step motor).
+//! - The world's load asks for a torque in % of the rated torque; the
+//!   margin is `1 − load / available`.
+//! - The stallGuard2 reading (AP 206) is `800 × margin + 8 × AP 174`,
+//!   clamped to 0…1023, measured while the motor moves (it holds the last
+//!   reading at standstill). 0 means the load takes all the torque.
+//! - With a negative margin (overload), a driver that is off (shutdown,
+//!   short, undervoltage, zero current, TOFF = 0) or a carriage at its end
+//!   stop, the motor loses steps: the position counter goes on, the
+//!   carriage does not.
+
+use crate::module::{ap, Module};
+use crate::program::Source;
+
+/// Full steps per second at which the motor has no torque left.
+pub const CORNER_FULLSTEPS: f64 = 2000.0;
+/// The driver shuts down above this temperature (°C)…
+pub const SHUTDOWN_C: f64 = 150.0;
+/// …and warns above this one.
+pub const PREWARNING_C: f64 = 120.0;
+/// Below this supply (0.1 V) the driver is off (undervoltage).
+pub const UNDERVOLTAGE_DV: u16 = 80;
+/// No step for 2^20 clocks of 16 MHz: the standstill flag.
+pub const STANDSTILL_NS: u64 = 65_536_000;
+
+/// Per-axis driver state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Driver {
+    /// Last stallGuard2 reading, 0…1023.
+    pub load_value: i32,
+    /// coolStep's current scale (0…31), while coolStep regulates.
+    pub cool_scale: Option<f64>,
+    /// Measurements towards the next coolStep decrement.
+    pub down_count: f64,
+}
+
+impl Module {
+    /// The driver is switched off (no torque) and why, as AP 208 bits.
+    pub(crate) fn driver_off(&self, m: usize) -> bool {
+        let f = self.world.axes[m].faults;
+        self.world.temperature >= SHUTDOWN_C
+            || f.short_a
+            || f.short_b
+            || self.world.supply_decivolts < UNDERVOLTAGE_DV
+            || self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0
+    }
+
+    /// AP 208.
+    pub(crate) fn driver_flags(&self, m: usize) -> i32 {
+        let f = self.world.axes[m].faults;
+        let axis = &self.axes[m];
+        let t = self.world.temperature;
+        let still = axis.standstill_since.is_some_and(|s| self.now_ns.saturating_sub(s) >= STANDSTILL_NS);
+        (axis.motion.v != 0.0 && axis.driver.load_value == 0) as i32
+            | ((t >= SHUTDOWN_C) as i32) << 1
+            | ((t >= PREWARNING_C) as i32) << 2
+            | (f.short_a as i32) << 3
+            | (f.short_b as i32) << 4
+            | (f.open_a as i32) << 5
+            | (f.open_b as i32) << 6
+            | (still as i32) << 7
+    }
+
+    /// Current scale in effect (0…31): coolStep's, or the current setting's.
+    pub(crate) fn current_scale(&self, m: usize) -> f64 {
+        match self.axes[m].driver.cool_scale {
+            Some(cs) if self.axes[m].motion.v != 0.0 => cs,
+            _ => (self.motor_current(m) >> 3) as f64,
+        }
+    }
+
+    fn microsteps(&self, m: usize) -> f64 {
+        2f64.powi(self.axes[m].params[ap::MICROSTEP_RESOLUTION as usize].clamp(0, 8))
+    }
+
+    /// Torque margin `1 − load/available` at the axis's state now.
+    fn margin(&self, m: usize, scale: f64) -> f64 {
+        let axis = &self.axes[m];
+        let fullsteps = axis.motion.v.abs() / self.microsteps(m);
+        let available = if self.driver_off(m) { 0.0 } else { (scale + 1.0) / 32.0 * (1.0 - fullsteps / CORNER_FULLSTEPS).max(0.0) * 100.0 };
+        let load = self.world.axes[m].load_at(self.mech(m, axis.motion.x), self.now_ns as f64 * 1e-9);
+        if scale <= 0.0 && self.motor_current(m) == 0 {
+            return if load > 0.0 { -1.0 } else { 1.0 };
+        }
+        if available <= 0.0 {
+            return if load > 0.0 || self.driver_off(m) { -1.0 } else { 1.0 };
+        }
+        1.0 - load / available
+    }
+
+    fn stallguard(&self, m: usize, margin: f64) -> i32 {
+        let sgt = self.axes[m].params[ap::STALLGUARD_THRESHOLD as usize];
+        (800.0 * margin + 8.0 * sgt as f64).round().clamp(0.0, 1023.0) as i32
+    }
+
+    /// After the motion controller moved the axis from `x_before` during
+    /// `dt` seconds: the driver measures, regulates, stops on stall and the
+    /// carriage follows, or not.
+    pub(crate) fn drive(&mut self, m: usize, x_before: f64, dt: f64) {
+        let moved = self.axes[m].motion.x - x_before;
+        let moving = self.axes[m].motion.v != 0.0 || moved != 0.0;
+        let p = self.axes[m].params;
+        let v_int = self.actual_speed(m).abs();
+        // coolStep regulates above its threshold speed, when enabled.
+        let semin = p[ap::SMART_ENERGY_HYSTERESIS_START as usize];
+        let cool = semin > 0 && moving && v_int >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
+        if cool {
+            let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
+            let min = if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
+            let mut cs = self.axes[m].driver.cool_scale.unwrap_or(max);
+            let per_measurement = if p[ap::STALLGUARD_FILTER as usize] == 1 { 4.0 } else { 1.0 };
+            let measurements = (moved.abs() / self.microsteps(m) / per_measurement).min(256.0);
+            let lower = (semin * 32) as i32;
+            let upper = ((semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32) as i32;
+            let up = [1.0, 2.0, 4.0, 8.0][p[ap::SMART_ENERGY_CURRENT_UP_STEP as usize].clamp(0, 3) as usize];
+            let down_every = [32.0, 8.0, 2.0, 1.0][p[ap::SMART_ENERGY_CURRENT_DOWN_STEP as usize].clamp(0, 3) as usize];
+            let mut count = self.axes[m].driver.down_count;
+            for _ in 0..measurements.ceil() as usize {
+                let sg = self.stallguard(m, self.margin(m, cs));
+                if sg < lower {
+                    cs = (cs + up).min(max);
+                    count = 0.0;
+                } else if sg > upper {
+                    count += 1.0;
+                    if count >= down_every {
+                        cs = (cs - 1.0).max(min);
+                        count = 0.0;
+                    }
+                }
+            }
+            self.axes[m].driver.cool_scale = Some(cs);
+            self.axes[m].driver.down_count = count;
+        } else {
+            self.axes[m].driver.cool_scale = None;
+        }
+        let scale = self.current_scale(m);
+        let margin = self.margin(m, scale);
+        if moving {
+            self.axes[m].driver.load_value = self.stallguard(m, margin);
+        }
+        // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
+        let stall_speed = p[ap::STOP_ON_STALL as usize];
+        if moving && stall_speed > 0 && v_int >= stall_speed && self.axes[m].driver.load_value == 0 {
+            self.motor_stop(m);
+            self.axes[m].motion.v = 0.0;
+            self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
+            self.raise(Source::Stall(m as u8));
+        }
+        // The carriage follows the motor unless it cannot.
+        let sign = self.shaft_sign();
+        let slips = moved != 0.0 && (margin < 0.0 || self.driver_off(m));
+        let axis = &mut self.axes[m];
+        if slips {
+            axis.mech_offset -= moved * sign;
+        }
+        if let Some((lo, hi)) = self.world.axes[m].travel {
+            let mech = axis.motion.x * sign + axis.mech_offset;
+            let clamped = mech.clamp(lo, hi);
+            axis.mech_offset += clamped - mech;
+        }
+        let _ = dt;
+    }
+}

@@ -1,0 +1,189 @@
+//! The world description file (TOML), see `docs/world.md`.
+
+use crate::world::{AxisWorld, Load, World};
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WorldFile {
+    /// Start from the built-in stage (true) or from free axes (false).
+    #[serde(default)]
+    base: Option<String>,
+    /// Supply voltage in volts.
+    supply: Option<f64>,
+    /// Driver temperature in °C.
+    temperature: Option<f64>,
+    /// Digital input levels, IN0 first.
+    #[serde(default)]
+    inputs: Vec<u8>,
+    /// ADC values (0…4095), by analog input.
+    #[serde(default)]
+    analog: Vec<u16>,
+    #[serde(default)]
+    axis: Vec<AxisFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SwitchFile {
+    position: f64,
+    width: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HomeFile {
+    from: f64,
+    to: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LoadFile {
+    torque: f64,
+    from: Option<f64>,
+    to: Option<f64>,
+    after: Option<f64>,
+    until: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AxisFile {
+    travel: Option<[f64; 2]>,
+    start: Option<f64>,
+    left_switch: Option<SwitchFile>,
+    right_switch: Option<SwitchFile>,
+    home_switch: Option<HomeFile>,
+    /// `false` removes a switch of the base world.
+    #[serde(default)]
+    no_left_switch: bool,
+    #[serde(default)]
+    no_right_switch: bool,
+    #[serde(default)]
+    no_home_switch: bool,
+    #[serde(default)]
+    load: Vec<LoadFile>,
+}
+
+impl World {
+    /// Reads a world description for a module with `axes` axes.
+    pub fn from_toml(text: &str, axes: usize) -> Result<World, String> {
+        let f: WorldFile = toml::from_str(text).map_err(|e| e.to_string())?;
+        let mut w = match f.base.as_deref() {
+            None | Some("stage") => World::stage(axes),
+            Some("free") => World::free(axes),
+            Some(other) => return Err(format!("base = \"{other}\": use \"stage\" or \"free\"")),
+        };
+        if f.axis.len() > axes {
+            return Err(format!("the world describes {} axes, the module has {axes}", f.axis.len()));
+        }
+        if let Some(v) = f.supply {
+            if !(0.0..=100.0).contains(&v) {
+                return Err(format!("supply = {v} V is out of range"));
+            }
+            w.supply_decivolts = (v * 10.0).round() as u16;
+        }
+        if let Some(t) = f.temperature {
+            w.temperature = t;
+        }
+        for (n, level) in f.inputs.iter().enumerate() {
+            w.set_digital(n as u8, *level != 0);
+        }
+        for (n, v) in f.analog.iter().enumerate() {
+            if *v > 4095 {
+                return Err(format!("analog[{n}] = {v} is above 4095"));
+            }
+            w.set_analog(n as u8, *v);
+        }
+        for (a, af) in f.axis.into_iter().enumerate() {
+            let axis: &mut AxisWorld = &mut w.axes[a];
+            if let Some([lo, hi]) = af.travel {
+                if lo >= hi {
+                    return Err(format!("axis {a}: travel [{lo}, {hi}] is empty"));
+                }
+                axis.travel = Some((lo, hi));
+            }
+            if let Some(s) = af.start {
+                axis.start = s;
+            }
+            if af.no_left_switch {
+                axis.left_switch = None;
+            }
+            if af.no_right_switch {
+                axis.right_switch = None;
+            }
+            if af.no_home_switch {
+                axis.home_switch = None;
+            }
+            if let Some(s) = af.left_switch {
+                axis.left_switch = Some(s.position);
+                axis.left_width = s.width;
+            }
+            if let Some(s) = af.right_switch {
+                axis.right_switch = Some(s.position);
+                axis.right_width = s.width;
+            }
+            if let Some(h) = af.home_switch {
+                if h.from > h.to {
+                    return Err(format!("axis {a}: home switch from {} to {} is empty", h.from, h.to));
+                }
+                axis.home_switch = Some((h.from, h.to));
+            }
+            for l in af.load {
+                if l.torque < 0.0 {
+                    return Err(format!("axis {a}: a load of {} % is negative", l.torque));
+                }
+                axis.loads.push(Load { torque: l.torque, from: l.from, to: l.to, after: l.after, until: l.until });
+            }
+        }
+        Ok(w)
+    }
+
+    pub fn load_file(path: &std::path::Path, axes: usize) -> Result<World, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        World::from_toml(&text, axes).map_err(|e| format!("{}: {e}", path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_world_file() {
+        let w = World::from_toml(
+            r#"
+            supply = 12.5
+            inputs = [1, 0, 1]
+            [[axis]]
+            travel = [-5000, 5000]
+            left_switch = { position = -4000 }
+            no_home_switch = true
+            [[axis.load]]
+            torque = 30
+            from = 1000
+            to = 2000
+            "#,
+            1,
+        )
+        .unwrap();
+        assert_eq!(w.supply_decivolts, 125);
+        assert_eq!(w.digital_inputs, 0b101);
+        let a = &w.axes[0];
+        assert_eq!(a.travel, Some((-5000.0, 5000.0)));
+        assert_eq!((a.left_switch, a.left_width), (Some(-4000.0), None));
+        assert_eq!(a.right_switch, Some(1_000_000.0), "kept from the built-in stage");
+        assert_eq!(a.home_switch, None);
+        assert_eq!(a.load_at(1500.0, 0.0), 30.0);
+        assert_eq!(a.load_at(2500.0, 0.0), 0.0);
+    }
+
+    #[test]
+    fn errors_say_what_is_wrong() {
+        assert!(World::from_toml("[[axis]]\ntravel = [5, 1]\n", 1).unwrap_err().contains("empty"));
+        assert!(World::from_toml("[[axis]]\n[[axis]]\n", 1).unwrap_err().contains("1"));
+        assert!(World::from_toml("bogus = 1\n", 1).is_err());
+        assert!(World::from_toml("analog = [5000]\n", 1).unwrap_err().contains("4095"));
+    }
+}
