@@ -41,7 +41,20 @@ class Served:
                 raise RuntimeError("tmclsim serve did not start")
         text = "".join(self.banner)
         self.tcp = re.search(r"tcp: (\S+)", text).group(1)
+        control = re.search(r"control: (\S+)", text)
+        self.control = control.group(1) if control else None
         self.connect_hint = self.banner[-1]
+
+    def world(self, command):
+        """Sends one line to the control socket; returns the answer."""
+        import socket
+
+        host, port = self.control.rsplit(":", 1)
+        with socket.create_connection((host, int(port)), timeout=5) as s:
+            s.sendall(command.encode() + b"\n")
+            answer = s.makefile().readline().strip()
+        assert answer.startswith("ok"), answer
+        return answer
 
     def stop(self):
         if self.proc.poll() is None:

@@ -40,6 +40,8 @@ enum Command {
     Run(run::RunArgs),
     /// Download a program to a module (real or virtual), verify it, start it.
     Upload(upload::UploadArgs),
+    /// Change the world of a served module: inputs, switches, loads, faults.
+    World(WorldArgs),
 }
 
 #[derive(Args)]
@@ -79,6 +81,26 @@ pub struct ServeArgs {
     /// Most TCP clients served at once.
     #[arg(long, value_name = "N", default_value_t = 64)]
     pub max_connections: usize,
+    /// The world around the module: a TOML file (docs/world.md), or
+    /// `stage` (the built-in linear stage, the default) or `free` (no
+    /// switches, no end stops).
+    #[arg(long, value_name = "FILE", default_value = "stage")]
+    pub world: String,
+    /// Address of the control socket that changes the world while the
+    /// module is served (`tmclsim world`); loopback, any free port by default.
+    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:0")]
+    pub control: SocketAddr,
+}
+
+#[derive(Args)]
+pub struct WorldArgs {
+    /// The control socket printed by `tmclsim serve`.
+    #[arg(long, value_name = "ADDR")]
+    pub control: String,
+    /// A control command, e.g. `input 0 1`, `load 0 50`, `switch 0 left press`,
+    /// `link drop 3`, `show` (`help` lists them all).
+    #[arg(required = true, num_args = 1.., value_name = "COMMAND")]
+    pub command: Vec<String>,
 }
 
 #[derive(Args)]
@@ -122,6 +144,7 @@ fn main() -> ExitCode {
         Command::Disasm(a) => asm::disasm(a),
         Command::Run(a) => run::run(a),
         Command::Upload(a) => upload::run(a),
+        Command::World(a) => world(a),
     };
     match result {
         Ok(code) => code,
@@ -152,6 +175,26 @@ fn profile(name: &str) -> Result<ExitCode, String> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The world named on the command line: `stage`, `free` or a file.
+pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::World, String> {
+    match name {
+        "stage" => Ok(tmclsim_firmware::World::stage(axes)),
+        "free" => Ok(tmclsim_firmware::World::free(axes)),
+        path => tmclsim_firmware::World::load_file(std::path::Path::new(path), axes),
+    }
+}
+
+fn world(args: WorldArgs) -> Result<ExitCode, String> {
+    use std::io::{BufRead, Write};
+    let mut s = std::net::TcpStream::connect(&args.control).map_err(|e| format!("cannot connect to {}: {e}", args.control))?;
+    s.set_read_timeout(Some(Duration::from_secs(5))).ok();
+    writeln!(s, "{}", args.command.join(" ")).map_err(|e| e.to_string())?;
+    let mut line = String::new();
+    std::io::BufReader::new(s).read_line(&mut line).map_err(|e| e.to_string())?;
+    print!("{line}");
+    Ok(if line.starts_with("ok") { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 pub(crate) fn millis(ms: u64) -> Duration {

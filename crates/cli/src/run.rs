@@ -34,6 +34,9 @@ pub struct RunArgs {
     /// Start in the interactive debugger (step, continue, inspect).
     #[arg(long)]
     pub debug: bool,
+    /// The world: a TOML file (docs/world.md), `stage` (default) or `free`.
+    #[arg(long, value_name = "FILE", default_value = "stage")]
+    pub world: String,
 }
 
 /// Parses `500ms`, `10s`, `5m`, `1h`, `2.5` (seconds) into nanoseconds.
@@ -61,7 +64,8 @@ pub fn parse_duration(text: &str) -> Result<u64, String> {
 
 pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let (program, profile) = assemble(&args.source, &args.module)?;
-    let mut module = Module::new(profile.clone());
+    let world = crate::load_world(&args.world, profile.module.axes as usize)?;
+    let mut module = Module::with_world(profile.clone(), tmclsim_firmware::Eeprom::new(&profile.module.name), world);
     module.load_program(&program.instructions).map_err(|s| format!("the program does not fit the module: {s}"))?;
     let mut breakpoints = Vec::new();
     for b in &args.breakpoints {

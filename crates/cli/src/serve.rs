@@ -12,18 +12,21 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
         (None, None) => (Some("127.0.0.1:1141".parse().unwrap()), Some(std::env::temp_dir().join(format!("tmclsim-{key}")))),
         other => other,
     };
-    let (module, eeprom_note) = match &args.eeprom {
+    let world = crate::load_world(&args.world, profile.module.axes as usize)?;
+    let fresh = Eeprom::new(&profile.module.name);
+    let (image, eeprom_note) = match &args.eeprom {
         Some(path) => match Eeprom::load(path)? {
             Some(image) => {
                 if image.module != profile.module.name {
                     return Err(format!("{} holds the EEPROM of a {}, not of a {}", path.display(), image.module, profile.module.name));
                 }
-                (Module::with_eeprom(profile.clone(), image), format!("restored from {}", path.display()))
+                (image, format!("restored from {}", path.display()))
             }
-            None => (Module::new(profile.clone()), format!("factory defaults; changes are kept in {} (new)", path.display())),
+            None => (fresh, format!("factory defaults; changes are kept in {} (new)", path.display())),
         },
-        None => (Module::new(profile.clone()), "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
+        None => (fresh, "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
     };
+    let module = Module::with_world(profile.clone(), image, world);
     let mut module = module;
     if let Some(a) = args.address {
         module.set_address(a);
@@ -35,6 +38,7 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
         eeprom: args.eeprom.clone(),
         inter_byte_timeout: crate::millis(args.inter_byte_timeout),
         max_connections: args.max_connections,
+        control: Some(args.control),
     };
     if let Some(path) = &config.eeprom {
         // Write the file at once so a fresh one exists from the start.
@@ -51,6 +55,10 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     }
     if let Some((link, device)) = &ep.pty {
         println!("  pty: {} -> {}", link.display(), device.display());
+    }
+    println!("  world: {}", args.world);
+    if let Some(addr) = ep.control {
+        println!("  control: {addr}  (tmclsim world --control {addr} help)");
     }
     if let Some(a) = ep.pytrinamic_args() {
         println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));

@@ -227,9 +227,16 @@ impl Module {
 
     /// A module powered up with the given EEPROM contents.
     pub fn with_eeprom(profile: Arc<Profile>, eeprom: Eeprom) -> Module {
-        let axes = profile.module.axes as usize;
+        let world = World::free(profile.module.axes as usize);
+        Module::with_world(profile, eeprom, world)
+    }
+
+    /// A module powered up with the given EEPROM, in the given world (its
+    /// carriages start where the world says).
+    pub fn with_world(profile: Arc<Profile>, eeprom: Eeprom, mut world: World) -> Module {
+        world.axes.resize(profile.module.axes as usize, Default::default());
         let mut m = Module {
-            world: World::free(axes),
+            world,
             axes: Vec::new(),
             globals: [[0; 256]; 4],
             outputs: 0,

@@ -8,11 +8,14 @@
 //! a heartbeat stop), so an idle server uses no CPU.
 
 mod clock;
+pub mod control;
+mod faults;
 mod link;
 mod pty;
 mod shared;
 mod tcp;
 
+pub use faults::LinkFaults;
 pub use shared::SharedModule;
 
 use std::net::SocketAddr;
@@ -35,6 +38,8 @@ pub struct ServerConfig {
     pub inter_byte_timeout: Duration,
     /// Most TCP clients at once; more are refused with a log line.
     pub max_connections: usize,
+    /// TCP address of the control socket (world and link faults).
+    pub control: Option<SocketAddr>,
 }
 
 impl Default for ServerConfig {
@@ -45,6 +50,7 @@ impl Default for ServerConfig {
             eeprom: None,
             inter_byte_timeout: Duration::from_millis(5),
             max_connections: 64,
+            control: None,
         }
     }
 }
@@ -55,6 +61,8 @@ pub struct Endpoints {
     pub tcp: Option<SocketAddr>,
     /// The symlink a host opens, and the pty device it points to.
     pub pty: Option<(PathBuf, PathBuf)>,
+    /// The control socket.
+    pub control: Option<SocketAddr>,
 }
 
 impl Endpoints {
@@ -139,9 +147,13 @@ pub fn start(module: Module, config: ServerConfig) -> std::io::Result<ServerHand
                     Some(path) => Some(pty::Pty::open(path)?),
                     None => None,
                 };
-                Ok::<_, std::io::Error>((tcp, pty))
+                let control = match config.control {
+                    Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
+                    None => None,
+                };
+                Ok::<_, std::io::Error>((tcp, pty, control))
             };
-            let (tcp, pty) = match setup.await {
+            let (tcp, pty, control) = match setup.await {
                 Ok(v) => v,
                 Err(e) => {
                     let _ = ready_tx.send(Err(e));
@@ -151,6 +163,7 @@ pub fn start(module: Module, config: ServerConfig) -> std::io::Result<ServerHand
             let endpoints = Endpoints {
                 tcp: tcp.as_ref().and_then(|l| l.local_addr().ok()),
                 pty: pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
+                control: control.as_ref().and_then(|l| l.local_addr().ok()),
             };
             let _ = ready_tx.send(Ok(endpoints));
             let mut tasks = tokio::task::JoinSet::new();
@@ -160,6 +173,9 @@ pub fn start(module: Module, config: ServerConfig) -> std::io::Result<ServerHand
             }
             if let Some(p) = pty {
                 tasks.spawn(pty::run(p, thread_shared.clone(), config.clone(), stop_rx.clone()));
+            }
+            if let Some(listener) = control {
+                tasks.spawn(control::run(listener, thread_shared.clone(), stop_rx.clone()));
             }
             let mut stop = stop_rx.clone();
             let _ = stop.wait_for(|s| *s).await;

@@ -36,19 +36,24 @@ where
                 let now = start.elapsed().as_nanos() as u64;
                 for &byte in &buf[..n] {
                     let Some(frame) = assembler.push(byte, now) else { continue };
-                    let (reply, delay) = module.handle(link, &events_tx, &frame);
+                    let (reply, pause) = module.handle(link, &events_tx, &frame);
+                    let Some(reply) = reply else { continue };
+                    let (reply, fault_delay) = module.outgoing(reply);
+                    let delay = pause + fault_delay;
+                    if !delay.is_zero() {
+                        tokio::time::sleep(delay).await;
+                    }
                     if let Some(reply) = reply {
-                        if !delay.is_zero() {
-                            tokio::time::sleep(delay).await;
-                        }
                         writer.write_all(&reply).await?;
                     }
                 }
                 writer.flush().await?;
             }
             Some(event) = events.recv() => {
-                writer.write_all(&event).await?;
-                writer.flush().await?;
+                if let (Some(event), _) = module.outgoing(event) {
+                    writer.write_all(&event).await?;
+                    writer.flush().await?;
+                }
             }
         }
     }

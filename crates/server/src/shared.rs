@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 use tmclsim_firmware::eeprom::save_atomic;
 use tmclsim_firmware::Module;
 use tmclsim_protocol::FRAME_LEN;
+use crate::faults::LinkFaults;
 use tokio::sync::{mpsc, Notify};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
@@ -27,6 +28,7 @@ pub struct SharedModule {
     origin_ns: u64,
     eeprom: Option<PathBuf>,
     changed: Notify,
+    faults: Mutex<LinkFaults>,
 }
 
 impl SharedModule {
@@ -39,7 +41,25 @@ impl SharedModule {
             origin_ns,
             eeprom,
             changed: Notify::new(),
+            faults: Mutex::new(LinkFaults::default()),
         }
+    }
+
+    /// The link faults in force.
+    pub fn link_faults(&self) -> LinkFaults {
+        *self.faults.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    pub fn set_link_faults(&self, f: LinkFaults) {
+        *self.faults.lock().unwrap_or_else(|p| p.into_inner()) = f;
+    }
+
+    /// Passes an outgoing frame through the link faults: `None` drops it;
+    /// the duration is an extra delay.
+    pub(crate) fn outgoing(&self, frame: [u8; FRAME_LEN]) -> (Option<[u8; FRAME_LEN]>, Duration) {
+        let mut f = self.faults.lock().unwrap_or_else(|p| p.into_inner());
+        let delay = f.delay;
+        (f.apply(frame), delay)
     }
 
     /// Virtual time now, by the wall clock.
