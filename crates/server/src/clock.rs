@@ -9,8 +9,8 @@ pub(crate) async fn run(module: Arc<SharedModule>, mut stop: watch::Receiver<boo
     loop {
         let due = module.schedule();
         let sleep = async {
-            match due {
-                Some(ns) => tokio::time::sleep_until(Instant::from_std(module.instant_of(ns))).await,
+            match due.and_then(|ns| module.instant_of(ns)) {
+                Some(at) => tokio::time::sleep_until(Instant::from_std(at)).await,
                 None => std::future::pending::<()>().await,
             }
         };

@@ -20,12 +20,19 @@ struct State {
     scheduled: Option<u64>,
 }
 
+/// How virtual time passes for a served module.
+#[derive(Clone, Copy, Debug)]
+enum Clock {
+    /// Paced by the wall clock: virtual time `origin_ns` at `origin`.
+    Wall { origin: Instant, origin_ns: u64 },
+    /// Only `SharedModule::advance` moves time (stepped virtual time).
+    Stepped,
+}
+
 /// The served module behind a lock, with its clock and EEPROM file.
 pub struct SharedModule {
     state: Mutex<State>,
-    origin: Instant,
-    /// Virtual time at `origin`.
-    origin_ns: u64,
+    clock: Mutex<Clock>,
     eeprom: Option<PathBuf>,
     changed: Notify,
     faults: Mutex<LinkFaults>,
@@ -37,8 +44,7 @@ impl SharedModule {
         let saved_generation = module.eeprom_generation();
         SharedModule {
             state: Mutex::new(State { module, saved_generation, sink: None, scheduled: None }),
-            origin: Instant::now(),
-            origin_ns,
+            clock: Mutex::new(Clock::Wall { origin: Instant::now(), origin_ns }),
             eeprom,
             changed: Notify::new(),
             faults: Mutex::new(LinkFaults::default()),
@@ -62,14 +68,53 @@ impl SharedModule {
         (f.apply(frame), delay)
     }
 
-    /// Virtual time now, by the wall clock.
+    /// Virtual time now: by the wall clock, or (stepped) where the module is.
     pub fn now_ns(&self) -> u64 {
-        self.origin_ns + self.origin.elapsed().as_nanos() as u64
+        match *self.clock.lock().unwrap_or_else(|p| p.into_inner()) {
+            Clock::Wall { origin, origin_ns } => origin_ns + origin.elapsed().as_nanos() as u64,
+            Clock::Stepped => 0,
+        }
     }
 
-    /// The wall-clock instant of a virtual time.
-    pub fn instant_of(&self, ns: u64) -> Instant {
-        self.origin + Duration::from_nanos(ns.saturating_sub(self.origin_ns))
+    /// The wall-clock instant of a virtual time (`None` in stepped time).
+    pub fn instant_of(&self, ns: u64) -> Option<Instant> {
+        match *self.clock.lock().unwrap_or_else(|p| p.into_inner()) {
+            Clock::Wall { origin, origin_ns } => Some(origin + Duration::from_nanos(ns.saturating_sub(origin_ns))),
+            Clock::Stepped => None,
+        }
+    }
+
+    /// Stepped virtual time (`true`): time stands still between calls of
+    /// [`SharedModule::advance`]. `false` goes back to the wall clock from
+    /// where the module is.
+    pub fn set_stepped(&self, stepped: bool) {
+        let s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let mut clock = self.clock.lock().unwrap_or_else(|p| p.into_inner());
+        match (stepped, *clock) {
+            (true, Clock::Wall { origin, origin_ns }) => {
+                drop(clock);
+                drop(s);
+                // Bring the module up to the wall clock before it stops.
+                let now = origin_ns + origin.elapsed().as_nanos() as u64;
+                self.with(|m| m.advance_to(now));
+                *self.clock.lock().unwrap_or_else(|p| p.into_inner()) = Clock::Stepped;
+            }
+            (false, Clock::Stepped) => *clock = Clock::Wall { origin: Instant::now(), origin_ns: s.module.now_ns() },
+            _ => {}
+        }
+        self.changed.notify_one();
+    }
+
+    pub fn is_stepped(&self) -> bool {
+        matches!(*self.clock.lock().unwrap_or_else(|p| p.into_inner()), Clock::Stepped)
+    }
+
+    /// Stepped virtual time: moves the module on by `dt_ns` (events go out
+    /// on their links as they become due).
+    pub fn advance(&self, dt_ns: u64) {
+        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        s.module.advance(dt_ns);
+        self.after_change(&mut s);
     }
 
     /// Runs `f` on the module, brought up to the current time.
