@@ -86,6 +86,15 @@ pub struct ServeArgs {
     /// switches, no end stops).
     #[arg(long, value_name = "FILE", default_value = "stage")]
     pub world: String,
+    /// Several modules on one RS485-style link: `PROFILE@ADDRESS,…`, e.g.
+    /// `tmcm-1141@1,tmcm-1141@2,tmcm-351@3`. Only the addressed module
+    /// answers. Replaces --module and --address.
+    #[arg(long, value_name = "SPEC", conflicts_with_all = ["address", "eeprom"])]
+    pub bus: Option<String>,
+    /// Deliver bytes at each module's baud rate (GP 65), so that host
+    /// timeouts behave as on a real RS485 bus.
+    #[arg(long)]
+    pub wire_timing: bool,
     /// Address of the control socket that changes the world while the
     /// module is served (`tmclsim world`); loopback, any free port by default.
     #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:0")]

@@ -5,10 +5,32 @@ use std::process::ExitCode;
 use tmclsim_firmware::{Eeprom, Module, Profile};
 use tmclsim_server::ServerConfig;
 
+/// `PROFILE@ADDRESS,…` → modules on one link, in the world given.
+fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {
+    let mut modules = Vec::new();
+    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let (name, address) = item.split_once('@').ok_or_else(|| format!("'{item}': write PROFILE@ADDRESS"))?;
+        let address: u8 = address.parse().ok().filter(|a| *a >= 1).ok_or_else(|| format!("'{item}': the address is 1…255"))?;
+        let profile = Profile::built_in(name)?;
+        let w = crate::load_world(world, profile.module.axes as usize)?;
+        let mut m = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), w);
+        m.set_address(address);
+        modules.push(m);
+    }
+    if modules.is_empty() {
+        return Err("--bus names no module".into());
+    }
+    Ok(modules)
+}
+
 pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
+    if let Some(spec) = &args.bus {
+        let modules = bus(spec, &args.world)?;
+        return serve(args_links(&args), modules, None, "factory defaults for every module of the bus".into(), &args);
+    }
     let profile = Profile::built_in(&args.module)?;
     let key = profile.module.name.to_ascii_lowercase();
-    let (tcp, pty) = match (args.tcp, args.pty) {
+    let (tcp, pty) = match (args.tcp, args.pty.clone()) {
         (None, None) => (Some("127.0.0.1:1141".parse().unwrap()), Some(std::env::temp_dir().join(format!("tmclsim-{key}")))),
         other => other,
     };
@@ -31,24 +53,43 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     if let Some(a) = args.address {
         module.set_address(a);
     }
-    let address = module.address();
-    let config = ServerConfig {
-        tcp,
-        pty,
-        eeprom: args.eeprom.clone(),
-        inter_byte_timeout: crate::millis(args.inter_byte_timeout),
-        max_connections: args.max_connections,
-        control: Some(args.control),
-    };
-    if let Some(path) = &config.eeprom {
+    if let Some(path) = &args.eeprom {
         // Write the file at once so a fresh one exists from the start.
         if !path.exists() {
             tmclsim_firmware::eeprom::save_atomic(path, module.eeprom()).map_err(|e| format!("{}: {e}", path.display()))?;
         }
     }
-    let server = tmclsim_server::start(module, config).map_err(|e| format!("cannot serve: {e}"))?;
+    serve((tcp, pty), vec![module], args.eeprom.clone(), eeprom_note, &args)
+}
+
+/// The links to serve: both defaults when neither is named.
+fn args_links(args: &ServeArgs) -> (Option<std::net::SocketAddr>, Option<std::path::PathBuf>) {
+    match (args.tcp, args.pty.clone()) {
+        (None, None) => (Some("127.0.0.1:1141".parse().unwrap()), Some(std::env::temp_dir().join("tmclsim-bus"))),
+        other => other,
+    }
+}
+
+fn serve(
+    (tcp, pty): (Option<std::net::SocketAddr>, Option<std::path::PathBuf>),
+    modules: Vec<Module>,
+    eeprom: Option<std::path::PathBuf>,
+    eeprom_note: String,
+    args: &ServeArgs,
+) -> Result<ExitCode, String> {
+    let config = ServerConfig {
+        tcp,
+        pty,
+        eeprom,
+        inter_byte_timeout: crate::millis(args.inter_byte_timeout),
+        max_connections: args.max_connections,
+        control: Some(args.control),
+        wire_timing: args.wire_timing,
+    };
+    let names: Vec<String> = modules.iter().map(|m| format!("{} (address {})", m.profile().module.name, m.address())).collect();
+    let server = tmclsim_server::start_bus(modules, config).map_err(|e| format!("cannot serve: {e}"))?;
     let ep = server.endpoints().clone();
-    println!("tmclsim: virtual {} (address {address}) is serving", profile.module.name);
+    println!("tmclsim: virtual {} is serving", names.join(", "));
     println!("  EEPROM: {eeprom_note}");
     if let Some(addr) = ep.tcp {
         println!("  tcp: {addr}");
@@ -56,7 +97,7 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     if let Some((link, device)) = &ep.pty {
         println!("  pty: {} -> {}", link.display(), device.display());
     }
-    println!("  world: {}", args.world);
+    println!("  world: {}{}", args.world, if args.wire_timing { "; wire timing on" } else { "" });
     if let Some(addr) = ep.control {
         println!("  control: {addr}  (tmclsim world --control {addr} help)");
     }

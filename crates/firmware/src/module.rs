@@ -63,6 +63,7 @@ pub mod ap {
 
 /// Global parameter numbers (bank 0) the firmware gives a meaning to.
 pub mod gp {
+    pub const BAUD_RATE: u8 = 65;
     pub const SERIAL_ADDRESS: u8 = 66;
     pub const HEARTBEAT: u8 = 68;
     pub const AUTOSTART: u8 = 77;
@@ -328,6 +329,11 @@ impl Module {
 
     pub fn host_address(&self) -> u8 {
         self.globals[0][gp::HOST_ADDRESS as usize] as u8
+    }
+
+    /// GP 65: the baud rate code.
+    pub fn baud_rate_code(&self) -> i32 {
+        self.globals[0][gp::BAUD_RATE as usize]
     }
 
     /// GP 75: delay before every reply.

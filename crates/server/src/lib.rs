@@ -40,6 +40,8 @@ pub struct ServerConfig {
     pub max_connections: usize,
     /// TCP address of the control socket (world and link faults).
     pub control: Option<SocketAddr>,
+    /// Deliver bytes at the modules' baud rate (GP 65), as a real RS485 bus.
+    pub wire_timing: bool,
 }
 
 impl Default for ServerConfig {
@@ -51,6 +53,7 @@ impl Default for ServerConfig {
             inter_byte_timeout: Duration::from_millis(5),
             max_connections: 64,
             control: None,
+            wire_timing: false,
         }
     }
 }
@@ -125,7 +128,25 @@ impl Drop for ServerHandle {
 
 /// Starts serving `module` in a background thread.
 pub fn start(module: Module, config: ServerConfig) -> std::io::Result<ServerHandle> {
-    let shared = Arc::new(SharedModule::new(module, config.eeprom.clone()));
+    let eeprom = config.eeprom.clone();
+    start_bus_with_eeproms(vec![(module, eeprom)], config)
+}
+
+/// Starts serving several modules on one link (an RS485-style multi-drop
+/// bus: every module sees every frame, the addressed one answers).
+/// `config.eeprom` is used when there is a single module.
+pub fn start_bus(modules: Vec<Module>, config: ServerConfig) -> std::io::Result<ServerHandle> {
+    let single = modules.len() == 1;
+    let nodes = modules.into_iter().map(|m| (m, if single { config.eeprom.clone() } else { None })).collect();
+    start_bus_with_eeproms(nodes, config)
+}
+
+/// Starts serving modules, each with its own EEPROM file, on one link.
+pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: ServerConfig) -> std::io::Result<ServerHandle> {
+    if modules.is_empty() {
+        return Err(std::io::Error::other("a link needs at least one module"));
+    }
+    let shared = Arc::new(SharedModule::bus(modules, config.wire_timing));
     let (stop_tx, stop_rx) = watch::channel(false);
     let (ready_tx, ready_rx) = std::sync::mpsc::channel::<std::io::Result<Endpoints>>();
     let thread_shared = shared.clone();

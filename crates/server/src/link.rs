@@ -36,15 +36,16 @@ where
                 let now = start.elapsed().as_nanos() as u64;
                 for &byte in &buf[..n] {
                     let Some(frame) = assembler.push(byte, now) else { continue };
-                    let (reply, pause) = module.handle(link, &events_tx, &frame);
-                    let Some(reply) = reply else { continue };
-                    let (reply, fault_delay) = module.outgoing(reply);
-                    let delay = pause + fault_delay;
-                    if !delay.is_zero() {
-                        tokio::time::sleep(delay).await;
-                    }
-                    if let Some(reply) = reply {
-                        writer.write_all(&reply).await?;
+                    let (replies, pause) = module.handle(link, &events_tx, &frame);
+                    for reply in replies {
+                        let (reply, fault_delay) = module.outgoing(reply);
+                        let delay = pause + fault_delay;
+                        if !delay.is_zero() {
+                            tokio::time::sleep(delay).await;
+                        }
+                        if let Some(reply) = reply {
+                            writer.write_all(&reply).await?;
+                        }
                     }
                 }
                 writer.flush().await?;

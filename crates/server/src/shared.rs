@@ -1,26 +1,34 @@
-//! A module shared by the links of a server, paced by the wall clock.
+//! The modules of one link (a single module, or several on an RS485-style
+//! multi-drop bus), shared by the link's connections and paced by the wall
+//! clock or stepped by hand.
 
+use crate::faults::LinkFaults;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use tmclsim_firmware::eeprom::save_atomic;
 use tmclsim_firmware::Module;
 use tmclsim_protocol::FRAME_LEN;
-use crate::faults::LinkFaults;
 use tokio::sync::{mpsc, Notify};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
 type EventSink = mpsc::UnboundedSender<[u8; FRAME_LEN]>;
 
-struct State {
+/// One module on the link, with its EEPROM file.
+struct Node {
     module: Module,
+    eeprom: Option<PathBuf>,
     saved_generation: u64,
+}
+
+struct State {
+    nodes: Vec<Node>,
     sink: Option<(u64, EventSink)>,
     /// What the clock task sleeps until (`None`: nothing).
     scheduled: Option<u64>,
 }
 
-/// How virtual time passes for a served module.
+/// How virtual time passes.
 #[derive(Clone, Copy, Debug)]
 enum Clock {
     /// Paced by the wall clock: virtual time `origin_ns` at `origin`.
@@ -29,26 +37,67 @@ enum Clock {
     Stepped,
 }
 
-/// The served module behind a lock, with its clock and EEPROM file.
+/// The served module(s) behind a lock, with the clock and EEPROM files.
 pub struct SharedModule {
     state: Mutex<State>,
     clock: Mutex<Clock>,
-    eeprom: Option<PathBuf>,
     changed: Notify,
     faults: Mutex<LinkFaults>,
+    /// Deliver bytes at the modules' baud rate (GP 65).
+    wire_timing: bool,
+}
+
+/// GP 65 codes → bits per second (TMCM-1141 table 18).
+pub fn baud_rate(code: i32) -> u32 {
+    match code {
+        1 => 14_400,
+        2 => 19_200,
+        3 => 28_800,
+        4 => 38_400,
+        5 => 57_600,
+        6 => 76_800,
+        7 => 115_200,
+        8 => 230_400,
+        _ => 9_600,
+    }
 }
 
 impl SharedModule {
     pub fn new(module: Module, eeprom: Option<PathBuf>) -> SharedModule {
-        let origin_ns = module.now_ns();
-        let saved_generation = module.eeprom_generation();
+        SharedModule::bus(vec![(module, eeprom)], false)
+    }
+
+    /// Several modules on one link; each with its own EEPROM file.
+    pub fn bus(modules: Vec<(Module, Option<PathBuf>)>, wire_timing: bool) -> SharedModule {
+        let origin_ns = modules.iter().map(|(m, _)| m.now_ns()).max().unwrap_or(0);
+        let nodes = modules
+            .into_iter()
+            .map(|(mut module, eeprom)| {
+                module.advance_to(origin_ns);
+                let saved_generation = module.eeprom_generation();
+                Node { module, eeprom, saved_generation }
+            })
+            .collect();
         SharedModule {
-            state: Mutex::new(State { module, saved_generation, sink: None, scheduled: None }),
+            state: Mutex::new(State { nodes, sink: None, scheduled: None }),
             clock: Mutex::new(Clock::Wall { origin: Instant::now(), origin_ns }),
-            eeprom,
             changed: Notify::new(),
             faults: Mutex::new(LinkFaults::default()),
+            wire_timing,
         }
+    }
+
+    /// How many modules the link has.
+    pub fn len(&self) -> usize {
+        self.lock().nodes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, State> {
+        self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// The link faults in force.
@@ -68,7 +117,8 @@ impl SharedModule {
         (f.apply(frame), delay)
     }
 
-    /// Virtual time now: by the wall clock, or (stepped) where the module is.
+    /// Virtual time now: by the wall clock, or (stepped) 0, which moves
+    /// nothing.
     pub fn now_ns(&self) -> u64 {
         match *self.clock.lock().unwrap_or_else(|p| p.into_inner()) {
             Clock::Wall { origin, origin_ns } => origin_ns + origin.elapsed().as_nanos() as u64,
@@ -86,21 +136,19 @@ impl SharedModule {
 
     /// Stepped virtual time (`true`): time stands still between calls of
     /// [`SharedModule::advance`]. `false` goes back to the wall clock from
-    /// where the module is.
+    /// where the modules are.
     pub fn set_stepped(&self, stepped: bool) {
-        let s = self.state.lock().unwrap_or_else(|p| p.into_inner());
-        let mut clock = self.clock.lock().unwrap_or_else(|p| p.into_inner());
-        match (stepped, *clock) {
-            (true, Clock::Wall { origin, origin_ns }) => {
-                drop(clock);
-                drop(s);
-                // Bring the module up to the wall clock before it stops.
-                let now = origin_ns + origin.elapsed().as_nanos() as u64;
-                self.with(|m| m.advance_to(now));
-                *self.clock.lock().unwrap_or_else(|p| p.into_inner()) = Clock::Stepped;
+        if stepped {
+            // Bring the modules up to the wall clock before time stops.
+            self.tick();
+            *self.clock.lock().unwrap_or_else(|p| p.into_inner()) = Clock::Stepped;
+        } else {
+            let s = self.lock();
+            let now = s.nodes.iter().map(|n| n.module.now_ns()).max().unwrap_or(0);
+            let mut clock = self.clock.lock().unwrap_or_else(|p| p.into_inner());
+            if matches!(*clock, Clock::Stepped) {
+                *clock = Clock::Wall { origin: Instant::now(), origin_ns: now };
             }
-            (false, Clock::Stepped) => *clock = Clock::Wall { origin: Instant::now(), origin_ns: s.module.now_ns() },
-            _ => {}
         }
         self.changed.notify_one();
     }
@@ -109,90 +157,118 @@ impl SharedModule {
         matches!(*self.clock.lock().unwrap_or_else(|p| p.into_inner()), Clock::Stepped)
     }
 
-    /// Stepped virtual time: moves the module on by `dt_ns` (events go out
-    /// on their links as they become due).
+    /// Stepped virtual time: moves every module on by `dt_ns` (events go
+    /// out on their links as they become due).
     pub fn advance(&self, dt_ns: u64) {
-        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
-        s.module.advance(dt_ns);
-        self.after_change(&mut s);
+        let mut s = self.lock();
+        for n in &mut s.nodes {
+            n.module.advance(dt_ns);
+        }
+        Self::after_change(&mut s);
     }
 
-    /// Runs `f` on the module, brought up to the current time.
+    /// Runs `f` on the first module, brought up to the current time.
     pub fn with<R>(&self, f: impl FnOnce(&mut Module) -> R) -> R {
-        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        self.with_module(0, f)
+    }
+
+    /// Runs `f` on module `index` (in the order given to the server).
+    pub fn with_module<R>(&self, index: usize, f: impl FnOnce(&mut Module) -> R) -> R {
+        let mut s = self.lock();
         let now = self.now_ns();
-        s.module.advance_to(now);
-        let r = f(&mut s.module);
-        self.after_change(&mut s);
+        for n in &mut s.nodes {
+            n.module.advance_to(now);
+        }
+        let r = f(&mut s.nodes[index].module);
+        Self::after_change(&mut s);
         r
     }
 
-    /// Handles one frame from link `link`, whose events go to `sink`.
-    /// Returns the reply and how long to wait before sending it (GP 75).
-    pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Option<[u8; FRAME_LEN]>, Duration) {
-        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+    /// Handles one frame from link `link`, whose events go to `sink`: every
+    /// module sees it, the addressed one answers. Returns the replies and
+    /// how long to wait before sending them (GP 75 of the module that
+    /// answered, and with wire timing the time the bytes take on the wire).
+    pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
+        let mut s = self.lock();
         let now = self.now_ns();
-        s.module.advance_to(now);
-        let reply = s.module.handle_frame(frame);
-        if reply.is_some() || s.module.has_events() {
-            if s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
-                s.sink = Some((link, sink.clone()));
+        let mut replies = Vec::new();
+        let mut delay = Duration::ZERO;
+        for n in &mut s.nodes {
+            n.module.advance_to(now);
+            if let Some(r) = n.module.handle_frame(frame) {
+                replies.push(r);
+                delay = delay.max(Duration::from_nanos(n.module.reply_delay_ns()));
+                if self.wire_timing {
+                    // Request and reply, 10 bits a byte.
+                    let baud = baud_rate(n.module.baud_rate_code()) as u64;
+                    delay += Duration::from_nanos(2 * 9 * 10 * 1_000_000_000 / baud);
+                }
             }
         }
-        let delay = Duration::from_nanos(s.module.reply_delay_ns());
-        self.after_change(&mut s);
+        let has_events = s.nodes.iter().any(|n| n.module.has_events());
+        if (!replies.is_empty() || has_events) && s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
+            s.sink = Some((link, sink.clone()));
+        }
+        Self::after_change(&mut s);
         // Wake the clock task only when something is due sooner than what
         // it sleeps for.
-        let due = s.module.next_event_ns();
+        let due = s.nodes.iter().filter_map(|n| n.module.next_event_ns()).min();
         let wake = due.is_some_and(|d| s.scheduled.is_none_or(|sch| d < sch));
         drop(s);
         if wake {
             self.changed.notify_one();
         }
-        (reply, delay)
+        (replies, delay)
     }
 
     /// The clock task's next wake-up: what is due, remembered so that
     /// frames know whether to wake it earlier.
     pub(crate) fn schedule(&self) -> Option<u64> {
-        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let mut s = self.lock();
         let now = self.now_ns();
-        s.module.advance_to(now);
-        self.after_change(&mut s);
-        let due = s.module.next_event_ns();
+        for n in &mut s.nodes {
+            n.module.advance_to(now);
+        }
+        Self::after_change(&mut s);
+        let due = s.nodes.iter().filter_map(|n| n.module.next_event_ns()).min();
         s.scheduled = due;
         due
     }
 
     /// Advances to now and dispatches what became due.
     pub(crate) fn tick(&self) {
-        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let mut s = self.lock();
         let now = self.now_ns();
-        s.module.advance_to(now);
-        self.after_change(&mut s);
+        for n in &mut s.nodes {
+            n.module.advance_to(now);
+        }
+        Self::after_change(&mut s);
     }
 
-    /// Resolves when a frame changed the module's plans.
+    /// Resolves when a frame changed the modules' plans.
     pub(crate) async fn changed(&self) {
         self.changed.notified().await
     }
 
-    fn after_change(&self, s: &mut State) {
-        if s.module.has_events() {
-            let events = s.module.take_events();
-            if let Some((_, sink)) = &s.sink {
-                for e in events {
-                    let _ = sink.send(e);
+    fn after_change(s: &mut State) {
+        let State { nodes, sink, .. } = s;
+        for n in nodes.iter_mut() {
+            if n.module.has_events() {
+                let events = n.module.take_events();
+                if let Some((_, sink)) = sink {
+                    for e in events {
+                        let _ = sink.send(e);
+                    }
                 }
             }
-        }
-        if s.module.eeprom_generation() != s.saved_generation {
-            if let Some(path) = &self.eeprom {
-                if let Err(e) = save_atomic(path, s.module.eeprom()) {
-                    eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
+            if n.module.eeprom_generation() != n.saved_generation {
+                if let Some(path) = &n.eeprom {
+                    if let Err(e) = save_atomic(path, n.module.eeprom()) {
+                        eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
+                    }
                 }
+                n.saved_generation = n.module.eeprom_generation();
             }
-            s.saved_generation = s.module.eeprom_generation();
         }
     }
 }
