@@ -17,7 +17,7 @@
 //!   stop, the motor loses steps: the position counter goes on, the
 //!   carriage does not.
 
-use crate::module::{ap, Module};
+use crate::module::{ap, error_flag, gp, Module};
 use crate::program::Source;
 
 /// Full steps per second at which the motor has no torque left.
@@ -28,6 +28,8 @@ pub const SHUTDOWN_C: f64 = 150.0;
 pub const PREWARNING_C: f64 = 120.0;
 /// Below this supply (0.1 V) the driver is off (undervoltage).
 pub const UNDERVOLTAGE_DV: u16 = 80;
+/// AP 210 value for an encoder factor of 1 (68672 ↔ 6.4).
+pub const PRESCALER_UNIT: f64 = 10730.0;
 /// No step for 2^20 clocks of 16 MHz: the standstill flag.
 pub const STANDSTILL_NS: u64 = 65_536_000;
 
@@ -43,14 +45,51 @@ pub struct Driver {
 }
 
 impl Module {
-    /// The driver is switched off (no torque) and why, as AP 208 bits.
+    /// The driver is switched off (no torque).
     pub(crate) fn driver_off(&self, m: usize) -> bool {
         let f = self.world.axes[m].faults;
-        self.world.temperature >= SHUTDOWN_C
-            || f.short_a
-            || f.short_b
-            || self.world.supply_decivolts < UNDERVOLTAGE_DV
-            || self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0
+        let toff_zero = self.profile.axis_parameter(ap::CHOPPER_OFF_TIME).is_some() && self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0;
+        let shutdown_pin = match self.profile.global_parameter(0, gp::SHUTDOWN_PIN).map(|_| self.globals[0][gp::SHUTDOWN_PIN as usize]) {
+            Some(1) => self.world.shutdown_input,
+            Some(2) => !self.world.shutdown_input,
+            _ => false,
+        };
+        self.world.temperature >= SHUTDOWN_C || f.short_a || f.short_b || self.world.supply_decivolts < UNDERVOLTAGE_DV || toff_zero || shutdown_pin
+    }
+
+    /// AP 209: the encoder's count scaled by the prescaler (AP 210; the
+    /// manual's example 68672 is a factor of 6.4, and the factor is taken
+    /// as proportional: value / 10730), plus the offset SAP 209 set.
+    pub(crate) fn encoder_position(&self, m: usize) -> i32 {
+        let w = &self.world.axes[m];
+        let Some(counts_per_rev) = w.encoder_counts else { return self.axes[m].encoder_offset as i32 };
+        let microsteps_per_rev = w.fullsteps_per_rev * self.microsteps(m);
+        let counts = self.mechanical_position(m) / microsteps_per_rev * counts_per_rev;
+        let factor = self.axes[m].params[ap::ENCODER_PRESCALER as usize] as f64 / PRESCALER_UNIT;
+        ((counts * factor).round() as i64 + self.axes[m].encoder_offset) as i32
+    }
+
+    /// Some moving axis has something the driver must look at often: a
+    /// load, stall detection, coolStep, an encoder deviation limit, or a
+    /// driver that is off.
+    pub(crate) fn driver_watches(&self) -> bool {
+        (0..self.axes.len()).any(|m| {
+            let axis = &self.axes[m];
+            let p = &axis.params;
+            let has = |n: u8| self.profile.axis_parameter(n).is_some();
+            let will_move = axis.motion.v != 0.0
+                || match axis.motion.mode {
+                    crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
+                    _ => axis.motion.x != axis.motion.target,
+                };
+            will_move
+                && (!self.world.axes[m].loads.is_empty()
+                    || (has(ap::STOP_ON_STALL) && p[ap::STOP_ON_STALL as usize] > 0)
+                    || (has(ap::STALL_THRESHOLD) && p[ap::STALL_THRESHOLD as usize] > 0)
+                    || (has(ap::SMART_ENERGY_HYSTERESIS_START) && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
+                    || (has(ap::MAX_ENCODER_DEVIATION) && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
+                    || self.driver_off(m))
+        })
     }
 
     /// AP 208.
@@ -77,7 +116,7 @@ impl Module {
         }
     }
 
-    fn microsteps(&self, m: usize) -> f64 {
+    pub(crate) fn microsteps(&self, m: usize) -> f64 {
         2f64.powi(self.axes[m].params[ap::MICROSTEP_RESOLUTION as usize].clamp(0, 8))
     }
 
@@ -110,7 +149,7 @@ impl Module {
         let p = self.axes[m].params;
         let v_int = self.actual_speed(m).abs();
         // coolStep regulates above its threshold speed, when enabled.
-        let semin = p[ap::SMART_ENERGY_HYSTERESIS_START as usize];
+        let semin = if self.profile.axis_parameter(ap::SMART_ENERGY_HYSTERESIS_START).is_some() { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
         let cool = semin > 0 && moving && v_int >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
         if cool {
             let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
@@ -143,16 +182,27 @@ impl Module {
         }
         let scale = self.current_scale(m);
         let margin = self.margin(m, scale);
-        if moving {
-            self.axes[m].driver.load_value = self.stallguard(m, margin);
-        }
-        // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
-        let stall_speed = p[ap::STOP_ON_STALL as usize];
-        if moving && stall_speed > 0 && v_int >= stall_speed && self.axes[m].driver.load_value == 0 {
-            self.motor_stop(m);
-            self.axes[m].motion.v = 0.0;
-            self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
-            self.raise(Source::Stall(m as u8));
+        if self.profile.axis_parameter(ap::STALLGUARD_THRESHOLD).is_some() {
+            if moving {
+                self.axes[m].driver.load_value = self.stallguard(m, margin);
+            }
+            // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
+            let stall_speed = p[ap::STOP_ON_STALL as usize];
+            if moving && stall_speed > 0 && v_int >= stall_speed && self.axes[m].driver.load_value == 0 {
+                self.stop_now(m);
+                self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
+                self.raise(Source::Stall(m as u8));
+            }
+        } else if self.profile.axis_parameter(ap::STALL_THRESHOLD).is_some() {
+            // TMC249 load indicator (TMCM-351): 0…7, higher is more load;
+            // a reading above AP 205 (not 0) stops the motor.
+            if moving {
+                self.axes[m].driver.load_value = (7.0 * (1.0 - margin)).round().clamp(0.0, 7.0) as i32;
+            }
+            let threshold = p[ap::STALL_THRESHOLD as usize];
+            if moving && threshold > 0 && self.axes[m].driver.load_value > threshold {
+                self.stop_now(m);
+            }
         }
         // The carriage follows the motor unless it cannot.
         let sign = self.shaft_sign();
@@ -166,6 +216,23 @@ impl Module {
             let clamped = mech.clamp(lo, hi);
             axis.mech_offset += clamped - mech;
         }
+        // Encoder deviation (AP 212): the motor stops when the position
+        // counter and the encoder drift apart further than allowed.
+        let limit = p[ap::MAX_ENCODER_DEVIATION as usize];
+        if limit > 0 && moving && self.profile.axis_parameter(ap::MAX_ENCODER_DEVIATION).is_some() {
+            let deviation = (self.actual_position(m) as i64 - self.encoder_position(m) as i64).abs();
+            if deviation > limit as i64 {
+                self.stop_now(m);
+                self.registers.errors |= error_flag::DEVIATION;
+                self.raise(Source::Deviation(m as u8));
+            }
+        }
         let _ = dt;
+    }
+
+    /// A hard stop: velocity mode, zero speed, at once.
+    fn stop_now(&mut self, m: usize) {
+        self.motor_stop(m);
+        self.axes[m].motion.v = 0.0;
     }
 }

@@ -66,14 +66,19 @@ impl Module {
         let echo = ins.value;
         let program = origin == Origin::Program;
         match cmd {
-            Ror { motor, velocity } => self.rotate(motor, velocity, 1).map(|_| echo),
-            Rol { motor, velocity } => self.rotate(motor, velocity, -1).map(|_| echo),
-            Mst { motor } => {
-                let m = self.motor(motor)?;
-                self.motor_stop(m);
-                Ok(echo)
+            Ror { motor, velocity } => self.for_group(motor, |s, m| s.rotate(m, velocity, 1)).map(|_| echo),
+            Rol { motor, velocity } => self.for_group(motor, |s, m| s.rotate(m, velocity, -1)).map(|_| echo),
+            Mst { motor } => self
+                .for_group(motor, |s, m| {
+                    let m = s.motor(m)?;
+                    s.motor_stop(m);
+                    Ok(())
+                })
+                .map(|_| echo),
+            Mvp { mode: MoveMode::Coordinate, motor, value } if motor & 0xC0 != 0 && self.axes.len() > 1 => {
+                self.move_coordinate_mask(motor, value).map(|_| echo)
             }
-            Mvp { mode, motor, value } => self.move_to(mode, motor, value).map(|_| echo),
+            Mvp { mode, motor, value } => self.for_group(motor, |s, m| s.move_to(mode, m, value)).map(|_| echo),
             Mvpa { mode, motor } => {
                 let a = self.registers.accumulator;
                 self.move_to(mode, motor, a).map(|_| echo)
@@ -89,6 +94,9 @@ impl Module {
             Stap { param, motor } => {
                 let m = self.motor(motor)?;
                 self.axis_spec(param, |a| a.eeprom)?;
+                if self.eeprom_locked() {
+                    return Err(Status::EepromLocked);
+                }
                 let v = self.axes[m].params[param as usize];
                 self.eeprom.set_axis(motor, param, v);
                 self.eeprom_generation += 1;
@@ -109,6 +117,9 @@ impl Module {
             }
             Stgp { param, bank } => {
                 self.global_spec(param, bank, |a| a.eeprom)?;
+                if self.eeprom_locked() {
+                    return Err(Status::EepromLocked);
+                }
                 let v = self.globals[bank as usize][param as usize];
                 self.eeprom.set_global(bank, param, v);
                 self.eeprom_generation += 1;
@@ -275,19 +286,23 @@ impl Module {
             Rfs { action, motor } => {
                 let m = self.motor(motor)?;
                 match action {
-                    RfsAction::Start => self.start_reference_search(m)?,
-                    RfsAction::Stop => {
-                        if self.axes[m].rfs.take().is_some() {
-                            self.motor_stop(m);
+                    RfsAction::Start => self.for_group(motor, |s, g| s.start_reference_search(g as usize))?,
+                    RfsAction::Stop => self.for_group(motor, |s, g| {
+                        if s.axes[g as usize].rfs.take().is_some() {
+                            s.motor_stop(g as usize);
                         }
-                    }
+                        Ok(())
+                    })?,
                     RfsAction::Status => return Ok(self.reference_search_active(m) as i32),
                 }
                 Ok(echo)
             }
-            // ASCII mode is not part of this firmware yet.
-            AsciiMode => Err(Status::NotAvailable),
-            Sac { .. } => Err(Status::InvalidCommand),
+            AsciiMode => {
+                // The reply goes out in binary; then the link speaks text.
+                self.enter_ascii_mode();
+                Ok(echo)
+            }
+            Sac { bus, count, value } => self.spi_transfer(bus, count, value),
             FirmwareVersion { binary: false } | FactoryDefaults { .. } => unreachable!("handled in execute"),
             Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti => {
                 Err(Status::NotAvailable)
@@ -401,6 +416,7 @@ impl Module {
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
         axis.rfs = None;
+        axis.ramp_override = None;
         axis.params[ap::TARGET_SPEED as usize] = velocity * sign;
         axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
         axis.motion.mode = RampMode::Velocity;
@@ -412,6 +428,7 @@ impl Module {
     pub(crate) fn motor_stop(&mut self, m: usize) {
         let axis = &mut self.axes[m];
         axis.rfs = None;
+        axis.ramp_override = None;
         axis.params[ap::TARGET_SPEED as usize] = 0;
         axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
         axis.motion.mode = RampMode::Velocity;
@@ -428,9 +445,13 @@ impl Module {
                 *self.axes[m].coordinates.get(n).ok_or(Status::InvalidValue)?
             }
         };
+        if mode == MoveMode::Absolute && !self.profile.axis_parameter(ap::TARGET_POSITION).is_some_and(|p| p.accepts(value)) {
+            return Err(Status::InvalidValue);
+        }
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
         axis.rfs = None;
+        axis.ramp_override = None;
         // MVP selects position mode; soft mode, once chosen, stays.
         if axis.motion.mode != RampMode::Soft {
             axis.motion.mode = RampMode::Position;
@@ -451,6 +472,84 @@ impl Module {
             }
         }
         Ok(())
+    }
+
+    /// Runs a motion command for `motor` and for every other motor with the
+    /// same non-zero group index (AP 213, on modules that have it).
+    fn for_group(&mut self, motor: u8, mut f: impl FnMut(&mut Module, u8) -> Result<(), Status>) -> Result<(), Status> {
+        let m = self.motor(motor)?;
+        f(self, motor)?;
+        if self.profile.axis_parameter(ap::GROUP_INDEX).is_some() {
+            let group = self.axes[m].params[ap::GROUP_INDEX as usize];
+            if group != 0 {
+                for other in 0..self.axes.len() {
+                    if other != m && self.axes[other].params[ap::GROUP_INDEX as usize] == group {
+                        f(self, other as u8)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// MVP COORD with a motor mask: bit 7 moves the masked motors each with
+    /// its own ramp, bit 6 interpolates (all arrive together: the axis with
+    /// the longest travel time sets the pace, the others scale speed and
+    /// acceleration by their share of the distance).
+    fn move_coordinate_mask(&mut self, motor: u8, coordinate: i32) -> Result<(), Status> {
+        let mask = (motor & 0x3F) as usize;
+        let motors: Vec<usize> = (0..self.axes.len()).filter(|m| mask & (1 << m) != 0).collect();
+        if motors.is_empty() || mask >> self.axes.len() != 0 {
+            return Err(Status::InvalidValue);
+        }
+        for &m in &motors {
+            self.move_to(MoveMode::Coordinate, m as u8, coordinate)?;
+        }
+        if motor & 0x40 == 0 {
+            return Ok(());
+        }
+        let plans: Vec<(usize, f64, f64)> = motors
+            .iter()
+            .map(|&m| {
+                let d = (self.axes[m].motion.target - self.axes[m].motion.x).abs();
+                (m, d, crate::motion::Motion::closed_form_duration(d, &self.ramp(m)))
+            })
+            .collect();
+        let &(lead, d_lead, _) = plans.iter().max_by(|a, b| a.2.total_cmp(&b.2)).expect("motors is not empty");
+        if d_lead == 0.0 {
+            return Ok(());
+        }
+        let lead_ramp = self.ramp(lead);
+        for (m, d, _) in plans {
+            if m != lead {
+                let k = d / d_lead;
+                let mut r = lead_ramp;
+                r.vmax *= k;
+                r.vmin *= k;
+                r.accel_position *= k;
+                self.axes[m].ramp_override = (k > 0.0).then_some(r);
+            }
+        }
+        Ok(())
+    }
+
+    /// SAC (TMCM-351): an SPI transfer of `count` bytes on chip select
+    /// `bus`. The simulated device on each bus is a shift register: it
+    /// answers with what the previous transfer sent.
+    fn spi_transfer(&mut self, bus: u8, count: u8, value: i32) -> Exec {
+        let slot = self.spi.get_mut(bus as usize).ok_or(Status::WrongType)?;
+        if !(1..=4).contains(&count) {
+            return Err(Status::InvalidValue);
+        }
+        let mask = if count == 4 { u32::MAX } else { (1u32 << (8 * count)) - 1 };
+        let answer = *slot & mask;
+        *slot = value as u32 & mask;
+        Ok(answer as i32)
+    }
+
+    /// GP 73 on modules that have it: the configuration EEPROM is locked.
+    pub(crate) fn eeprom_locked(&self) -> bool {
+        self.profile.global_parameter(0, gp::EEPROM_LOCK).is_some() && self.globals[0][gp::EEPROM_LOCK as usize] == 1
     }
 
     fn clear_motion_errors(&mut self, m: usize) {
@@ -483,7 +582,8 @@ impl Module {
     /// RFS START with the mode of AP 193.
     fn start_reference_search(&mut self, m: usize) -> Result<(), Status> {
         let mode = self.axes[m].params[ap::REFERENCE_SEARCH_MODE as usize];
-        let rfs = ReferenceSearch::new(mode).ok_or(Status::InvalidValue)?;
+        let rfs = if self.profile.module.motion_controller == "TMC428" { ReferenceSearch::new_tmc428(mode) } else { ReferenceSearch::new(mode) };
+        let rfs = rfs.ok_or(Status::InvalidValue)?;
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
         axis.notify_on_arrival = false;
@@ -601,6 +701,10 @@ impl Module {
                 axis.params[param as usize] = value;
                 axis.motion.mode = RampMode::from_code(value);
             }
+            ap::ENCODER_POSITION => {
+                let now = self.encoder_position(m) as i64 - self.axes[m].encoder_offset;
+                self.axes[m].encoder_offset = value as i64 - now;
+            }
             _ => self.axes[m].params[param as usize] = value,
         }
     }
@@ -621,6 +725,7 @@ impl Module {
             ap::HOME_SWITCH => self.switches(m).2 as i32,
             ap::ACTUAL_CURRENT => self.current_scale(m).round() as i32,
             ap::LOAD_VALUE => self.axes[m].driver.load_value,
+            ap::ENCODER_POSITION if self.profile.axis_parameter(ap::ENCODER_POSITION).is_some() => self.encoder_position(m),
             ap::DRIVER_ERROR_FLAGS => self.driver_flags(m),
             ap::EXTENDED_ERROR_FLAGS => {
                 // Cleared by reading.
@@ -673,6 +778,21 @@ impl Module {
             return Err(Status::InvalidValue);
         }
         let auto = spec.access.auto;
+        if (bank, param) == (0, gp::EEPROM_LOCK) {
+            // 1234 locks, 4321 unlocks; the state itself is kept.
+            let locked = match value {
+                1234 => 1,
+                4321 => 0,
+                _ => return Err(Status::InvalidValue),
+            };
+            self.globals[0][param as usize] = locked;
+            self.eeprom.set_global(0, param, locked);
+            self.eeprom_generation += 1;
+            return Ok(());
+        }
+        if auto && self.eeprom_locked() {
+            return Err(Status::EepromLocked);
+        }
         match (bank, param) {
             (0, gp::TICK_TIMER) => {
                 self.tick_base_ns = self.now_ns;
@@ -818,6 +938,9 @@ impl Module {
             return Err(Status::WrongType);
         }
         if motor == 255 {
+            if self.eeprom_locked() {
+                return Err(Status::EepromLocked);
+            }
             // SCO n, 255, 0: RAM → EEPROM (0 = all but coordinate 0).
             let range = if n == 0 { 1..=self.profile.module.coordinates } else { n..=n };
             for m in 0..self.axes.len() {

@@ -51,7 +51,7 @@ impl Module {
                 Ok(ok(0))
             }
             Command::EnterDownload { address } => {
-                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 2 | 3) {
+                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 2 | 3) || self.eeprom_locked() {
                     return Err(Status::EepromLocked);
                 }
                 if !(0..memory).contains(&address) {

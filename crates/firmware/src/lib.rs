@@ -4,6 +4,7 @@
 //! Pure and deterministic: a [`Module`] changes only through
 //! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
 
+pub mod ascii;
 pub mod driver;
 pub mod eeprom;
 pub mod executor;

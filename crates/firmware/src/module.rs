@@ -46,6 +46,11 @@ pub mod ap {
     pub const SMART_ENERGY_THRESHOLD_SPEED: u8 = 182;
     pub const SMART_ENERGY_SLOW_RUN_CURRENT: u8 = 183;
     pub const LOAD_VALUE: u8 = 206;
+    pub const STALL_THRESHOLD: u8 = 205;
+    pub const ENCODER_POSITION: u8 = 209;
+    pub const ENCODER_PRESCALER: u8 = 210;
+    pub const MAX_ENCODER_DEVIATION: u8 = 212;
+    pub const GROUP_INDEX: u8 = 213;
     pub const DRIVER_ERROR_FLAGS: u8 = 208;
     pub const RAMP_DIVISOR: u8 = 153;
     pub const REFERENCE_SEARCH_MODE: u8 = 193;
@@ -63,10 +68,14 @@ pub mod ap {
 
 /// Global parameter numbers (bank 0) the firmware gives a meaning to.
 pub mod gp {
+    pub const EEPROM_MAGIC: u8 = 64;
     pub const BAUD_RATE: u8 = 65;
     pub const SERIAL_ADDRESS: u8 = 66;
+    pub const ASCII_MODE: u8 = 67;
     pub const HEARTBEAT: u8 = 68;
     pub const AUTOSTART: u8 = 77;
+    pub const EEPROM_LOCK: u8 = 73;
+    pub const SHUTDOWN_PIN: u8 = 80;
     pub const CODE_PROTECTION: u8 = 81;
     pub const TELEGRAM_PAUSE: u8 = 75;
     pub const HOST_ADDRESS: u8 = 76;
@@ -103,6 +112,10 @@ pub struct Axis {
     /// The reference search in progress.
     pub rfs: Option<ReferenceSearch>,
     pub driver: Driver,
+    /// An interpolated move's ramp (MVP COORD with bit 6), until it ends.
+    pub ramp_override: Option<motion::Ramp>,
+    /// AP 209 minus what the encoder measures (set by SAP 209).
+    pub encoder_offset: i64,
 }
 
 /// Result of the last comparison (or of an accumulator load against 0).
@@ -216,6 +229,11 @@ pub struct Module {
     /// and switch interrupts.
     pub(crate) last_inputs: u32,
     pub(crate) last_switches: Vec<(bool, bool)>,
+    /// SAC: the shift register of the SPI device on each chip select.
+    pub(crate) spi: [u32; 3],
+    /// ASCII mode and the line being typed.
+    pub(crate) ascii: bool,
+    pub(crate) ascii_line: crate::ascii::AsciiLine,
 }
 
 impl Module {
@@ -235,7 +253,8 @@ impl Module {
     /// A module powered up with the given EEPROM, in the given world (its
     /// carriages start where the world says).
     pub fn with_world(profile: Arc<Profile>, eeprom: Eeprom, mut world: World) -> Module {
-        world.axes.resize(profile.module.axes as usize, Default::default());
+        let template = World::free(1).axes[0].clone();
+        world.axes.resize(profile.module.axes as usize, template);
         let mut m = Module {
             world,
             axes: Vec::new(),
@@ -260,6 +279,9 @@ impl Module {
             program: Program::new(profile.module.program_memory as usize),
             last_inputs: 0,
             last_switches: Vec::new(),
+            spi: [0; 3],
+            ascii: false,
+            ascii_line: Default::default(),
             now_ns: 0,
             eeprom,
             profile,
@@ -357,6 +379,14 @@ impl Module {
     /// Power cycle: RAM from factory defaults, then what the EEPROM holds.
     pub fn power_on(&mut self) {
         let profile = self.profile.clone();
+        if profile.global_parameter(0, gp::EEPROM_MAGIC).is_some() {
+            // Any magic but 0xE4 re-initialises the EEPROM (TMCM-351 GP 64).
+            if self.eeprom.global(0, gp::EEPROM_MAGIC).is_some_and(|v| v != 0xE4) {
+                self.eeprom.clear();
+                self.eeprom.set_global(0, gp::EEPROM_MAGIC, 0xE4);
+                self.eeprom_generation += 1;
+            }
+        }
         let ee = &self.eeprom;
         let restored = !ee.axis.is_empty() || !ee.global.is_empty() || !ee.coordinates.is_empty();
         self.globals = [[0; 256]; 4];
@@ -401,6 +431,8 @@ impl Module {
                 notify_on_arrival: false,
                 rfs: None,
                 driver: Driver::default(),
+                ramp_override: None,
+                encoder_offset: 0,
             });
         }
         self.restored_from_eeprom = restored;
@@ -435,6 +467,8 @@ impl Module {
             let (l, r, _) = self.switches(m);
             (l, r)
         }).collect();
+        self.ascii = self.globals[0][gp::ASCII_MODE as usize] & 1 == 1;
+        self.ascii_line = Default::default();
         if self.globals[0][gp::AUTOSTART as usize] == 1 && self.program.length() > 0 {
             self.program.mode = RunMode::Run;
         }
@@ -552,6 +586,10 @@ impl Module {
             };
             at(self.heartbeat_deadline());
             at(timer);
+            if self.driver_watches() {
+                // Load, stall and deviation are looked at every millisecond.
+                at(Some(self.now_ns + 1_000_000));
+            }
             if self.program.is_running() {
                 if self.program.wait.is_none() {
                     at(Some(self.program.next_ns));
@@ -712,6 +750,9 @@ impl Module {
         } else if was_moving || axis.standstill_since.is_none() {
             axis.standstill_since = Some(self.now_ns);
         }
+        if arrived {
+            axis.ramp_override = None;
+        }
         if arrived && axis.notify_on_arrival {
             axis.notify_on_arrival = false;
             self.push_event(1 << motor);
@@ -763,6 +804,9 @@ impl Module {
 
     /// Ramp settings of an axis in µsteps and seconds.
     pub(crate) fn ramp(&self, motor: usize) -> motion::Ramp {
+        if let Some(r) = self.axes[motor].ramp_override {
+            return r;
+        }
         let p = &self.axes[motor].params;
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;

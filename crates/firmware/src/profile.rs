@@ -186,7 +186,10 @@ pub struct Profile {
 }
 
 /// The profiles compiled into tmclsim: (name, TOML text).
-pub const BUILT_IN: &[(&str, &str)] = &[("tmcm-1141", include_str!("../../../profiles/tmcm-1141.toml"))];
+pub const BUILT_IN: &[(&str, &str)] = &[
+    ("tmcm-1141", include_str!("../../../profiles/tmcm-1141.toml")),
+    ("tmcm-351", include_str!("../../../profiles/tmcm-351.toml")),
+];
 
 impl Profile {
     /// Parses and checks a profile.

@@ -65,7 +65,24 @@ fn seek(switch: Switch, active: bool, dir: f64, fast: bool) -> Seek {
 }
 
 impl ReferenceSearch {
-    /// A search for AP 193 = `mode`; `None` for a mode the module lacks.
+    /// The TMCM-351's (TMC428) modes: 1 left switch; 2 right switch, then
+    /// left switch, zero at the left one; 3 (three-switch mode) right
+    /// switch, then the reference (home) switch in the negative direction,
+    /// zero at its edge. AP 196 gets the distance in modes 2 and 3.
+    pub fn new_tmc428(mode: i32) -> Option<ReferenceSearch> {
+        let edge = |s: Switch, dir: f64| vec![(seek(s, true, dir, true), false), (seek(s, false, -dir, false), true), (seek(s, true, dir, false), true)];
+        let (seeks, result) = match mode {
+            1 => (edge(Switch::Left, -1.0), Result_::Edge),
+            2 => ([edge(Switch::Right, 1.0), edge(Switch::Left, -1.0)].concat(), Result_::TwoSwitches),
+            3 => ([edge(Switch::Right, 1.0), edge(Switch::Home, -1.0)].concat(), Result_::TwoSwitches),
+            _ => return None,
+        };
+        let dir = seeks[0].0.dir;
+        Some(ReferenceSearch { seeks, next: 0, marks: Vec::new(), result, invert_home: false, dir, finish: None })
+    }
+
+    /// A search for AP 193 = `mode` (TMCM-1141 modes); `None` for a mode
+    /// the module lacks.
     pub fn new(mode: i32) -> Option<ReferenceSearch> {
         let base = mode & 0x3F;
         let right = mode & 64 != 0;

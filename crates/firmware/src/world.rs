@@ -32,6 +32,11 @@ pub struct AxisWorld {
     pub start: f64,
     /// Driver faults injected by hand.
     pub faults: DriverFaults,
+    /// An incremental encoder on the motor shaft: counts per revolution
+    /// (`None`: no encoder).
+    pub encoder_counts: Option<f64>,
+    /// Full steps of the motor per revolution.
+    pub fullsteps_per_rev: f64,
 }
 
 /// A load on an axis: a torque demand in % of what the motor gives at
@@ -106,13 +111,16 @@ pub struct World {
     pub supply_decivolts: u16,
     /// Driver temperature in °C.
     pub temperature: f64,
+    /// Level of the shutdown input (TMCM-351 GP 80).
+    pub shutdown_input: bool,
 }
 
 impl World {
     /// A world with free axes (no switches), inputs low, 24 V supply,
     /// 40 °C.
     pub fn free(axes: usize) -> World {
-        World { axes: vec![AxisWorld::default(); axes], digital_inputs: 0, analog_inputs: vec![0; 8], supply_decivolts: 240, temperature: 40.0 }
+        let axis = AxisWorld { fullsteps_per_rev: 200.0, encoder_counts: Some(2000.0), ..AxisWorld::default() };
+        World { axes: vec![axis; axes], digital_inputs: 0, analog_inputs: vec![0; 8], supply_decivolts: 240, temperature: 40.0, shutdown_input: false }
     }
 
     /// The built-in world: every axis a linear stage of ±1 050 000 µsteps

@@ -64,6 +64,10 @@ struct AxisFile {
     no_home_switch: bool,
     #[serde(default)]
     load: Vec<LoadFile>,
+    /// Encoder counts per revolution (0: no encoder).
+    encoder: Option<f64>,
+    /// Motor full steps per revolution (200 by default).
+    fullsteps: Option<f64>,
 }
 
 impl World {
@@ -106,6 +110,15 @@ impl World {
             }
             if let Some(s) = af.start {
                 axis.start = s;
+            }
+            if let Some(e) = af.encoder {
+                axis.encoder_counts = (e > 0.0).then_some(e);
+            }
+            if let Some(f) = af.fullsteps {
+                if f <= 0.0 {
+                    return Err(format!("axis {a}: fullsteps = {f} must be positive"));
+                }
+                axis.fullsteps_per_rev = f;
             }
             if af.no_left_switch {
                 axis.left_switch = None;

@@ -34,7 +34,18 @@ where
                     Err(e) => return Err(e),
                 };
                 let now = start.elapsed().as_nanos() as u64;
+                let mut text = Vec::new();
                 for &byte in &buf[..n] {
+                    if module.ascii_active() {
+                        // ASCII mode: text in, text out; the frame
+                        // assembler starts afresh afterwards.
+                        module.ascii_byte(byte, &mut text);
+                        assembler.reset();
+                        continue;
+                    }
+                    if !text.is_empty() {
+                        writer.write_all(&std::mem::take(&mut text)).await?;
+                    }
                     let Some(frame) = assembler.push(byte, now) else { continue };
                     let (replies, pause) = module.handle(link, &events_tx, &frame);
                     for reply in replies {
@@ -47,6 +58,9 @@ where
                             writer.write_all(&reply).await?;
                         }
                     }
+                }
+                if !text.is_empty() {
+                    writer.write_all(&text).await?;
                 }
                 writer.flush().await?;
             }

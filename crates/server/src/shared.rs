@@ -45,6 +45,8 @@ pub struct SharedModule {
     faults: Mutex<LinkFaults>,
     /// Deliver bytes at the modules' baud rate (GP 65).
     wire_timing: bool,
+    /// Some module of the link is in ASCII mode.
+    ascii: std::sync::atomic::AtomicBool,
 }
 
 /// GP 65 codes → bits per second (TMCM-1141 table 18).
@@ -78,13 +80,42 @@ impl SharedModule {
                 Node { module, eeprom, saved_generation }
             })
             .collect();
-        SharedModule {
+        let shared = SharedModule {
             state: Mutex::new(State { nodes, sink: None, scheduled: None }),
             clock: Mutex::new(Clock::Wall { origin: Instant::now(), origin_ns }),
             changed: Notify::new(),
             faults: Mutex::new(LinkFaults::default()),
             wire_timing,
+            ascii: std::sync::atomic::AtomicBool::new(false),
+        };
+        shared.update_ascii(&shared.lock());
+        shared
+    }
+
+    /// Some module of the link reads text (ASCII mode): bytes go to
+    /// [`SharedModule::ascii_byte`] instead of the frame assembler.
+    pub fn ascii_active(&self) -> bool {
+        self.ascii.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    fn update_ascii(&self, s: &State) {
+        let any = s.nodes.iter().any(|n| n.module.ascii_mode());
+        self.ascii.store(any, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// One byte of text for the modules in ASCII mode; echoes and replies
+    /// are appended to `out`.
+    pub(crate) fn ascii_byte(&self, byte: u8, out: &mut Vec<u8>) {
+        let mut s = self.lock();
+        let now = self.now_ns();
+        for n in &mut s.nodes {
+            n.module.advance_to(now);
+            if n.module.ascii_mode() {
+                n.module.ascii_byte(byte, out);
+            }
         }
+        Self::after_change(&mut s);
+        self.update_ascii(&s);
     }
 
     /// How many modules the link has.
@@ -205,6 +236,7 @@ impl SharedModule {
                 }
             }
         }
+        self.update_ascii(&s);
         let has_events = s.nodes.iter().any(|n| n.module.has_events());
         if (!replies.is_empty() || has_events) && s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
             s.sink = Some((link, sink.clone()));

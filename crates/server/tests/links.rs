@@ -176,3 +176,31 @@ fn stepped_virtual_time() {
     assert_ne!(ask(&mut s, "GAP 1, 0").value, 0, "back on the wall clock");
     server.stop();
 }
+
+#[test]
+fn ascii_session_on_the_pty_in_every_echo_mode() {
+    let dir = std::env::temp_dir().join(format!("tmclsim-ascii-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let link = dir.join("tmcm");
+    let config = ServerConfig { pty: Some(link.clone()), ..ServerConfig::default() };
+    let server = start(Module::built_in("tmcm-1141").unwrap(), config).unwrap();
+    let mut port = std::fs::OpenOptions::new().read(true).write(true).open(&link).unwrap();
+    assert_eq!(ask(&mut port, "#139 0 0 0").status, 100);
+    let mut session = |line: &str, expect: &str| {
+        port.write_all(line.as_bytes()).unwrap();
+        let mut got = vec![0u8; expect.len()];
+        port.read_exact(&mut got).unwrap();
+        assert_eq!(String::from_utf8_lossy(&got), expect, "{line:?}");
+    };
+    session("ASAP 1, 0, -5000\r", "ASAP 1, 0, -5000\rBA 100 -5000\r");
+    session("AGAP 1, 0\r", "AGAP 1, 0\rBA 100 -5000\r");
+    session("ASGP 67, 0, 16\r", "ASGP 67, 0, 16\rBA 100 16\r");
+    session("AGAP 1, 0\r", "AGAP 1, 0\rBA 100 -5000\r");
+    session("ASGP 67, 0, 32\r", "ASGP 67, 0, 32\rBA 100 32\r");
+    session("AGAP 1, 0\r", "BA 100 -5000\r");
+    session("ABIN\r", "BA 100 0\r");
+    // Binary again.
+    assert_eq!(ask(&mut port, "GAP 1, 0").value, -5000);
+    server.stop();
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,129 @@
+//! The ASCII interface (TMCM-1141 manual 3.4): entered by command 139 or
+//! at power-up by GP 67 bit 0, left with `BIN`.
+//!
+//! A line is `<address character><command>` and a carriage return, e.g.
+//! `AMVP ABS, 1, 50000`; the address character is `A` for address 1, `B`
+//! for 2, and so on. The reply is `<host character><module character>
+//! <status> <value>` and a carriage return, e.g. `BA 100 -5000`. GP 67
+//! bits 4 and 5 choose the echo: each character as it comes (00, with
+//! backspace editing), the whole line after the carriage return (01), or
+//! none (10). Only the commands the module permits in ASCII mode run;
+//! `RUN` and `STOP` start and stop the TMCL program.
+
+use crate::module::{gp, Module};
+use tmclsim_protocol::{mnemonic, Instruction, Status};
+
+/// Longest line kept; the rest of a longer line is dropped.
+const MAX_LINE: usize = 128;
+
+const CR: u8 = b'\r';
+const BACKSPACE: u8 = 0x08;
+const DELETE: u8 = 0x7F;
+
+/// The line being typed.
+#[derive(Clone, Debug, Default)]
+pub struct AsciiLine {
+    buf: Vec<u8>,
+}
+
+/// The character that stands for an address (`A` = 1).
+pub fn address_char(address: u8) -> u8 {
+    b'@'.wrapping_add(address)
+}
+
+impl Module {
+    /// The module reads text (ASCII mode) rather than 9-byte frames.
+    pub fn ascii_mode(&self) -> bool {
+        self.ascii
+    }
+
+    pub(crate) fn enter_ascii_mode(&mut self) {
+        self.ascii = true;
+        self.ascii_line.buf.clear();
+    }
+
+    fn echo_mode(&self) -> i32 {
+        (self.globals[0][gp::ASCII_MODE as usize] >> 4) & 3
+    }
+
+    /// One character from the link in ASCII mode; what the module sends
+    /// back (echo, reply) is appended to `out`.
+    pub fn ascii_byte(&mut self, byte: u8, out: &mut Vec<u8>) {
+        let addressed = |m: &Module, line: &[u8]| line.first().is_some_and(|&c| c == address_char(m.address()) || (m.secondary_address() != 0 && c == address_char(m.secondary_address())));
+        match byte {
+            CR => {
+                let line = std::mem::take(&mut self.ascii_line.buf);
+                if !addressed(self, &line) {
+                    return;
+                }
+                match self.echo_mode() {
+                    0 => out.push(CR),
+                    1 => {
+                        out.extend_from_slice(&line);
+                        out.push(CR);
+                    }
+                    _ => {}
+                }
+                self.last_frame_ns = self.now_ns;
+                self.heartbeat_tripped = false;
+                let text = String::from_utf8_lossy(&line[1..]).into_owned();
+                let (status, value) = self.ascii_command(text.trim());
+                if let Some((status, value)) = status.zip(value) {
+                    let reply = format!("{}{} {} {}\r", address_char(self.host_address()) as char, line[0] as char, status.code(), value);
+                    out.extend_from_slice(reply.as_bytes());
+                }
+            }
+            b'\n' | 0 => {}
+            BACKSPACE | DELETE => {
+                if self.ascii_line.buf.len() > 1 && self.echo_mode() == 0 && addressed(self, &self.ascii_line.buf) {
+                    out.push(BACKSPACE);
+                }
+                if self.ascii_line.buf.len() > 1 || !addressed(self, &self.ascii_line.buf) {
+                    self.ascii_line.buf.pop();
+                }
+            }
+            _ => {
+                if self.ascii_line.buf.len() < MAX_LINE {
+                    self.ascii_line.buf.push(byte);
+                    if self.echo_mode() == 0 && addressed(self, &self.ascii_line.buf) {
+                        out.push(byte);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Runs one command line (without the address character). `None`:
+    /// nothing to answer.
+    fn ascii_command(&mut self, text: &str) -> (Option<Status>, Option<i32>) {
+        match text.to_ascii_uppercase().as_str() {
+            "" => return (None, None),
+            "BIN" => {
+                self.ascii = false;
+                return (Some(Status::Ok), Some(0));
+            }
+            "RUN" => {
+                self.start_program();
+                return (Some(Status::Ok), Some(0));
+            }
+            "STOP" => {
+                self.pause_program();
+                self.program.mode = crate::program::RunMode::Stop;
+                return (Some(Status::Ok), Some(0));
+            }
+            _ => {}
+        }
+        let ins: Instruction = match mnemonic::parse_line(text) {
+            Ok(i) => i,
+            Err(_) if text.split_whitespace().next().and_then(tmclsim_protocol::opcode::from_mnemonic).is_none() => {
+                return (Some(Status::InvalidCommand), Some(0));
+            }
+            Err(_) => return (Some(Status::WrongType), Some(0)),
+        };
+        if !self.profile.ascii_allows(ins.opcode) {
+            return (Some(Status::InvalidCommand), Some(ins.value));
+        }
+        let outcome = self.execute(ins);
+        (Some(outcome.status), Some(outcome.value))
+    }
+}
