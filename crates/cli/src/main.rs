@@ -91,6 +91,11 @@ pub struct ServeArgs {
     /// answers. Replaces --module and --address.
     #[arg(long, value_name = "SPEC", conflicts_with_all = ["address", "eeprom"])]
     pub bus: Option<String>,
+    /// Also offer the modules on a CAN bus behind a virtual serial-line CAN
+    /// adapter (SLCAN) on a pty with a symlink at PATH (python-can's
+    /// `slcan`, PyTrinamic's `slcan_tmcl`).
+    #[arg(long, value_name = "PATH")]
+    pub slcan: Option<PathBuf>,
     /// Deliver bytes at each module's baud rate (GP 65), so that host
     /// timeouts behave as on a real RS485 bus.
     #[arg(long)]

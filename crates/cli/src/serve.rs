@@ -14,7 +14,7 @@ fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {
         let profile = Profile::built_in(name)?;
         let w = crate::load_world(world, profile.module.axes as usize)?;
         let mut m = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), w);
-        m.set_address(address);
+        set_addresses(&mut m, address);
         modules.push(m);
     }
     if modules.is_empty() {
@@ -51,7 +51,7 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     let module = Module::with_world(profile.clone(), image, world);
     let mut module = module;
     if let Some(a) = args.address {
-        module.set_address(a);
+        set_addresses(&mut module, a);
     }
     if let Some(path) = &args.eeprom {
         // Write the file at once so a fresh one exists from the start.
@@ -60,6 +60,15 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
         }
     }
     serve((tcp, pty), vec![module], args.eeprom.clone(), eeprom_note, &args)
+}
+
+/// The serial address, and on modules with their own CAN identifier
+/// (GP 71) that too.
+fn set_addresses(m: &mut Module, address: u8) {
+    m.set_address(address);
+    if m.profile().global_parameter(0, 71).is_some() {
+        let _ = m.set_global_parameter(71, 0, address as i32);
+    }
 }
 
 /// The links to serve: both defaults when neither is named.
@@ -85,6 +94,7 @@ fn serve(
         max_connections: args.max_connections,
         control: Some(args.control),
         wire_timing: args.wire_timing,
+        slcan: args.slcan.clone(),
     };
     let names: Vec<String> = modules.iter().map(|m| format!("{} (address {})", m.profile().module.name, m.address())).collect();
     let server = tmclsim_server::start_bus(modules, config).map_err(|e| format!("cannot serve: {e}"))?;
@@ -96,6 +106,9 @@ fn serve(
     }
     if let Some((link, device)) = &ep.pty {
         println!("  pty: {} -> {}", link.display(), device.display());
+    }
+    if let Some((link, device)) = &ep.slcan {
+        println!("  slcan: {} -> {}  (CAN adapter: python-can interface \"slcan\")", link.display(), device.display());
     }
     println!("  world: {}{}", args.world, if args.wire_timing { "; wire timing on" } else { "" });
     if let Some(addr) = ep.control {

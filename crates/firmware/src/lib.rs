@@ -5,6 +5,7 @@
 //! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
 
 pub mod ascii;
+pub mod can;
 pub mod driver;
 pub mod eeprom;
 pub mod executor;

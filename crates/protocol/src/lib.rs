@@ -11,6 +11,7 @@ pub mod frame;
 pub mod mnemonic;
 pub mod opcode;
 pub mod serial;
+pub mod slcan;
 pub mod status;
 
 pub use command::{CalcOp, Command, Condition, DecodeError, ErrorFlag, MoveMode, RfsAction, WaitCondition};

@@ -13,6 +13,7 @@ mod faults;
 mod link;
 mod pty;
 mod shared;
+mod slcan;
 mod tcp;
 
 pub use faults::LinkFaults;
@@ -42,6 +43,9 @@ pub struct ServerConfig {
     pub control: Option<SocketAddr>,
     /// Deliver bytes at the modules' baud rate (GP 65), as a real RS485 bus.
     pub wire_timing: bool,
+    /// Path of the symlink to a pty that is a serial-line CAN adapter
+    /// (SLCAN) with the modules on its CAN bus.
+    pub slcan: Option<PathBuf>,
 }
 
 impl Default for ServerConfig {
@@ -54,6 +58,7 @@ impl Default for ServerConfig {
             max_connections: 64,
             control: None,
             wire_timing: false,
+            slcan: None,
         }
     }
 }
@@ -66,6 +71,8 @@ pub struct Endpoints {
     pub pty: Option<(PathBuf, PathBuf)>,
     /// The control socket.
     pub control: Option<SocketAddr>,
+    /// The SLCAN adapter's symlink and device.
+    pub slcan: Option<(PathBuf, PathBuf)>,
 }
 
 impl Endpoints {
@@ -107,7 +114,7 @@ impl ServerHandle {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
-        if let Some((link, _)) = &self.endpoints.pty {
+        for (link, _) in self.endpoints.pty.iter().chain(&self.endpoints.slcan) {
             let _ = std::fs::remove_file(link);
         }
     }
@@ -172,9 +179,13 @@ pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: S
                     Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
                     None => None,
                 };
-                Ok::<_, std::io::Error>((tcp, pty, control))
+                let slcan = match &config.slcan {
+                    Some(path) => Some(pty::Pty::open(path)?),
+                    None => None,
+                };
+                Ok::<_, std::io::Error>((tcp, pty, control, slcan))
             };
-            let (tcp, pty, control) = match setup.await {
+            let (tcp, pty, control, slcan) = match setup.await {
                 Ok(v) => v,
                 Err(e) => {
                     let _ = ready_tx.send(Err(e));
@@ -185,6 +196,7 @@ pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: S
                 tcp: tcp.as_ref().and_then(|l| l.local_addr().ok()),
                 pty: pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
                 control: control.as_ref().and_then(|l| l.local_addr().ok()),
+                slcan: slcan.as_ref().map(|p| (p.link.clone(), p.device.clone())),
             };
             let _ = ready_tx.send(Ok(endpoints));
             let mut tasks = tokio::task::JoinSet::new();
@@ -197,6 +209,9 @@ pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: S
             }
             if let Some(listener) = control {
                 tasks.spawn(control::run(listener, thread_shared.clone(), stop_rx.clone()));
+            }
+            if let Some(p) = slcan {
+                tasks.spawn(slcan::run(p, thread_shared.clone(), stop_rx.clone()));
             }
             let mut stop = stop_rx.clone();
             let _ = stop.wait_for(|s| *s).await;

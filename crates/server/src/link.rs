@@ -12,6 +12,11 @@ use tokio::sync::mpsc;
 
 static NEXT_LINK: AtomicU64 = AtomicU64::new(1);
 
+/// A fresh identifier for a link (events go to the link that spoke last).
+pub(crate) fn next_link_id() -> u64 {
+    NEXT_LINK.fetch_add(1, Ordering::Relaxed)
+}
+
 /// Serves one stream until it closes or fails. Replies are written by this
 /// task as soon as they exist; unsolicited events (138) reach it through a
 /// channel, so one task writes and frames never interleave.
@@ -20,7 +25,7 @@ where
     R: AsyncRead + Unpin,
     W: AsyncWrite + Unpin,
 {
-    let link = NEXT_LINK.fetch_add(1, Ordering::Relaxed);
+    let link = next_link_id();
     let (events_tx, mut events) = mpsc::unbounded_channel::<[u8; FRAME_LEN]>();
     let start = Instant::now();
     let mut assembler = FrameAssembler::new(inter_byte_timeout.as_nanos() as u64);

@@ -68,7 +68,17 @@ impl Pty {
 
 /// The master side as an async byte stream.
 #[derive(Clone)]
-struct Master(Arc<AsyncFd<OwnedFd>>);
+pub(crate) struct Master(Arc<AsyncFd<OwnedFd>>);
+
+impl Pty {
+    /// The master side as a stream (the slave stays open with the pty).
+    pub(crate) fn into_stream(self) -> io::Result<(Master, OwnedFd)> {
+        let Pty { master, _slave, .. } = self;
+        // SAFETY: the AsyncFd owns the descriptor for its whole life.
+        let fd = unsafe { AsyncFd::register(master) }.map_err(|e| e.into_parts().1)?;
+        Ok((Master(Arc::new(fd)), _slave))
+    }
+}
 
 fn raw(fd: &AsyncFd<OwnedFd>) -> RawFd {
     fd.get_ref().as_raw_fd()
@@ -122,12 +132,10 @@ impl AsyncWrite for Master {
 }
 
 pub(crate) async fn run(pty: Pty, module: Arc<SharedModule>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
-    let Pty { master, _slave, .. } = pty;
-    // SAFETY: the AsyncFd owns the descriptor for its whole life.
-    let master = match unsafe { AsyncFd::register(master) } {
-        Ok(fd) => Master(Arc::new(fd)),
+    let (master, _slave) = match pty.into_stream() {
+        Ok(v) => v,
         Err(e) => {
-            eprintln!("tmclsim: pty: {}", e.into_parts().1);
+            eprintln!("tmclsim: pty: {e}");
             return;
         }
     };

@@ -253,6 +253,33 @@ impl SharedModule {
         (replies, delay)
     }
 
+    /// Handles a CAN frame: every module sees it, those it is for answer.
+    pub(crate) fn handle_can(&self, link: u64, sink: &EventSink, frame: &tmclsim_firmware::can::CanFrame) -> Vec<tmclsim_firmware::can::CanFrame> {
+        let mut s = self.lock();
+        let now = self.now_ns();
+        let mut replies = Vec::new();
+        for n in &mut s.nodes {
+            n.module.advance_to(now);
+            if let Some(r) = n.module.handle_can(frame) {
+                replies.push(r);
+            }
+        }
+        if s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
+            s.sink = Some((link, sink.clone()));
+        }
+        Self::after_change(&mut s);
+        self.update_ascii(&s);
+        drop(s);
+        self.changed.notify_one();
+        replies
+    }
+
+    /// A 138 event (9-byte form) as the CAN frame of the module it is from.
+    pub(crate) fn event_as_can(&self, event: &[u8; FRAME_LEN]) -> Option<tmclsim_firmware::can::CanFrame> {
+        let s = self.lock();
+        s.nodes.iter().find(|n| n.module.answers_to(event[1])).map(|n| n.module.event_as_can(event))
+    }
+
     /// The clock task's next wake-up: what is due, remembered so that
     /// frames know whether to wake it earlier.
     pub(crate) fn schedule(&self) -> Option<u64> {
