@@ -260,3 +260,26 @@ fn encoder_prescaler_and_deviation_stop() {
     let deviation = (send(&mut m, "GAP 1, 0") - send(&mut m, "GAP 209, 0")).abs();
     assert!(deviation > 250 && deviation < 1000, "stopped just past the limit: {deviation}");
 }
+
+#[test]
+fn ascii_examples_of_the_manual() {
+    let mut m = module();
+    send(&mut m, "#139 0 0 0");
+    let mut text = |line: &str| {
+        let mut out = Vec::new();
+        for b in line.bytes() {
+            m.ascii_byte(b, &mut out);
+        }
+        String::from_utf8(out).unwrap()
+    };
+    // Manual 3.4.2's command lines and 3.4.3's reply.
+    assert!(text("AMVP ABS, 1, 50000\r").ends_with("BA 100 50000\r"));
+    assert!(text("A MVP ABS, 1, 50000\r").ends_with("BA 100 50000\r"));
+    assert!(text("AROL 2, 500\r").ends_with("BA 100 500\r"));
+    assert!(text("A MST 1\r").ends_with("BA 100 0\r"));
+    assert!(text("ASAP 1, 1, -5000\r").ends_with("BA 100 -5000\r"));
+    assert_eq!(text("AGAP 1, 1\r"), "AGAP 1, 1\rBA 100 -5000\r");
+    assert!(text("ASAC 0, 1, 7\r").ends_with("BA 100 0\r"), "SAC is permitted in ASCII mode on the 351");
+    assert!(text("ABIN\r").ends_with("BA 100 0\r"));
+    assert!(!m.ascii_mode());
+}

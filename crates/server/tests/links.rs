@@ -204,3 +204,20 @@ fn ascii_session_on_the_pty_in_every_echo_mode() {
     server.stop();
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn wire_timing_follows_the_baud_rate() {
+    let config = ServerConfig { tcp: Some("127.0.0.1:0".parse().unwrap()), wire_timing: true, ..ServerConfig::default() };
+    let server = start(Module::built_in("tmcm-1141").unwrap(), config).unwrap();
+    let mut s = connect(&server);
+    // GP 65 = 0: 9600 baud; 18 bytes of 10 bits take 18.75 ms.
+    let t = Instant::now();
+    ask(&mut s, "GAP 4, 0");
+    assert!(t.elapsed() >= Duration::from_micros(18_750), "{:?}", t.elapsed());
+    ask(&mut s, "SGP 65, 0, 8"); // 230400 baud: 0.8 ms
+    let t = Instant::now();
+    ask(&mut s, "GAP 4, 0");
+    let e = t.elapsed();
+    assert!(e >= Duration::from_micros(780) && e < Duration::from_millis(15), "{e:?}");
+    server.stop();
+}
