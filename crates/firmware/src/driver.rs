@@ -82,8 +82,10 @@ impl Module {
                     crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
                     _ => axis.motion.x != axis.motion.target,
                 };
-            will_move
-                && (!self.world.axes[m].loads.is_empty()
+            let closed_loop = self.has_closed_loop() && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6);
+            closed_loop
+                || will_move
+                    && (!self.world.axes[m].loads.is_empty()
                     || (has(ap::STOP_ON_STALL) && p[ap::STOP_ON_STALL as usize] > 0)
                     || (has(ap::STALL_THRESHOLD) && p[ap::STALL_THRESHOLD as usize] > 0)
                     || (has(ap::SMART_ENERGY_HYSTERESIS_START) && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
@@ -205,8 +207,12 @@ impl Module {
             }
         }
         // The carriage follows the motor unless it cannot.
-        let sign = self.shaft_sign();
         let slips = moved != 0.0 && (margin < 0.0 || self.driver_off(m));
+        if self.has_closed_loop() {
+            self.closed_loop_step(m, moved, dt, slips);
+            return;
+        }
+        let sign = self.shaft_sign();
         let axis = &mut self.axes[m];
         if slips {
             axis.mech_offset -= moved * sign;

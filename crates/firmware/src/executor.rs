@@ -417,6 +417,7 @@ impl Module {
         let axis = &mut self.axes[m];
         axis.rfs = None;
         axis.ramp_override = None;
+        axis.closed_loop.torque_mode = false;
         axis.params[ap::TARGET_SPEED as usize] = velocity * sign;
         axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
         axis.motion.mode = RampMode::Velocity;
@@ -429,6 +430,7 @@ impl Module {
         let axis = &mut self.axes[m];
         axis.rfs = None;
         axis.ramp_override = None;
+        axis.closed_loop.torque_mode = false;
         axis.params[ap::TARGET_SPEED as usize] = 0;
         axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
         axis.motion.mode = RampMode::Velocity;
@@ -452,6 +454,7 @@ impl Module {
         let axis = &mut self.axes[m];
         axis.rfs = None;
         axis.ramp_override = None;
+        axis.closed_loop.torque_mode = false;
         // MVP selects position mode; soft mode, once chosen, stays.
         if axis.motion.mode != RampMode::Soft {
             axis.motion.mode = RampMode::Position;
@@ -695,15 +698,34 @@ impl Module {
                 axis.motion.x = value as f64;
                 axis.mech_offset = mech - axis.motion.x * sign;
                 self.set_target(m, target);
+                self.closed_loop_sync(m);
             }
             ap::RAMP_MODE => {
                 let axis = &mut self.axes[m];
                 axis.params[param as usize] = value;
                 axis.motion.mode = RampMode::from_code(value);
             }
+            ap::ENCODER_POSITION if self.has_closed_loop() => {
+                let now = self.closed_loop_encoder(m) as f64 - self.axes[m].closed_loop.encoder_offset;
+                self.axes[m].closed_loop.encoder_offset = value as f64 - now;
+            }
             ap::ENCODER_POSITION => {
                 let now = self.encoder_position(m) as i64 - self.axes[m].encoder_offset;
                 self.axes[m].encoder_offset = value as i64 - now;
+            }
+            crate::closed_loop::cl::TORQUE_TARGET if self.has_closed_loop() => {
+                // Torque mode: the driver sets this current (mA).
+                let axis = &mut self.axes[m];
+                axis.params[param as usize] = value;
+                axis.closed_loop.torque_mode = true;
+                axis.rfs = None;
+                axis.ramp_override = None;
+                axis.motion.mode = RampMode::Velocity;
+                axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
+            }
+            crate::closed_loop::cl::MODE if self.has_closed_loop() => {
+                self.axes[m].params[param as usize] = value;
+                self.closed_loop_sync(m);
             }
             _ => self.axes[m].params[param as usize] = value,
         }
@@ -711,6 +733,9 @@ impl Module {
 
     /// Reads a parameter, computing the measured ones.
     pub(crate) fn read_axis_parameter(&mut self, m: usize, param: u8) -> i32 {
+        if let Some(v) = self.read_closed_loop(m, param) {
+            return v;
+        }
         let pd = self.axes[m].params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let rd = self.axes[m].params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
         let motion = &self.axes[m].motion;

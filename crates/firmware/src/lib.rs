@@ -6,6 +6,7 @@
 
 pub mod ascii;
 pub mod can;
+pub mod closed_loop;
 pub mod driver;
 pub mod eeprom;
 pub mod executor;

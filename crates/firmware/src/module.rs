@@ -116,6 +116,7 @@ pub struct Axis {
     pub ramp_override: Option<motion::Ramp>,
     /// AP 209 minus what the encoder measures (set by SAP 209).
     pub encoder_offset: i64,
+    pub closed_loop: crate::closed_loop::ClosedLoop,
 }
 
 /// Result of the last comparison (or of an accumulator load against 0).
@@ -433,6 +434,7 @@ impl Module {
                 driver: Driver::default(),
                 ramp_override: None,
                 encoder_offset: 0,
+                closed_loop: Default::default(),
             });
         }
         self.restored_from_eeprom = restored;
@@ -467,6 +469,9 @@ impl Module {
             let (l, r, _) = self.switches(m);
             (l, r)
         }).collect();
+        for m in 0..self.axes.len() {
+            self.closed_loop_power_on(m);
+        }
         self.ascii = self.globals[0][gp::ASCII_MODE as usize] & 1 == 1;
         self.ascii_line = Default::default();
         if self.globals[0][gp::AUTOSTART as usize] == 1 && self.program.length() > 0 {
@@ -741,6 +746,13 @@ impl Module {
                 break;
             }
         }
+        // Time the motion did not use (standing still): the driver and the
+        // closed loop still act.
+        let rest = dt_ns as f64 * 1e-9 - elapsed;
+        if rest > 1e-12 {
+            let x = self.axes[motor].motion.x;
+            self.drive(motor, x, rest);
+        }
         let moving = self.axes[motor].motion.v != 0.0;
         let axis = &mut self.axes[motor];
         if moving {
@@ -813,6 +825,9 @@ impl Module {
         let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
         let mut vmax = p[ap::MAX_SPEED as usize].clamp(0, 2047) as f64;
         let mut target_velocity = p[ap::TARGET_SPEED as usize] as f64;
+        if self.axes[motor].closed_loop.torque_mode {
+            target_velocity = self.torque_mode_velocity(motor);
+        }
         if let Some(rfs) = &self.axes[motor].rfs {
             let slow = p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047) as f64;
             match rfs.current() {

@@ -189,6 +189,7 @@ pub struct Profile {
 pub const BUILT_IN: &[(&str, &str)] = &[
     ("tmcm-1141", include_str!("../../../profiles/tmcm-1141.toml")),
     ("tmcm-351", include_str!("../../../profiles/tmcm-351.toml")),
+    ("tmcm-1310", include_str!("../../../profiles/tmcm-1310.toml")),
 ];
 
 impl Profile {

@@ -37,6 +37,8 @@ pub struct AxisWorld {
     pub encoder_counts: Option<f64>,
     /// Full steps of the motor per revolution.
     pub fullsteps_per_rev: f64,
+    /// The encoder's signal is lost (the count stands still).
+    pub encoder_lost: bool,
 }
 
 /// A load on an axis: a torque demand in % of what the motor gives at

@@ -1,0 +1,315 @@
+//! Closed-loop operation (TMCM-1310): the ramp generator drives a virtual
+//! position, the encoder measures the rotor, and the controller scales the
+//! current to the load and corrects the position error instead of losing
+//! steps. In open loop the rotor loses steps under overload as on the
+//! TMCM-1141. Position, velocity and torque mode. (docs/closed-loop.md)
+//!
+//! The model, in the units of the module (TMC429 velocity units, µsteps):
+//! - Rotor = virtual position − lag. In closed loop the current scale
+//!   (AP 123, %) is what the load needs plus a reserve, between AP 113 and
+//!   AP 114 (or AP 114 when regulation is off, AP 122 = 0); the lag grows
+//!   while the load exceeds the torque at that scale and shrinks at the
+//!   correction velocity (AP 126) when it does not. In open loop the
+//!   current is AP 6 and lost steps stay lost.
+//! - AP 1 is the rotor position measured by the encoder; AP 233 the
+//!   virtual position; AP 237 their difference. A difference above AP 125
+//!   raises interrupt 21 (deviation) and sets the EDV flag.
+//! - Encoder (AP 201: 0 incremental ABN, counting from power-up; 1 absolute
+//!   SSI): AP 210 counts per revolution of an AP 202 full-step motor. A
+//!   lost encoder signal freezes the count.
+//! - Torque mode (SAP 14, mA): the driver sets that current; the motor runs
+//!   at the speed where its torque equals the load.
+
+use crate::module::{ap, error_flag, Module};
+use crate::motion::{self, RampMode};
+use crate::program::Source;
+
+/// The module's current for 100 % (TMCM-1310: 3 A RMS).
+pub const FULL_SCALE_MA: f64 = 3000.0;
+/// Current scale reserve above what the load needs (%).
+pub const RESERVE_PERCENT: f64 = 20.0;
+
+pub mod cl {
+    pub const TORQUE_TARGET: u8 = 14;
+    pub const MAX_POSSIBLE_CURRENT: u8 = 15;
+    pub const VELOCITY_REACHED: u8 = 16;
+    pub const VELOCITY_WINDOW: u8 = 17;
+    pub const STATUS_WORD: u8 = 18;
+    pub const TORQUE_ACTUAL: u8 = 19;
+    pub const SCALE_MIN: u8 = 113;
+    pub const SCALE_MAX: u8 = 114;
+    pub const SCALE_ENABLE: u8 = 122;
+    pub const SCALE_ACTUAL: u8 = 123;
+    pub const MAX_FOLLOWING_ERROR: u8 = 125;
+    pub const MAX_CORRECTION_VELOCITY: u8 = 126;
+    pub const MODE: u8 = 129;
+    pub const MEASURED_VELOCITY: u8 = 131;
+    pub const INIT_FLAG: u8 = 133;
+    pub const POSITION_WINDOW: u8 = 134;
+    pub const ENCODER_MODE: u8 = 201;
+    pub const FULLSTEPS: u8 = 202;
+    pub const ENCODER_RESOLUTION: u8 = 210;
+    pub const GAMMA: u8 = 230;
+    pub const VIRTUAL_POSITION: u8 = 233;
+    pub const TARGET_SCALE: u8 = 236;
+    pub const POSITION_ERROR: u8 = 237;
+}
+
+/// Per-axis closed-loop state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClosedLoop {
+    /// Mechanical offset at which rotor and virtual position agree.
+    pub sync_offset: f64,
+    /// Current scale in effect, %.
+    pub scale: f64,
+    /// Torque mode is selected (SAP 14).
+    pub torque_mode: bool,
+    /// Encoder count at power-up (incremental encoders count from there).
+    pub encoder_zero: f64,
+    /// Last count the encoder delivered (frozen while its signal is lost).
+    pub encoder_last: f64,
+    /// Added by SAP 209.
+    pub encoder_offset: f64,
+    /// A deviation was reported and has not gone away yet.
+    pub deviation_reported: bool,
+    /// The rotor's velocity in µsteps/s over the last step.
+    pub rotor_velocity: f64,
+}
+
+impl Module {
+    /// The module has closed-loop parameters.
+    pub(crate) fn has_closed_loop(&self) -> bool {
+        self.profile.axis_parameter(cl::MODE).is_some()
+    }
+
+    pub(crate) fn closed_loop_on(&self, m: usize) -> bool {
+        self.has_closed_loop() && self.axes[m].params[cl::MODE as usize] == 1
+    }
+
+    /// Virtual position minus rotor position, µsteps.
+    pub(crate) fn lag(&self, m: usize) -> f64 {
+        let axis = &self.axes[m];
+        (axis.closed_loop.sync_offset - axis.mech_offset) * self.shaft_sign()
+    }
+
+    /// Encoder counts of the rotor (raw, before SAP 209's offset).
+    fn encoder_counts(&self, m: usize) -> f64 {
+        let p = &self.axes[m].params;
+        let per_rev = p[cl::FULLSTEPS as usize].max(1) as f64 * self.microsteps(m);
+        self.mechanical_position(m) / per_rev * p[cl::ENCODER_RESOLUTION as usize].max(1) as f64
+    }
+
+    /// What the encoder delivers now: the rotor's count, or the last one
+    /// while its signal is lost.
+    fn encoder_now(&self, m: usize) -> f64 {
+        if self.world.axes[m].encoder_lost { self.axes[m].closed_loop.encoder_last } else { self.encoder_counts(m) }
+    }
+
+    /// AP 209 of a closed-loop module.
+    pub(crate) fn closed_loop_encoder(&self, m: usize) -> i32 {
+        let c = &self.axes[m].closed_loop;
+        let absolute = self.axes[m].params[cl::ENCODER_MODE as usize] == 1;
+        let now = self.encoder_now(m);
+        let counts = if absolute { now } else { now - c.encoder_zero };
+        (counts + c.encoder_offset).round() as i32
+    }
+
+    /// The rotor position the encoder reports, in µsteps of the counter.
+    pub(crate) fn measured_position(&self, m: usize) -> f64 {
+        let p = &self.axes[m].params;
+        let per_rev = p[cl::FULLSTEPS as usize].max(1) as f64 * self.microsteps(m);
+        let counts = self.encoder_now(m);
+        // The counter and the rotor agreed at `sync_offset`.
+        let sign = self.shaft_sign();
+        let mech = counts / p[cl::ENCODER_RESOLUTION as usize].max(1) as f64 * per_rev;
+        (mech - self.axes[m].closed_loop.sync_offset) * sign
+    }
+
+    /// Sets the encoder at power-up and when the counter is set.
+    pub(crate) fn closed_loop_sync(&mut self, m: usize) {
+        if !self.has_closed_loop() {
+            return;
+        }
+        let counts = self.encoder_counts(m);
+        let axis = &mut self.axes[m];
+        axis.closed_loop.sync_offset = axis.mech_offset;
+        axis.closed_loop.encoder_last = counts;
+    }
+
+    pub(crate) fn closed_loop_power_on(&mut self, m: usize) {
+        if !self.has_closed_loop() {
+            return;
+        }
+        self.closed_loop_sync(m);
+        let counts = self.axes[m].closed_loop.encoder_last;
+        self.axes[m].closed_loop.encoder_zero = counts;
+    }
+
+    /// Torque available at a current scale (% of rated torque).
+    fn torque_at(&self, m: usize, scale_percent: f64) -> f64 {
+        let fullsteps = self.axes[m].motion.v.abs() / self.microsteps(m);
+        if self.driver_off(m) {
+            return 0.0;
+        }
+        scale_percent * (1.0 - fullsteps / crate::driver::CORNER_FULLSTEPS).max(0.0)
+    }
+
+    /// After a step of `dt` seconds in which the virtual position moved by
+    /// `moved`: current regulation, lag, correction, encoder, deviation.
+    /// `open_loop_slips`: in open loop, the driver model says the rotor
+    /// could not follow.
+    pub(crate) fn closed_loop_step(&mut self, m: usize, moved: f64, dt: f64, open_loop_slips: bool) {
+        let p = self.axes[m].params;
+        let load = self.world.axes[m].load_at(self.mechanical_position(m), self.now_ns as f64 * 1e-9);
+        let sign = self.shaft_sign();
+        let before = self.mechanical_position(m) - moved * sign;
+        if self.closed_loop_on(m) {
+            let (lo, hi) = (p[cl::SCALE_MIN as usize].clamp(0, 100) as f64, p[cl::SCALE_MAX as usize].clamp(0, 100) as f64);
+            let speed_factor = (1.0 - self.axes[m].motion.v.abs() / self.microsteps(m) / crate::driver::CORNER_FULLSTEPS).max(0.01);
+            let needed = load / speed_factor + RESERVE_PERCENT;
+            let scale = if self.axes[m].closed_loop.torque_mode {
+                (p[cl::TORQUE_TARGET as usize] as f64).abs() / FULL_SCALE_MA * 100.0
+            } else if p[cl::SCALE_ENABLE as usize] == 1 {
+                needed.clamp(lo.min(hi), hi)
+            } else {
+                hi
+            };
+            self.axes[m].closed_loop.scale = scale;
+            let torque = self.torque_at(m, scale);
+            let axis = &mut self.axes[m];
+            if moved != 0.0 && load > torque {
+                // The rotor stalls; the controller keeps the error.
+                axis.mech_offset -= moved * sign;
+            } else {
+                // Correct the error at up to the correction velocity.
+                let lag = (axis.closed_loop.sync_offset - axis.mech_offset) * sign;
+                let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+                let v_corr = motion::velocity_pps(p[cl::MAX_CORRECTION_VELOCITY as usize].clamp(0, 2047) as f64, pd);
+                let step = (v_corr * dt).min(lag.abs());
+                if load <= torque {
+                    axis.mech_offset += step * lag.signum() * sign;
+                }
+            }
+        } else {
+            // Open loop: lost steps stay lost.
+            self.axes[m].closed_loop.scale = (self.motor_current(m) as f64 / 255.0 * 100.0).round();
+            let axis = &mut self.axes[m];
+            if open_loop_slips {
+                axis.mech_offset -= moved * sign;
+            }
+            axis.closed_loop.sync_offset = axis.mech_offset;
+        }
+        if let Some((lo, hi)) = self.world.axes[m].travel {
+            let axis = &mut self.axes[m];
+            let mech = axis.motion.x * sign + axis.mech_offset;
+            axis.mech_offset += mech.clamp(lo, hi) - mech;
+        }
+        if dt > 0.0 {
+            self.axes[m].closed_loop.rotor_velocity = (self.mechanical_position(m) - before) * sign / dt;
+        }
+        // The encoder counts the rotor, unless its signal is lost.
+        if !self.world.axes[m].encoder_lost {
+            self.axes[m].closed_loop.encoder_last = self.encoder_counts(m);
+        }
+        // Deviation: measured rotor against the virtual position.
+        let limit = p[cl::MAX_FOLLOWING_ERROR as usize];
+        let error = (self.axes[m].motion.x - self.measured_position(m)).abs();
+        if limit > 0 && error > limit as f64 {
+            if !self.axes[m].closed_loop.deviation_reported {
+                self.axes[m].closed_loop.deviation_reported = true;
+                self.registers.errors |= error_flag::DEVIATION;
+                self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] |= 2;
+                self.raise(Source::Deviation(m as u8));
+            }
+        } else {
+            self.axes[m].closed_loop.deviation_reported = false;
+        }
+        if self.world.axes[m].encoder_lost {
+            self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] |= 4;
+        }
+    }
+
+    /// The velocity (internal units) at which the motor's torque at the
+    /// torque-mode current equals the load.
+    pub(crate) fn torque_mode_velocity(&self, m: usize) -> f64 {
+        let p = &self.axes[m].params;
+        let target = p[cl::TORQUE_TARGET as usize] as f64;
+        let percent = (target.abs() / FULL_SCALE_MA * 100.0).min(100.0);
+        let load = self.world.axes[m].load_at(self.mechanical_position(m), self.now_ns as f64 * 1e-9);
+        if self.driver_off(m) || percent <= load {
+            return 0.0;
+        }
+        let fullsteps = crate::driver::CORNER_FULLSTEPS * (1.0 - load / percent);
+        let pps = fullsteps * self.microsteps(m);
+        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        (motion::velocity_internal(pps, pd).min(2047.0)) * target.signum()
+    }
+
+    /// Reads of the closed-loop parameters; `None` for the others.
+    pub(crate) fn read_closed_loop(&self, m: usize, param: u8) -> Option<i32> {
+        if !self.has_closed_loop() {
+            return None;
+        }
+        let axis = &self.axes[m];
+        let p = &axis.params;
+        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        let torque_ma = if axis.closed_loop.torque_mode { (p[cl::TORQUE_TARGET as usize] as f64).clamp(-FULL_SCALE_MA, FULL_SCALE_MA) } else { axis.closed_loop.scale / 100.0 * FULL_SCALE_MA };
+        Some(match param {
+            ap::ACTUAL_POSITION => self.measured_position(m).round() as i32,
+            ap::POSITION_REACHED => self.closed_loop_target_reached(m) as i32,
+            cl::MAX_POSSIBLE_CURRENT => FULL_SCALE_MA as i32,
+            cl::VELOCITY_REACHED => self.velocity_reached(m) as i32,
+            cl::STATUS_WORD => self.status_word(m),
+            cl::TORQUE_ACTUAL => torque_ma.round() as i32,
+            cl::SCALE_ACTUAL | cl::TARGET_SCALE => if axis.closed_loop.torque_mode { (torque_ma.abs() / FULL_SCALE_MA * 100.0).round() as i32 } else { axis.closed_loop.scale.round() as i32 },
+            cl::MEASURED_VELOCITY => motion::velocity_internal(axis.closed_loop.rotor_velocity, pd).round() as i32,
+            cl::INIT_FLAG => self.closed_loop_on(m) as i32,
+            ap::ENCODER_POSITION => self.closed_loop_encoder(m),
+            cl::GAMMA => {
+                let load = self.world.axes[m].load_at(self.mechanical_position(m), self.now_ns as f64 * 1e-9);
+                let torque = self.torque_at(m, axis.closed_loop.scale.max(1.0));
+                (256.0 * (load / torque.max(1e-9)).min(1.0)).round() as i32
+            }
+            cl::VIRTUAL_POSITION => self.wrap_position(axis.motion.position()),
+            cl::POSITION_ERROR => (axis.motion.x - self.measured_position(m)).round() as i32,
+            _ => return None,
+        })
+    }
+
+    fn closed_loop_target_reached(&self, m: usize) -> bool {
+        let axis = &self.axes[m];
+        let window = axis.params[cl::POSITION_WINDOW as usize].max(0) as f64;
+        if !self.closed_loop_on(m) {
+            return self.actual_position(m) == axis.target_word;
+        }
+        axis.motion.mode != RampMode::Velocity && axis.motion.v == 0.0 && (axis.target_word as f64 - self.measured_position(m)).abs() <= window.max(0.5)
+    }
+
+    fn velocity_reached(&self, m: usize) -> bool {
+        let axis = &self.axes[m];
+        let window = axis.params[cl::VELOCITY_WINDOW as usize].max(0);
+        (self.actual_speed(m) - axis.params[ap::TARGET_SPEED as usize]).abs() <= window
+    }
+
+    /// AP 18 (bits per tmcm-1310.md).
+    pub(crate) fn status_word(&self, m: usize) -> i32 {
+        let axis = &self.axes[m];
+        let (l, r, h) = self.switches(m);
+        let velocity = axis.motion.mode == RampMode::Velocity && !axis.closed_loop.torque_mode;
+        let bits = [
+            self.closed_loop_target_reached(m),
+            self.velocity_reached(m),
+            self.closed_loop_on(m),
+            axis.motion.mode != RampMode::Velocity,
+            velocity,
+            axis.closed_loop.torque_mode,
+            h,
+            l,
+            r,
+            self.world.supply_decivolts < crate::driver::UNDERVOLTAGE_DV,
+            self.world.supply_decivolts > 550,
+            self.world.temperature >= crate::driver::SHUTDOWN_C,
+        ];
+        bits.iter().enumerate().fold(0, |w, (i, b)| w | (*b as i32) << i)
+    }
+}
