@@ -1,0 +1,33 @@
+"""PyTrinamic drives a closed-loop move on a virtual TMCM-1310 over the pty
+(its TMCM-1311 class is the closest host class; raw commands where the
+classes differ)."""
+
+import time
+
+from pytrinamic.connections import ConnectionManager
+from pytrinamic.modules import TMCM1311
+
+
+def test_closed_loop_move_over_the_pty(serve):
+    served = serve("--module", "tmcm-1310", "--world", "free")
+    args = f"--interface serial_tmcl --port {served.pty_link} --data-rate 115200"
+    with ConnectionManager(args.split()).connect() as interface:
+        assert interface.get_version_string() == "1310V114"
+        module = TMCM1311(interface)
+        motor = module.motors[0]
+        motor.set_axis_parameter(motor.AP.ClosedLoopMode, 1)
+        motor.set_axis_parameter(motor.AP.CLCurrentScaleMaximum, 100)
+        motor.set_axis_parameter(4, 2047)  # maximum positioning speed (TMC429 units)
+        served.world("load 0 60")
+        interface.move_to(0, 51200)
+        deadline = time.monotonic() + 10
+        while not interface.get_axis_parameter(8, 0):
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        assert motor.get_axis_parameter(motor.AP.ActualPosition, signed=True) == 51200
+        assert motor.get_axis_parameter(motor.AP.CLPositionError, signed=True) == 0
+        status = motor.get_axis_parameter(motor.AP.StatusWord)
+        assert status & 0b101 == 0b101  # target reached, closed loop active
+        assert motor.get_axis_parameter(motor.AP.CLVirtualActualPosition, signed=True) == 51200
+        scale = motor.get_axis_parameter(motor.AP.CLActualCurrentScaleFactor)
+        assert scale >= 60, "the current follows the load"
