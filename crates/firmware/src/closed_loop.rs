@@ -108,7 +108,7 @@ impl Module {
     /// AP 209 of a closed-loop module.
     pub(crate) fn closed_loop_encoder(&self, m: usize) -> i32 {
         let c = &self.axes[m].closed_loop;
-        let absolute = self.axes[m].params[cl::ENCODER_MODE as usize] == 1;
+        let absolute = self.axes[m].params[cl::ENCODER_MODE as usize] & 1 == 1;
         let now = self.encoder_now(m);
         let counts = if absolute { now } else { now - c.encoder_zero };
         (counts + c.encoder_offset).round() as i32
@@ -207,9 +207,21 @@ impl Module {
         if dt > 0.0 {
             self.axes[m].closed_loop.rotor_velocity = (self.mechanical_position(m) - before) * sign / dt;
         }
-        // The encoder counts the rotor, unless its signal is lost.
+        // The encoder counts the rotor, unless its signal is lost. Its index
+        // (N) pulse comes once per revolution; with AP 201 bit 2 the next
+        // one clears the count.
         if !self.world.axes[m].encoder_lost {
-            self.axes[m].closed_loop.encoder_last = self.encoder_counts(m);
+            let last = self.axes[m].closed_loop.encoder_last;
+            let now = self.encoder_counts(m);
+            let per_rev = p[cl::ENCODER_RESOLUTION as usize].max(1) as f64;
+            let (a, b) = ((last / per_rev).floor(), (now / per_rev).floor());
+            let index = if now >= last { (a < b).then_some(b * per_rev) } else { (b < a).then_some(a * per_rev) };
+            if let (Some(at), true) = (index, p[cl::ENCODER_MODE as usize] & 0b101 == 0b100) {
+                let c = &mut self.axes[m].closed_loop;
+                c.encoder_offset = c.encoder_zero - at;
+                self.axes[m].params[cl::ENCODER_MODE as usize] &= !4;
+            }
+            self.axes[m].closed_loop.encoder_last = now;
         }
         // Deviation: measured rotor against the virtual position.
         let limit = p[cl::MAX_FOLLOWING_ERROR as usize];

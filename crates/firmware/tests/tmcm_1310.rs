@@ -160,6 +160,14 @@ fn incremental_and_absolute_encoders() {
     assert_eq!(send(&mut m, "GAP 209, 0"), 2000, "half a turn");
     send(&mut m, "SAP 209, 0, 0");
     assert_eq!(send(&mut m, "GAP 209, 0"), 0);
+    // Index (N) channel: clear the count at the next index pulse. The
+    // rotor stands at 1.5 turns; the index is at 2 turns.
+    send(&mut m, "SAP 209, 0, 777");
+    send(&mut m, "SAP 201, 0, 4");
+    send(&mut m, "MVP REL, 0, 38400"); // to 2.25 turns
+    m.advance(5000 * MS);
+    assert_eq!(send(&mut m, "GAP 209, 0"), 1000, "a quarter turn past the index");
+    assert_eq!(send(&mut m, "GAP 201, 0"), 0, "the clear-at-index bit cleared itself");
 }
 
 #[test]
