@@ -1,24 +1,15 @@
 """Fixtures: a `tmclsim serve` process on loopback TCP and a pty."""
 
-import os
 import pathlib
 import re
 import subprocess
+import sys
 import time
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-
-
-def tmclsim_binary():
-    path = os.environ.get("TMCLSIM_BIN")
-    if path:
-        return path
-    built = ROOT / "target" / "release" / "tmclsim"
-    if not built.exists():
-        subprocess.run(["cargo", "build", "--release", "-p", "tmclsim"], cwd=ROOT, check=True)
-    return str(built)
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
+from tmclsim_binary import ROOT, tmclsim_binary  # noqa: E402,F401
 
 
 class Served:

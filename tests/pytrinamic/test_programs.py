@@ -9,7 +9,7 @@ import time
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1141
 
-from conftest import ROOT, tmclsim_binary
+from tmclsim_binary import tmclsim_binary
 
 PROGRAM = """
 // Count to 100 in user variable 7, then blink OUT0 every 100 ms.

@@ -96,6 +96,14 @@ pub struct ServeArgs {
     /// `slcan`, PyTrinamic's `slcan_tmcl`).
     #[arg(long, value_name = "PATH")]
     pub slcan: Option<PathBuf>,
+    /// Serve TMCM-1310 modules as EtherCAT slaves on this network
+    /// interface (raw Ethernet, EtherType 0x88A4; needs root). With
+    /// --slaves N, N slaves form one segment.
+    #[arg(long, value_name = "IFACE")]
+    pub ethercat: Option<String>,
+    /// Number of slaves in the EtherCAT segment.
+    #[arg(long, value_name = "N", default_value_t = 1, requires = "ethercat")]
+    pub slaves: usize,
     /// Deliver bytes at each module's baud rate (GP 65), so that host
     /// timeouts behave as on a real RS485 bus.
     #[arg(long)]

@@ -24,6 +24,9 @@ fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {
 }
 
 pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
+    if let Some(iface) = &args.ethercat {
+        return ethercat(iface, &args);
+    }
     if let Some(spec) = &args.bus {
         let modules = bus(spec, &args.world)?;
         return serve(args_links(&args), modules, None, "factory defaults for every module of the bus".into(), &args);
@@ -60,6 +63,33 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
         }
     }
     serve((tcp, pty), vec![module], args.eeprom.clone(), eeprom_note, &args)
+}
+
+/// EtherCAT: TMCM-1310 slaves on a network interface.
+fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
+    let profile = Profile::built_in(&args.module)?;
+    if profile.module.name != "TMCM-1310" {
+        return Err(format!("EtherCAT is the TMCM-1310's; {} has none", profile.module.name));
+    }
+    if args.slaves == 0 || args.slaves > 256 {
+        return Err("--slaves takes 1…256".into());
+    }
+    let slaves = (0..args.slaves)
+        .map(|i| {
+            let world = crate::load_world(&args.world, 1)?;
+            let m = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), world);
+            Ok(tmclsim_ethercat::Slave::new(m, 1 + i as u32))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let handle = tmclsim_server::ethercat::serve(iface, tmclsim_ethercat::Segment::new(slaves)).map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
+    println!("tmclsim: {} virtual TMCM-1310 EtherCAT slave(s) on {iface}", args.slaves);
+    println!("connect with: an EtherCAT master on {iface}'s peer, e.g. pysoem: master.open(\"<peer interface>\")");
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    wait_for_signal();
+    println!("tmclsim: stopping");
+    handle.stop();
+    Ok(ExitCode::SUCCESS)
 }
 
 /// The serial address, and on modules with their own CAN identifier

@@ -267,7 +267,7 @@ impl Module {
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let torque_ma = if axis.closed_loop.torque_mode { (p[cl::TORQUE_TARGET as usize] as f64).clamp(-FULL_SCALE_MA, FULL_SCALE_MA) } else { axis.closed_loop.scale / 100.0 * FULL_SCALE_MA };
         Some(match param {
-            ap::ACTUAL_POSITION => self.measured_position(m).round() as i32,
+            ap::ACTUAL_POSITION if self.closed_loop_on(m) => self.measured_position(m).round() as i32,
             ap::POSITION_REACHED => self.closed_loop_target_reached(m) as i32,
             cl::MAX_POSSIBLE_CURRENT => FULL_SCALE_MA as i32,
             cl::VELOCITY_REACHED => self.velocity_reached(m) as i32,

@@ -9,6 +9,7 @@
 
 mod clock;
 pub mod control;
+pub mod ethercat;
 mod faults;
 mod link;
 mod pty;

@@ -1,0 +1,128 @@
+//! EtherCAT on a real Linux network interface: raw Ethernet frames of
+//! EtherType 0x88A4 go through the slaves of a segment and back out of
+//! the same interface, as from the last slave of a line.
+
+use std::io;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use tmclsim_ethercat::Segment;
+
+const ETH_P_ALL: u16 = 0x0003;
+const PACKET_OUTGOING: u8 = 4;
+
+/// A segment served on an interface; dropping it stops it.
+pub struct EthercatHandle {
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+    pub segment: Arc<Mutex<Segment>>,
+    /// Frames processed and frames ignored (not EtherCAT or malformed).
+    pub counters: Arc<Mutex<(u64, u64)>>,
+}
+
+impl EthercatHandle {
+    pub fn stop(mut self) {
+        self.shutdown();
+    }
+
+    fn shutdown(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+
+    pub fn wait(mut self) {
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Drop for EthercatHandle {
+    fn drop(&mut self) {
+        self.shutdown();
+    }
+}
+
+fn check(r: libc::c_int) -> io::Result<libc::c_int> {
+    if r < 0 { Err(io::Error::last_os_error()) } else { Ok(r) }
+}
+
+/// Opens a raw packet socket on `iface`.
+fn open(iface: &str) -> io::Result<(libc::c_int, libc::c_int)> {
+    let name = std::ffi::CString::new(iface).map_err(io::Error::other)?;
+    // SAFETY: libc calls with valid arguments; the descriptor is owned by
+    // the serving thread and closed by it.
+    unsafe {
+        let index = libc::if_nametoindex(name.as_ptr());
+        if index == 0 {
+            return Err(io::Error::new(io::ErrorKind::NotFound, format!("no network interface '{iface}'")));
+        }
+        let fd = check(libc::socket(libc::AF_PACKET, libc::SOCK_RAW, (ETH_P_ALL).to_be() as i32))?;
+        let mut sll: libc::sockaddr_ll = std::mem::zeroed();
+        sll.sll_family = libc::AF_PACKET as u16;
+        sll.sll_protocol = ETH_P_ALL.to_be();
+        sll.sll_ifindex = index as i32;
+        if libc::bind(fd, &sll as *const _ as *const libc::sockaddr, std::mem::size_of::<libc::sockaddr_ll>() as u32) < 0 {
+            let e = io::Error::last_os_error();
+            libc::close(fd);
+            return Err(e);
+        }
+        let tv = libc::timeval { tv_sec: 0, tv_usec: 100_000 };
+        libc::setsockopt(fd, libc::SOL_SOCKET, libc::SO_RCVTIMEO, &tv as *const _ as *const libc::c_void, std::mem::size_of::<libc::timeval>() as u32);
+        Ok((fd, index as i32))
+    }
+}
+
+/// Serves `segment` on `iface` in a background thread.
+pub fn serve(iface: &str, segment: Segment) -> io::Result<EthercatHandle> {
+    let (fd, index) = open(iface)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let segment = Arc::new(Mutex::new(segment));
+    let counters = Arc::new(Mutex::new((0u64, 0u64)));
+    let (t_stop, t_segment, t_counters) = (stop.clone(), segment.clone(), counters.clone());
+    let thread = std::thread::Builder::new().name("tmclsim-ethercat".into()).spawn(move || {
+        let start = Instant::now();
+        let mut buf = vec![0u8; 2048];
+        while !t_stop.load(Ordering::Relaxed) {
+            // SAFETY: receiving into a buffer we own, with its length.
+            let (n, pkttype) = unsafe {
+                let mut from: libc::sockaddr_ll = std::mem::zeroed();
+                let mut len = std::mem::size_of::<libc::sockaddr_ll>() as u32;
+                let n = libc::recvfrom(fd, buf.as_mut_ptr().cast(), buf.len(), 0, &mut from as *mut _ as *mut libc::sockaddr, &mut len);
+                (n, from.sll_pkttype)
+            };
+            if n <= 0 || pkttype == PACKET_OUTGOING {
+                continue;
+            }
+            let frame = &mut buf[..n as usize];
+            if frame.len() < 14 || u16::from_be_bytes([frame[12], frame[13]]) != tmclsim_ethercat::frame::ETHERTYPE {
+                continue;
+            }
+            let now = start.elapsed().as_nanos() as u64;
+            let processed = t_segment.lock().unwrap_or_else(|p| p.into_inner()).process(frame, now);
+            {
+                let mut c = t_counters.lock().unwrap_or_else(|p| p.into_inner());
+                if processed { c.0 += 1 } else { c.1 += 1 }
+            }
+            if !processed {
+                continue;
+            }
+            // SAFETY: sending a buffer we own to the interface we are bound to.
+            unsafe {
+                let mut to: libc::sockaddr_ll = std::mem::zeroed();
+                to.sll_family = libc::AF_PACKET as u16;
+                to.sll_ifindex = index;
+                to.sll_halen = 6;
+                libc::sendto(fd, frame.as_ptr().cast(), frame.len(), 0, &to as *const _ as *const libc::sockaddr, std::mem::size_of::<libc::sockaddr_ll>() as u32);
+            }
+        }
+        // SAFETY: the thread owns the descriptor.
+        unsafe {
+            libc::close(fd);
+        }
+        let _ = Duration::ZERO;
+    })?;
+    Ok(EthercatHandle { stop, thread: Some(thread), segment, counters })
+}

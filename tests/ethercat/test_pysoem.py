@@ -1,0 +1,158 @@
+"""A real EtherCAT master (pysoem, from the package registry) against the
+virtual TMCM-1310 slave on a veth pair: enumeration and identity, the state
+machine up to OP and its refusals, process data moves, TMCL over the
+mailbox, and frames that are not valid."""
+
+import socket
+import struct
+import time
+
+import pysoem
+import pytest
+
+TMCL = 0x2000
+
+
+def open_master(iface, expect=1):
+    m = pysoem.Master()
+    m.open(iface)
+    assert m.config_init() == expect
+    return m
+
+
+def to_op(m):
+    m.config_map()
+    assert m.state_check(pysoem.SAFEOP_STATE, 50_000) == pysoem.SAFEOP_STATE
+    for s in m.slaves:
+        s.output = struct.pack("<Ii", 0, 0)
+    m.send_processdata()
+    m.receive_processdata(2000)
+    m.state = pysoem.OP_STATE
+    m.write_state()
+    for _ in range(200):
+        m.send_processdata()
+        m.receive_processdata(2000)
+        if m.state_check(pysoem.OP_STATE, 1000) == pysoem.OP_STATE:
+            return
+    pytest.fail("no OP")
+
+
+def cycle_until(m, done, timeout=10.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        m.send_processdata()
+        wkc = m.receive_processdata(2000)
+        assert wkc == m.expected_wkc
+        if done():
+            return
+        time.sleep(0.001)
+    pytest.fail("process data never showed the expected state")
+
+
+def inputs(slave):
+    return struct.unpack("<12i", slave.input)
+
+
+def tmcl(slave, opcode, kind, motor, value, address=1):
+    slave.sdo_write(TMCL, 0, bytes([address, opcode, kind, motor]) + struct.pack(">i", value))
+    reply = slave.sdo_read(TMCL, 0)
+    host, module, status, op = reply[:4]
+    return status, struct.unpack(">i", reply[4:])[0]
+
+
+def test_enumerate_and_identity(ethercat):
+    m = open_master(ethercat())
+    s = m.slaves[0]
+    assert (s.name, s.man, s.id, s.rev) == ("TMCM-1310", 0x286, 1310, 0x0001000E)
+    assert m.read_state() == pysoem.PREOP_STATE
+    assert s.sdo_read(0x1018, 1) == struct.pack("<I", 0x286)
+    m.close()
+
+
+def test_op_and_process_data_moves(ethercat):
+    m = open_master(ethercat())
+    s = m.slaves[0]
+    to_op(m)
+    assert (len(s.output), len(s.input)) == (8, 48)
+    # Position mode: set-point 51200.
+    s.output = struct.pack("<Ii", 1, 51200)
+    cycle_until(m, lambda: inputs(s)[1] == 51200)
+    f = inputs(s)
+    assert f[0] == 51200 and f[2] == 51200, "target and virtual position"
+    assert f[7] & 0b1001 == 0b1001, "status word: target reached, position mode"
+    # Velocity mode: set-point 500 (internal units).
+    s.output = struct.pack("<Ii", 2, 500)
+    cycle_until(m, lambda: inputs(s)[5] == 500)
+    assert inputs(s)[4] == 500
+    assert inputs(s)[7] & 0b10000, "velocity mode bit"
+    s.output = struct.pack("<Ii", 2, 0)
+    cycle_until(m, lambda: inputs(s)[5] == 0)
+    m.close()
+
+
+def test_tmcl_over_the_mailbox(ethercat):
+    m = open_master(ethercat())
+    s = m.slaves[0]
+    assert tmcl(s, 5, 4, 0, 1234) == (100, 1234)  # SAP 4
+    assert tmcl(s, 6, 4, 0, 0) == (100, 1234)  # GAP 4
+    assert tmcl(s, 5, 4, 0, 5000)[0] == 4  # out of range
+    assert tmcl(s, 6, 99, 0, 0)[0] == 3  # no such parameter
+    assert tmcl(s, 200, 0, 0, 0)[0] == 2  # no such command
+    assert tmcl(s, 9, 66, 0, 5)[0] == 8  # SGP 66: password protected
+    s.sdo_write(TMCL, 0, bytes([1, 136, 0, 0, 0, 0, 0, 0]))
+    assert s.sdo_read(TMCL, 0) == b"1310V114"
+    # Download over the mailbox answers 100 (EtherCAT has no 101).
+    assert tmcl(s, 132, 0, 0, 0) == (100, 0)
+    assert tmcl(s, 3, 0, 0, 0)[0] == 100
+    assert tmcl(s, 133, 0, 0, 0)[0] == 100
+    m.close()
+
+
+def test_the_state_machine_refuses_invalid_transitions(ethercat):
+    m = open_master(ethercat())
+    s = m.slaves[0]
+    # PreOp → Op directly: refused, the slave stays in PreOp with an error.
+    s.state = pysoem.OP_STATE
+    s.write_state()
+    m.read_state()
+    assert s.state == pysoem.PREOP_STATE | 0x10
+    assert s.al_status == 0x0011
+    # Acknowledge, then SafeOp without the process data SyncManagers.
+    s.state = pysoem.PREOP_STATE | 0x10
+    s.write_state()
+    m.read_state()
+    assert s.state == pysoem.PREOP_STATE
+    s.state = pysoem.SAFEOP_STATE
+    s.write_state()
+    m.read_state()
+    assert s.state & 0x0F == pysoem.PREOP_STATE and s.al_status in (0x001D, 0x001E)
+    m.close()
+
+
+def test_malformed_frames_are_ignored(ethercat):
+    iface = ethercat()
+    raw = socket.socket(socket.AF_PACKET, socket.SOCK_RAW)
+    raw.bind((iface, 0))
+    head = b"\xff" * 6 + b"\x02" * 6 + b"\x88\xa4"
+    for junk in [
+        head + b"\xff\x1f",  # length beyond the frame
+        head + b"\x10\x10" + b"\x04\x00\x00\x00\x30\x01\x50\x00",  # truncated datagram
+        head + bytes(range(46)),  # random datagrams
+        head,  # header only
+        b"\x00" * 8,  # not even Ethernet
+    ]:
+        raw.send(junk.ljust(14, b"\x00"))
+    raw.close()
+    time.sleep(0.1)
+    m = open_master(iface)
+    to_op(m)
+    m.close()
+
+
+def test_sixteen_slaves_on_one_segment(ethercat):
+    m = open_master(ethercat(16), expect=16)
+    to_op(m)
+    for i, s in enumerate(m.slaves):
+        s.output = struct.pack("<Ii", 1, 1000 * (i + 1))
+    cycle_until(m, lambda: all(inputs(s)[1] == 1000 * (i + 1) for i, s in enumerate(m.slaves)))
+    m.close()
