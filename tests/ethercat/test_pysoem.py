@@ -156,3 +156,17 @@ def test_sixteen_slaves_on_one_segment(ethercat):
         s.output = struct.pack("<Ii", 1, 1000 * (i + 1))
     cycle_until(m, lambda: all(inputs(s)[1] == 1000 * (i + 1) for i, s in enumerate(m.slaves)))
     m.close()
+
+
+def test_process_data_watchdog(ethercat):
+    m = open_master(ethercat())
+    s = m.slaves[0]
+    to_op(m)
+    s.output = struct.pack("<Ii", 2, 800)
+    cycle_until(m, lambda: inputs(s)[5] == 800)
+    time.sleep(0.3)  # no process data for longer than the 100 ms watchdog
+    m.read_state()
+    assert s.state == pysoem.SAFEOP_STATE | 0x10
+    assert s.al_status == 0x001B
+    assert tmcl(s, 6, 2, 0, 0) == (100, 0), "the motor was stopped"
+    m.close()
