@@ -198,7 +198,7 @@ fn us(d: Duration) -> f64 {
 }
 
 /// User and system CPU time of a process, from /proc.
-fn process_cpu(pid: u32) -> Result<(Duration, Duration), String> {
+pub(crate) fn process_cpu(pid: u32) -> Result<(Duration, Duration), String> {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).map_err(|e| e.to_string())?;
     let after = stat.rsplit_once(')').ok_or("bad /proc stat")?.1;
     let fields: Vec<&str> = after.split_whitespace().collect();

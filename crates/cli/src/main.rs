@@ -9,6 +9,7 @@ use std::time::Duration;
 mod asm;
 mod bench;
 mod client;
+mod fleet;
 mod plot;
 mod run;
 mod send;
@@ -42,6 +43,8 @@ enum Command {
     Upload(upload::UploadArgs),
     /// Change the world of a served module: inputs, switches, loads, faults.
     World(WorldArgs),
+    /// Serve a fleet from a second process, drive every module, report.
+    FleetBench(fleet::FleetBenchArgs),
 }
 
 #[derive(Args)]
@@ -104,6 +107,9 @@ pub struct ServeArgs {
     /// Number of slaves in the EtherCAT segment.
     #[arg(long, value_name = "N", default_value_t = 1, requires = "ethercat")]
     pub slaves: usize,
+    /// Serve a fleet: many modules on many links, from a fleet file (TOML).
+    #[arg(long, value_name = "FILE")]
+    pub fleet: Option<PathBuf>,
     /// Deliver bytes at each module's baud rate (GP 65), so that host
     /// timeouts behave as on a real RS485 bus.
     #[arg(long)]
@@ -167,6 +173,7 @@ fn main() -> ExitCode {
         Command::Run(a) => run::run(a),
         Command::Upload(a) => upload::run(a),
         Command::World(a) => world(a),
+        Command::FleetBench(a) => fleet::bench(a),
     };
     match result {
         Ok(code) => code,

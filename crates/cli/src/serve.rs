@@ -24,6 +24,9 @@ fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {
 }
 
 pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
+    if let Some(path) = &args.fleet {
+        return crate::fleet::serve(path, &args);
+    }
     if let Some(iface) = &args.ethercat {
         return ethercat(iface, &args);
     }
@@ -163,7 +166,7 @@ fn send_target(ep: &tmclsim_server::Endpoints) -> String {
     }
 }
 
-fn wait_for_signal() {
+pub(crate) fn wait_for_signal() {
     let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().expect("signal runtime");
     rt.block_on(async {
         use tokio::signal::unix::{signal, SignalKind};

@@ -15,7 +15,12 @@ pub(crate) async fn run(module: Arc<SharedModule>, mut stop: watch::Receiver<boo
             }
         };
         tokio::select! {
-            _ = sleep => module.tick(),
+            _ = sleep => {
+                if let Some(at) = due.and_then(|ns| module.instant_of(ns)) {
+                    module.record_wakeup(std::time::Instant::now().saturating_duration_since(at).as_nanos() as u64);
+                }
+                module.tick()
+            }
             _ = module.changed() => {}
             _ = stop.changed() => return,
         }

@@ -87,25 +87,42 @@ impl Endpoints {
     }
 }
 
+/// One served link: its endpoints and its module(s).
+#[derive(Clone)]
+pub struct LinkHandle {
+    pub endpoints: Endpoints,
+    pub module: Arc<SharedModule>,
+}
+
 /// A server running on its own thread; dropping it stops it.
 pub struct ServerHandle {
-    endpoints: Endpoints,
-    module: Arc<SharedModule>,
+    links: Vec<LinkHandle>,
     stop: watch::Sender<bool>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
 
 impl ServerHandle {
+    /// The endpoints of the (first) link.
     pub fn endpoints(&self) -> &Endpoints {
-        &self.endpoints
+        &self.links[0].endpoints
     }
 
-    /// The served module (lock it to inspect or change the world).
+    /// The served module(s) of the (first) link.
     pub fn module(&self) -> &Arc<SharedModule> {
-        &self.module
+        &self.links[0].module
     }
 
-    /// Stops serving, closes the links and removes the pty symlink.
+    /// Every link of a fleet.
+    pub fn links(&self) -> &[LinkHandle] {
+        &self.links
+    }
+
+    /// Frames handled and real-time deadlines missed, over all links.
+    pub fn stats(&self) -> shared::Stats {
+        self.links.iter().fold(shared::Stats::default(), |acc, l| acc.add(l.module.stats()))
+    }
+
+    /// Stops serving, closes the links and removes the pty symlinks.
     pub fn stop(mut self) {
         self.shutdown();
     }
@@ -115,8 +132,10 @@ impl ServerHandle {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
-        for (link, _) in self.endpoints.pty.iter().chain(&self.endpoints.slcan) {
-            let _ = std::fs::remove_file(link);
+        for l in &self.links {
+            for (link, _) in l.endpoints.pty.iter().chain(&l.endpoints.slcan) {
+                let _ = std::fs::remove_file(link);
+            }
         }
     }
 
@@ -132,6 +151,12 @@ impl Drop for ServerHandle {
     fn drop(&mut self) {
         self.shutdown();
     }
+}
+
+/// What one link serves and how.
+pub struct LinkSpec {
+    pub modules: Vec<(Module, Option<PathBuf>)>,
+    pub config: ServerConfig,
 }
 
 /// Starts serving `module` in a background thread.
@@ -151,13 +176,48 @@ pub fn start_bus(modules: Vec<Module>, config: ServerConfig) -> std::io::Result<
 
 /// Starts serving modules, each with its own EEPROM file, on one link.
 pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: ServerConfig) -> std::io::Result<ServerHandle> {
-    if modules.is_empty() {
-        return Err(std::io::Error::other("a link needs at least one module"));
+    start_fleet(vec![LinkSpec { modules, config }])
+}
+
+/// The listeners and ptys of one link, opened.
+struct Opened {
+    tcp: Option<tokio::net::TcpListener>,
+    pty: Option<pty::Pty>,
+    control: Option<tokio::net::TcpListener>,
+    slcan: Option<pty::Pty>,
+}
+
+async fn open(config: &ServerConfig) -> std::io::Result<Opened> {
+    let tcp = match config.tcp {
+        Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
+        None => None,
+    };
+    let pty = match &config.pty {
+        Some(path) => Some(pty::Pty::open(path)?),
+        None => None,
+    };
+    let control = match config.control {
+        Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
+        None => None,
+    };
+    let slcan = match &config.slcan {
+        Some(path) => Some(pty::Pty::open(path)?),
+        None => None,
+    };
+    Ok(Opened { tcp, pty, control, slcan })
+}
+
+/// Starts serving many links (a fleet) from one thread: one event loop,
+/// a task per connection and per clock, nothing that polls.
+pub fn start_fleet(links: Vec<LinkSpec>) -> std::io::Result<ServerHandle> {
+    if links.is_empty() || links.iter().any(|l| l.modules.is_empty()) {
+        return Err(std::io::Error::other("every link needs at least one module"));
     }
-    let shared = Arc::new(SharedModule::bus(modules, config.wire_timing));
+    let specs: Vec<(Arc<SharedModule>, ServerConfig)> =
+        links.into_iter().map(|l| (Arc::new(SharedModule::bus(l.modules, l.config.wire_timing)), l.config)).collect();
+    let shared: Vec<Arc<SharedModule>> = specs.iter().map(|(m, _)| m.clone()).collect();
     let (stop_tx, stop_rx) = watch::channel(false);
-    let (ready_tx, ready_rx) = std::sync::mpsc::channel::<std::io::Result<Endpoints>>();
-    let thread_shared = shared.clone();
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel::<std::io::Result<Vec<Endpoints>>>();
     let thread = std::thread::Builder::new().name("tmclsim-server".into()).spawn(move || {
         let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
             Ok(rt) => rt,
@@ -167,52 +227,41 @@ pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: S
             }
         };
         rt.block_on(async move {
-            let setup = async {
-                let tcp = match config.tcp {
-                    Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
-                    None => None,
-                };
-                let pty = match &config.pty {
-                    Some(path) => Some(pty::Pty::open(path)?),
-                    None => None,
-                };
-                let control = match config.control {
-                    Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
-                    None => None,
-                };
-                let slcan = match &config.slcan {
-                    Some(path) => Some(pty::Pty::open(path)?),
-                    None => None,
-                };
-                Ok::<_, std::io::Error>((tcp, pty, control, slcan))
-            };
-            let (tcp, pty, control, slcan) = match setup.await {
-                Ok(v) => v,
-                Err(e) => {
-                    let _ = ready_tx.send(Err(e));
-                    return;
+            let mut opened = Vec::with_capacity(specs.len());
+            for (_, config) in &specs {
+                match open(config).await {
+                    Ok(o) => opened.push(o),
+                    Err(e) => {
+                        let _ = ready_tx.send(Err(e));
+                        return;
+                    }
                 }
-            };
-            let endpoints = Endpoints {
-                tcp: tcp.as_ref().and_then(|l| l.local_addr().ok()),
-                pty: pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
-                control: control.as_ref().and_then(|l| l.local_addr().ok()),
-                slcan: slcan.as_ref().map(|p| (p.link.clone(), p.device.clone())),
-            };
+            }
+            let endpoints = opened
+                .iter()
+                .map(|o| Endpoints {
+                    tcp: o.tcp.as_ref().and_then(|l| l.local_addr().ok()),
+                    pty: o.pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
+                    control: o.control.as_ref().and_then(|l| l.local_addr().ok()),
+                    slcan: o.slcan.as_ref().map(|p| (p.link.clone(), p.device.clone())),
+                })
+                .collect();
             let _ = ready_tx.send(Ok(endpoints));
             let mut tasks = tokio::task::JoinSet::new();
-            tasks.spawn(clock::run(thread_shared.clone(), stop_rx.clone()));
-            if let Some(listener) = tcp {
-                tasks.spawn(tcp::run(listener, thread_shared.clone(), config.clone(), stop_rx.clone()));
-            }
-            if let Some(p) = pty {
-                tasks.spawn(pty::run(p, thread_shared.clone(), config.clone(), stop_rx.clone()));
-            }
-            if let Some(listener) = control {
-                tasks.spawn(control::run(listener, thread_shared.clone(), stop_rx.clone()));
-            }
-            if let Some(p) = slcan {
-                tasks.spawn(slcan::run(p, thread_shared.clone(), stop_rx.clone()));
+            for ((module, config), o) in specs.into_iter().zip(opened) {
+                tasks.spawn(clock::run(module.clone(), stop_rx.clone()));
+                if let Some(listener) = o.tcp {
+                    tasks.spawn(tcp::run(listener, module.clone(), config.clone(), stop_rx.clone()));
+                }
+                if let Some(p) = o.pty {
+                    tasks.spawn(pty::run(p, module.clone(), config.clone(), stop_rx.clone()));
+                }
+                if let Some(listener) = o.control {
+                    tasks.spawn(control::run(listener, module.clone(), stop_rx.clone()));
+                }
+                if let Some(p) = o.slcan {
+                    tasks.spawn(slcan::run(p, module.clone(), stop_rx.clone()));
+                }
             }
             let mut stop = stop_rx.clone();
             let _ = stop.wait_for(|s| *s).await;
@@ -221,5 +270,6 @@ pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: S
         });
     })?;
     let endpoints = ready_rx.recv().map_err(|_| std::io::Error::other("server thread ended early"))??;
-    Ok(ServerHandle { endpoints, module: shared, stop: stop_tx, thread: Some(thread) })
+    let links = endpoints.into_iter().zip(shared).map(|(endpoints, module)| LinkHandle { endpoints, module }).collect();
+    Ok(ServerHandle { links, stop: stop_tx, thread: Some(thread) })
 }

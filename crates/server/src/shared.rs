@@ -37,8 +37,26 @@ enum Clock {
     Stepped,
 }
 
+/// Counters of a served link.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Frames (and CAN/ASCII commands) handled.
+    pub frames: u64,
+    /// Times the clock woke more than a millisecond after something was due.
+    pub missed_deadlines: u64,
+    /// The latest wake-up, in nanoseconds after its due time.
+    pub max_lateness_ns: u64,
+}
+
+impl Stats {
+    pub fn add(self, o: Stats) -> Stats {
+        Stats { frames: self.frames + o.frames, missed_deadlines: self.missed_deadlines + o.missed_deadlines, max_lateness_ns: self.max_lateness_ns.max(o.max_lateness_ns) }
+    }
+}
+
 /// The served module(s) behind a lock, with the clock and EEPROM files.
 pub struct SharedModule {
+    stats: Mutex<Stats>,
     state: Mutex<State>,
     clock: Mutex<Clock>,
     changed: Notify,
@@ -81,6 +99,7 @@ impl SharedModule {
             })
             .collect();
         let shared = SharedModule {
+            stats: Mutex::new(Stats::default()),
             state: Mutex::new(State { nodes, sink: None, scheduled: None }),
             clock: Mutex::new(Clock::Wall { origin: Instant::now(), origin_ns }),
             changed: Notify::new(),
@@ -116,6 +135,19 @@ impl SharedModule {
         }
         Self::after_change(&mut s);
         self.update_ascii(&s);
+    }
+
+    pub fn stats(&self) -> Stats {
+        *self.stats.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The clock woke `late_ns` after a due time.
+    pub(crate) fn record_wakeup(&self, late_ns: u64) {
+        let mut s = self.stats.lock().unwrap_or_else(|p| p.into_inner());
+        if late_ns > 1_000_000 {
+            s.missed_deadlines += 1;
+        }
+        s.max_lateness_ns = s.max_lateness_ns.max(late_ns);
     }
 
     /// How many modules the link has.
@@ -220,11 +252,17 @@ impl SharedModule {
     /// how long to wait before sending them (GP 75 of the module that
     /// answered, and with wire timing the time the bytes take on the wire).
     pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
+        self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
         let now = self.now_ns();
         let mut replies = Vec::new();
         let mut delay = Duration::ZERO;
         for n in &mut s.nodes {
+            // Only the addressed module does anything with a frame; the
+            // others catch up with time when they are next looked at.
+            if !n.module.answers_to(frame[0]) {
+                continue;
+            }
             n.module.advance_to(now);
             if let Some(r) = n.module.handle_frame(frame) {
                 replies.push(r);
