@@ -103,6 +103,8 @@ impl Module {
         };
         *slot = ins;
         self.eeprom.program.insert(address, ins.to_bytes());
+        // Each word is in the EEPROM when it is acknowledged, as on the module.
+        self.eeprom_generation += 1;
         self.program.download = Some(address + 1);
         self.program.download_pointer = address + 1;
         Outcome { status: Status::Loaded, value: ins.value, special: Special::None }
