@@ -186,3 +186,32 @@ fn idle_connections_up_to_the_limit() {
     std::thread::sleep(Duration::from_millis(200));
     server.check();
 }
+
+#[test]
+fn half_open_and_half_closed_connections() {
+    let server = Server::start(&["--max-connections", "8"]);
+    // A host that sends its last command and closes its sending half still
+    // gets the reply.
+    let mut s = TcpStream::connect(&server.addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    s.write_all(&Request::new(1, parse_line("GAP 4, 0").unwrap()).encode()).unwrap();
+    s.shutdown(std::net::Shutdown::Write).unwrap();
+    let mut b = [0u8; 9];
+    s.read_exact(&mut b).unwrap();
+    assert_eq!(Reply::decode(&b).unwrap().status, 100);
+    assert_eq!(s.read(&mut b).unwrap(), 0, "then the server closes");
+    // Hosts that vanish in the middle of a frame (half-open from the
+    // server's side) hold no more than their own slot; others are served.
+    let stuck: Vec<TcpStream> = (0..7)
+        .map(|_| {
+            let mut s = TcpStream::connect(&server.addr).unwrap();
+            s.write_all(&[1, 6, 4, 0]).unwrap();
+            s
+        })
+        .collect();
+    std::thread::sleep(Duration::from_millis(100));
+    server.check();
+    drop(stuck);
+    std::thread::sleep(Duration::from_millis(100));
+    server.check();
+}
