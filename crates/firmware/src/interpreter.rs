@@ -392,6 +392,9 @@ impl Module {
                 let ramp = self.ramp(m);
                 let mut stops = |x: f64| self.stops_at(m, x);
                 match self.axes[m].motion.time_to_rest(&ramp, &mut stops) {
+                    // At rest off the target (a switch stopped it): nothing
+                    // changes by itself; only the timeout ends the wait.
+                    Some(s) if s <= 0.0 => None,
                     Some(s) => Some(self.now_ns + (s * 1e9).ceil() as u64),
                     None => Some(poll),
                 }

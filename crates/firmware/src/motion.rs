@@ -153,6 +153,12 @@ impl Phase {
 
 const EPS_POS: f64 = 1e-6;
 const EPS_VEL: f64 = 1e-9;
+/// A deceleration ends on the target at the stop speed; float dust from
+/// steps that split the ramp (a step per millisecond, a switch edge) may
+/// leave it a few 1e-8 µsteps/s above. Within this it stops there.
+const EPS_ARRIVE_VEL: f64 = 1e-6;
+/// A braking ramp that ends this close to the target (µsteps) ends on it.
+const EPS_LAND: f64 = 1e-2;
 /// Phases one `advance` may walk through; a guard against float dust.
 const MAX_PHASES: usize = 64;
 
@@ -203,7 +209,12 @@ impl Motion {
             let mut t = phase.duration.min(dt);
             let mut crossing = None;
             for &th in thresholds {
-                if let Some(tc) = self.crossing(phase.shape, th, t) {
+                // An edge within a nanosecond of the phase's end is reached
+                // at its end: splitting the phase there would leave float
+                // dust in the speed (a motor a hair short of its target
+                // with speed left).
+                let tc = self.crossing(phase.shape, th, t).map(|tc| if t - tc < 1e-9 { t } else { tc });
+                if let Some(tc) = tc {
                     if tc < t || crossing.is_none() && tc <= t {
                         t = tc;
                         crossing = Some(th);
@@ -214,8 +225,19 @@ impl Motion {
             self.integrate(phase.shape, t);
             dt -= t;
             elapsed += t;
+            // The phase ran to its end: on the target when it arrives there,
+            // even if a switch edge lies exactly on the target.
+            let arrived = t >= phase.duration && phase.arrives;
+            if arrived {
+                self.x = self.target;
+                self.v = 0.0;
+                self.a = 0.0;
+                step.arrived = true;
+            }
             if let Some(th) = crossing {
-                self.x = th;
+                if !arrived {
+                    self.x = th;
+                }
                 let s = stops(self.x);
                 if !s.soft && s.blocks(self.v.sgn()) {
                     self.v = 0.0;
@@ -228,11 +250,6 @@ impl Motion {
                     }
                     break;
                 }
-            } else if t >= phase.duration && phase.arrives {
-                self.x = self.target;
-                self.v = 0.0;
-                self.a = 0.0;
-                step.arrived = true;
             }
             if was_moving && self.v == 0.0 {
                 step.stopped_at = Some(elapsed);
@@ -379,7 +396,7 @@ impl Motion {
         let vmin = ramp.vmin.min(vmax);
         let delta = self.target - self.x;
         let d = delta.abs();
-        if d < EPS_POS && self.v.abs() <= vmin + EPS_VEL {
+        if d < EPS_POS && self.v.abs() <= vmin + EPS_ARRIVE_VEL {
             if self.v == 0.0 && delta == 0.0 {
                 return None;
             }
@@ -411,13 +428,15 @@ impl Motion {
             if u > vmin + EPS_VEL {
                 // Decelerate; if the target comes first (a target moved
                 // closer), pass it and come back.
-                let t_vmin = (u - vmin) / a;
-                let disc = u * u - 2.0 * a * d;
-                let t_target = if disc >= 0.0 { (u - disc.sqrt()) / a } else { f64::INFINITY };
-                if t_target < t_vmin - 1e-12 && disc > 1e-6 {
+                if d < b - EPS_LAND {
+                    let t_target = (u - (u * u - 2.0 * a * d).sqrt()) / a;
                     return Some(Phase::accel(-dir * a, t_target));
                 }
-                return Some(Phase::accel(-dir * a, t_vmin));
+                // The braking ramp ends on the target at the stop speed,
+                // where the motor stops. Ramps split into many steps end
+                // within float dust of it, not on it exactly.
+                let t_vmin = (u - vmin) / a;
+                return Some(Phase { shape: Shape::Accel(-dir * a), duration: t_vmin, arrives: d >= b - EPS_LAND });
             }
             // Creep at the stop speed for the last fraction of a step.
             let speed = u.max(vmin);

@@ -395,3 +395,31 @@ fn random_programs_never_panic_or_hang() {
         send(&mut m, "#128 0 0 0");
     }
 }
+
+/// One long `advance` runs a program exactly as many short ones do: a
+/// program that moves back and forth with WAIT POS counts the same number
+/// of trips either way, also when a switch edge lies on a target (the home
+/// switch of the built-in stage starts at 100 000).
+#[test]
+fn one_long_advance_equals_many_short_ones() {
+    for far in [20_000, 100_000] {
+        let far_line = format!("MVP ABS, 0, {far}");
+        let program = ["SAP 4, 0, 2047", far_line.as_str(), "WAIT POS, 0, 0", "MVP ABS, 0, 0", "WAIT POS, 0, 0", "GGP 51, 2", "CALC ADD, 1", "AGP 51, 2", "JA 1"];
+        let stage = || {
+            let profile = tmclsim_firmware::Profile::built_in("tmcm-1141").unwrap();
+            Module::with_world(profile, tmclsim_firmware::Eeprom::new("TMCM-1141"), tmclsim_firmware::World::stage(1))
+        };
+        let mut long = stage();
+        run(&mut long, &program, 0);
+        long.advance(60_000 * MS);
+        let mut short = stage();
+        run(&mut short, &program, 0);
+        for _ in 0..60_000 {
+            short.advance(MS);
+        }
+        let trips = var(&mut short, 51);
+        assert!(trips > 10, "the stepped module made {trips} trips to {far}");
+        assert_eq!(var(&mut long, 51), trips, "trips to {far}");
+        assert_eq!(value(&mut long, "GAP 1, 0"), value(&mut short, "GAP 1, 0"));
+    }
+}
