@@ -158,3 +158,28 @@ fn wait_rfs_in_a_program() {
     m.advance(600_000 * MS);
     assert_eq!(send(&mut m, "GGP 9, 2"), -20_000);
 }
+
+/// Mode 8 from far below the home switch of the built-in stage (home switch
+/// 100 000…110 000, carriage at −500 000): the search ends on the middle of
+/// the switch, in one long advance as in 1 ms steps.
+#[test]
+fn mode_8_from_far_below_in_one_long_advance() {
+    for stepped in [true, false] {
+        let profile = tmclsim_firmware::Profile::built_in("tmcm-1141").unwrap();
+        let mut world = tmclsim_firmware::World::stage(1);
+        world.axes[0].start = -500_000.0;
+        let mut m = Module::with_world(profile, tmclsim_firmware::Eeprom::new("TMCM-1141"), world);
+        send(&mut m, "SAP 193, 0, 8");
+        send(&mut m, "RFS START, 0");
+        if stepped {
+            for _ in 0..400_000 {
+                m.advance(MS);
+            }
+        } else {
+            m.advance(400_000 * MS);
+        }
+        assert_eq!(send(&mut m, "RFS STATUS, 0"), 0, "stepped: {stepped}");
+        assert_eq!(send(&mut m, "GAP 197, 0"), 605_000, "stepped: {stepped}");
+        assert!((zero_point(&m) - 105_000.0).abs() <= 0.5, "zero at {}", zero_point(&m));
+    }
+}

@@ -1,0 +1,144 @@
+//! `Bus`: several modules on one link, as on an RS485 bus.
+
+use crate::errors::value_error;
+use crate::module::{seconds_to_ns, served_error, Module};
+use crate::types::{command_from, ReplyKind, Reply};
+use pyo3::prelude::*;
+use std::borrow::Cow;
+use tmclsim_protocol::{Request, FRAME_LEN};
+
+/// Several modules on one link: every frame reaches every module, the
+/// addressed one answers.
+///
+/// ``Bus([Module(address=1), Module(address=2)])``. The modules stay
+/// usable on their own; the bus brings them to one virtual time and moves
+/// them together with ``advance``. ``tmclsim.serve(bus)`` serves the whole
+/// bus on one TCP port and pty.
+#[pyclass(module = "tmclsim", name = "Bus")]
+pub struct Bus {
+    pub modules: Vec<Py<Module>>,
+}
+
+#[pymethods]
+impl Bus {
+    #[new]
+    fn py_new(py: Python<'_>, modules: Vec<Py<Module>>) -> PyResult<Bus> {
+        if modules.is_empty() {
+            return Err(value_error("a bus needs at least one module"));
+        }
+        let mut addresses = Vec::new();
+        let mut latest = 0;
+        for m in &modules {
+            let mut m = m.bind(py).try_borrow_mut()?;
+            if m.is_served() {
+                return Err(served_error());
+            }
+            let address = m.address_now()?;
+            if addresses.contains(&address) {
+                return Err(value_error(format!("two modules have address {address}: give each its own (Module(address=…))")));
+            }
+            addresses.push(address);
+            latest = latest.max(m.now_ns()?);
+        }
+        for m in &modules {
+            let mut m = m.bind(py).try_borrow_mut()?;
+            let module = m.local_module()?;
+            module.advance_to(latest);
+        }
+        Ok(Bus { modules })
+    }
+
+    /// The modules, in the order given.
+    #[getter]
+    fn modules(&self, py: Python<'_>) -> Vec<Py<Module>> {
+        self.modules.iter().map(|m| m.clone_ref(py)).collect()
+    }
+
+    /// module(address: int) -> Module
+    /// --
+    ///
+    /// The module that answers to ``address`` now (GP 66).
+    fn module(&self, py: Python<'_>, address: u8) -> PyResult<Py<Module>> {
+        for m in &self.modules {
+            if m.bind(py).try_borrow_mut()?.address_now()? == address {
+                return Ok(m.clone_ref(py));
+            }
+        }
+        Err(value_error(format!("no module on the bus answers to address {address}")))
+    }
+
+    /// send_frame(frame: bytes) -> bytes | None
+    /// --
+    ///
+    /// Puts nine bytes on the bus: every module sees them, the addressed
+    /// one answers (None: nobody answered).
+    fn send_frame(&self, py: Python<'_>, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
+        let frame: &[u8; FRAME_LEN] = frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
+        let mut answer = None;
+        for m in &self.modules {
+            let reply = m.bind(py).try_borrow_mut()?.handle_frame(frame)?;
+            answer = answer.or(reply);
+        }
+        Ok(answer)
+    }
+
+    /// send(address, command, type=None, motor=None, value=None) -> Reply | None
+    /// --
+    ///
+    /// Sends one command to ``address`` on the bus; ``command`` as in
+    /// ``Module.send``.
+    #[pyo3(signature = (address, command, r#type=None, motor=None, value=None))]
+    fn send(&self, py: Python<'_>, address: u8, command: &Bound<'_, PyAny>, r#type: Option<u8>, motor: Option<u8>, value: Option<i64>) -> PyResult<Option<Reply>> {
+        let ins = command_from(command, r#type, motor, value)?;
+        let frame = Request::new(address, ins).encode();
+        let reply = self.send_frame(py, Cow::Borrowed(&frame))?;
+        Ok(reply.map(|raw| Reply::new(raw, ReplyKind::of(ins, address, &raw))))
+    }
+
+    /// advance(seconds: float) -> None
+    /// --
+    ///
+    /// Moves every module on by the same virtual time.
+    fn advance(&self, py: Python<'_>, seconds: f64) -> PyResult<()> {
+        let ns = seconds_to_ns(seconds)?;
+        for m in &self.modules {
+            let mut m = m.bind(py).try_borrow_mut()?;
+            if m.is_served() {
+                // A served bus moves together: once is enough.
+                return m.advance_ns(py, ns);
+            }
+            m.advance_ns(py, ns)?;
+        }
+        Ok(())
+    }
+
+    /// Virtual time in seconds (of the first module).
+    #[getter]
+    fn time(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.modules[0].bind(py).try_borrow_mut()?.now_ns()? as f64 * 1e-9)
+    }
+
+    fn __len__(&self) -> usize {
+        self.modules.len()
+    }
+
+    fn __getitem__(&self, py: Python<'_>, index: isize) -> PyResult<Py<Module>> {
+        let n = self.modules.len() as isize;
+        let i = if index < 0 { index + n } else { index };
+        if (0..n).contains(&i) {
+            Ok(self.modules[i as usize].clone_ref(py))
+        } else {
+            Err(pyo3::exceptions::PyIndexError::new_err("bus index out of range"))
+        }
+    }
+
+    fn __iter__(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let list = pyo3::types::PyList::new(py, self.modules(py))?;
+        Ok(list.try_iter()?.into_any().unbind())
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let addresses: Vec<String> = self.modules.iter().map(|m| m.bind(py).try_borrow_mut().ok().and_then(|mut m| m.address_now().ok()).map_or("?".into(), |a| a.to_string())).collect();
+        format!("<tmclsim.Bus addresses {}>", addresses.join(", "))
+    }
+}

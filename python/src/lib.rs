@@ -1,0 +1,52 @@
+//! The native part of the `tmclsim` Python package (`tmclsim._tmclsim`):
+//! PyO3 bindings over the tmclsim crates.
+//!
+//! - `module.rs`: `Module`, a virtual TMCL module in process (or, while it
+//!   is served, a handle that reaches it through the server);
+//! - `bus.rs`: `Bus`, several modules on one link;
+//! - `server.rs`: `Server`, modules served on TCP and a pty;
+//! - `asm.rs`: `Program`, `assemble`, `disassemble`;
+//! - `types.rs`: `Reply`, `Instruction`, `Registers`;
+//! - `world.rs`: the control protocol of docs/world.md on any module;
+//! - `names.rs`: parameters by name;
+//! - `errors.rs`: raising the package's Python exceptions.
+//!
+//! The pure-Python part (`tmclsim/__init__.py`) subclasses `Module` and
+//! `Server` to add the world convenience methods and PyTrinamic helpers.
+
+mod asm;
+mod bus;
+mod errors;
+mod module;
+mod names;
+mod server;
+mod types;
+mod world;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _tmclsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<module::Module>()?;
+    m.add_class::<bus::Bus>()?;
+    m.add_class::<server::Server>()?;
+    m.add_class::<types::Reply>()?;
+    m.add_class::<types::Instruction>()?;
+    m.add_class::<types::Registers>()?;
+    m.add_class::<asm::Program>()?;
+    m.add_function(wrap_pyfunction!(asm::assemble, m)?)?;
+    m.add_function(wrap_pyfunction!(asm::assemble_file, m)?)?;
+    m.add_function(wrap_pyfunction!(asm::disassemble, m)?)?;
+    m.add_function(wrap_pyfunction!(profiles, m)?)?;
+    m.add_function(wrap_pyfunction!(module::_time_core, m)?)?;
+    Ok(())
+}
+
+/// profiles() -> list[str]
+/// --
+///
+/// The names of the built-in module profiles (e.g. ``["tmcm-1141"]``).
+#[pyfunction]
+fn profiles() -> Vec<&'static str> {
+    tmclsim_firmware::Profile::names()
+}
