@@ -259,11 +259,13 @@ impl Profile {
     pub fn built_in(name: &str) -> Result<Arc<Profile>, String> {
         let key = name.to_ascii_lowercase();
         let key = if key.starts_with("tmcm-") { key } else { format!("tmcm-{key}") };
-        let (_, text) = BUILT_IN
+        // Each built-in profile is parsed once per process and shared.
+        static PARSED: [std::sync::OnceLock<Result<Arc<Profile>, String>>; BUILT_IN.len()] = [const { std::sync::OnceLock::new() }; BUILT_IN.len()];
+        let i = BUILT_IN
             .iter()
-            .find(|(n, _)| *n == key)
+            .position(|(n, _)| *n == key)
             .ok_or_else(|| format!("no built-in profile '{name}' (known: {})", Profile::names().join(", ")))?;
-        Profile::from_toml(text).map(Arc::new).map_err(|e| format!("profile {key}: {e}"))
+        PARSED[i].get_or_init(|| Profile::from_toml(BUILT_IN[i].1).map(Arc::new).map_err(|e| format!("profile {key}: {e}"))).clone()
     }
 
     pub fn names() -> Vec<&'static str> {

@@ -191,6 +191,15 @@ pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
         return format!("#{} {} {} {}", ins.opcode, ins.kind, ins.motor, ins.value);
     };
     let layout = layout(ins.opcode).unwrap_or(&[]);
+    // A field the mnemonic does not show must be zero, or the text would
+    // not give the same instruction back: then the raw form.
+    let shows = |f: fn(&Operand) -> bool| layout.iter().any(f);
+    let hidden = (ins.kind != 0 && !shows(|o| matches!(o, Operand::Type | Operand::TypeSymbol(_))))
+        || (ins.motor != 0 && !shows(|o| matches!(o, Operand::Motor)))
+        || (ins.value != 0 && !shows(|o| matches!(o, Operand::Value | Operand::Address)));
+    if hidden {
+        return format!("#{} {} {} {}", ins.opcode, ins.kind, ins.motor, ins.value);
+    }
     let parts: Vec<String> = layout
         .iter()
         .map(|k| match k {
@@ -225,6 +234,17 @@ mod tests {
         assert_eq!(bytes("EI 255"), [0x01, 0x19, 0xFF, 0x00, 0x00, 0x00, 0x00, 0x00, 0x19]);
         assert_eq!(bytes("SGP $42, 0, 0x3"), [0x01, 0x09, 0x42, 0x00, 0x00, 0x00, 0x00, 0x03, 0x4F]);
         assert_eq!(bytes("#138 1 0 1"), [0x01, 0x8A, 0x01, 0x00, 0x00, 0x00, 0x00, 0x01, 0x8D]);
+    }
+
+    #[test]
+    fn formatting_is_lossless() {
+        assert_eq!(format(Instruction::new(3, 0, 1, 0)), "MST 1");
+        // MST shows no type and no value: a word with them is written raw.
+        assert_eq!(format(Instruction::new(3, 61, 0, 0)), "#3 61 0 0");
+        assert_eq!(format(Instruction::new(28, 0, 0, 5)), "#28 0 0 5");
+        for ins in [Instruction::new(3, 61, 0, 0), Instruction::new(19, 0, 4, 7), Instruction::new(27, 1, 0, -3)] {
+            assert_eq!(parse_line(&format(ins)), Ok(ins));
+        }
     }
 
     #[test]
