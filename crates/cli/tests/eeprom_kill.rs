@@ -4,42 +4,18 @@
 //! acknowledged value or the one in flight, and the next start serves
 //! exactly what the file holds.
 
-use std::io::{BufRead, BufReader, Read, Write};
+mod common;
+
+use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Stdio};
 use std::time::Duration;
 use tmclsim_firmware::Eeprom;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Instruction, Reply, Request};
 
 fn spawn(eeprom: &std::path::Path) -> (Child, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .args(["serve", "--tcp", "127.0.0.1:0", "--eeprom"])
-        .arg(eeprom)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut addr = None;
-    for _ in 0..20 {
-        let mut line = String::new();
-        if out.read_line(&mut line).unwrap() == 0 {
-            break;
-        }
-        if let Some(a) = line.trim().strip_prefix("tcp: ") {
-            addr = Some(a.to_string());
-        }
-        if line.starts_with("connect with:") {
-            break;
-        }
-    }
-    // Keep draining stdout so the child never blocks on it.
-    std::thread::spawn(move || {
-        let mut sink = Vec::new();
-        let _ = out.read_to_end(&mut sink);
-    });
-    (child, addr.expect("server printed its tcp endpoint"))
+    common::serve(&["--eeprom", eeprom.to_str().unwrap()], Stdio::null())
 }
 
 fn ask(s: &mut TcpStream, line: &str) -> Option<Reply> {

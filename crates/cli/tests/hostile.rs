@@ -2,9 +2,11 @@
 //! of connects and disconnects, idle connections up to the limit. No
 //! crash, bounded memory, correct replies to the valid frames that follow.
 
+mod common;
+
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tmclsim_protocol::mnemonic::parse_line;
@@ -18,35 +20,13 @@ struct Server {
 
 impl Server {
     fn start(extra: &[&str]) -> Server {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-            .args(["serve", "--tcp", "127.0.0.1:0"])
-            .args(extra)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let mut out = BufReader::new(child.stdout.take().unwrap());
-        let mut addr = String::new();
-        loop {
-            let mut line = String::new();
-            assert!(out.read_line(&mut line).unwrap() > 0);
-            if let Some(a) = line.trim().strip_prefix("tcp: ") {
-                addr = a.to_string();
-            }
-            if line.starts_with("connect with:") {
-                break;
-            }
-        }
+        let (mut child, addr) = common::serve(extra, Stdio::piped());
         let log = Arc::new(Mutex::new(Vec::new()));
         let (l, err) = (log.clone(), child.stderr.take().unwrap());
         std::thread::spawn(move || {
             for line in BufReader::new(err).lines().map_while(Result::ok) {
                 l.lock().unwrap().push(line);
             }
-        });
-        std::thread::spawn(move || {
-            let mut sink = vec![];
-            let _ = out.read_to_end(&mut sink);
         });
         Server { child, addr, log }
     }

@@ -1,6 +1,7 @@
 //! `tmclsim asm`, `disasm`, `run` and `upload` as a user runs them.
 
-use std::io::{BufRead, BufReader, Read};
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 
@@ -102,27 +103,7 @@ fn run_with_breakpoint_and_scripted_debugger() {
 
 fn serve(d: &Path) -> (Child, String, PathBuf) {
     let pty = d.join("pty");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .args(["serve", "--tcp", "127.0.0.1:0", "--pty", pty.to_str().unwrap()])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut tcp = String::new();
-    loop {
-        let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "server ended");
-        if let Some(a) = line.trim().strip_prefix("tcp: ") {
-            tcp = a.to_string();
-        }
-        if line.starts_with("connect with:") {
-            break;
-        }
-    }
-    std::thread::spawn(move || {
-        let mut sink = vec![];
-        let _ = out.read_to_end(&mut sink);
-    });
+    let (child, tcp) = common::serve(&["--pty", pty.to_str().unwrap()], Stdio::inherit());
     (child, tcp, pty)
 }
 

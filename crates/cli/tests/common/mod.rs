@@ -1,0 +1,34 @@
+//! Starting the real `tmclsim serve` process in tests.
+
+use std::io::{BufRead, BufReader, Read};
+use std::process::{Child, Command, Stdio};
+
+/// Starts `tmclsim serve` with `args` (plus `--tcp 127.0.0.1:0`) and waits
+/// until it serves; returns the process and its TCP endpoint. Its stdout
+/// keeps being drained so it never blocks.
+pub fn serve(args: &[&str], stderr: Stdio) -> (Child, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["serve", "--tcp", "127.0.0.1:0"])
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(stderr)
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut tcp = None;
+    loop {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "the server ended before serving");
+        if let Some(a) = line.trim().strip_prefix("tcp: ") {
+            tcp = Some(a.to_string());
+        }
+        if line.starts_with("connect with:") {
+            break;
+        }
+    }
+    std::thread::spawn(move || {
+        let mut sink = vec![];
+        let _ = out.read_to_end(&mut sink);
+    });
+    (child, tcp.expect("the server printed its tcp endpoint"))
+}
