@@ -1,7 +1,7 @@
 """The pytest plugin: the tmcl_module fixture, its marker and indirect
 parametrization, with PyTrinamic over TCP and the pty."""
 
-import socket
+from endpoints import port_open
 import subprocess
 import sys
 import time
@@ -89,15 +89,6 @@ def test_inner(tmcl_module):
 def test_inner_param(tmcl_module):
     assert tmcl_module.module.profile == "TMCM-1141"
 """
-
-
-def port_open(address):
-    host, port = address.rsplit(":", 1)
-    try:
-        with socket.create_connection((host, int(port)), timeout=1):
-            return True
-    except OSError:
-        return False
 
 
 def run_pytest(directory, *args):

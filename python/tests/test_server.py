@@ -10,18 +10,10 @@ import time
 import pytest
 
 import tmclsim
+from endpoints import port_open
 
 pytrinamic = pytest.importorskip("pytrinamic")
 from pytrinamic.modules import TMCM1141  # noqa: E402
-
-
-def port_open(address):
-    host, port = address.rsplit(":", 1)
-    try:
-        with socket.create_connection((host, int(port)), timeout=1):
-            return True
-    except OSError:
-        return False
 
 
 def test_endpoints_and_pytrinamic_over_tcp():
