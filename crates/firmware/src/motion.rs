@@ -153,11 +153,9 @@ impl Phase {
 
 const EPS_POS: f64 = 1e-6;
 const EPS_VEL: f64 = 1e-9;
-/// A deceleration ends on the target at the stop speed; float dust from
-/// steps that split the ramp (a step per millisecond, a switch edge) may
-/// leave it a few 1e-8 µsteps/s above. Within this it stops there.
-const EPS_ARRIVE_VEL: f64 = 1e-6;
-/// A braking ramp that ends this close to the target (µsteps) ends on it.
+/// A braking ramp that ends this close to the target (µsteps) ends on it:
+/// ramps split into many steps (a step per millisecond, a switch edge)
+/// collect float dust.
 const EPS_LAND: f64 = 1e-2;
 /// Phases one `advance` may walk through; a guard against float dust.
 const MAX_PHASES: usize = 64;
@@ -396,7 +394,7 @@ impl Motion {
         let vmin = ramp.vmin.min(vmax);
         let delta = self.target - self.x;
         let d = delta.abs();
-        if d < EPS_POS && self.v.abs() <= vmin + EPS_ARRIVE_VEL {
+        if d < EPS_POS && self.v.abs() <= vmin + EPS_VEL {
             if self.v == 0.0 && delta == 0.0 {
                 return None;
             }
@@ -433,10 +431,9 @@ impl Motion {
                     return Some(Phase::accel(-dir * a, t_target));
                 }
                 // The braking ramp ends on the target at the stop speed,
-                // where the motor stops. Ramps split into many steps end
-                // within float dust of it, not on it exactly.
+                // where the motor stops.
                 let t_vmin = (u - vmin) / a;
-                return Some(Phase { shape: Shape::Accel(-dir * a), duration: t_vmin, arrives: d >= b - EPS_LAND });
+                return Some(Phase { shape: Shape::Accel(-dir * a), duration: t_vmin, arrives: true });
             }
             // Creep at the stop speed for the last fraction of a step.
             let speed = u.max(vmin);
