@@ -18,9 +18,8 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     let text = disassemble(&words, None);
-    if let Ok(again) = assemble(&text, "again.tmc", &NoIncludes, None) {
-        assert_eq!(again.instructions, words, "\n{text}");
-    }
+    let again = assemble(&text, "again.tmc", &NoIncludes, None).unwrap_or_else(|e| panic!("disassembly does not assemble: {e:?}\n{text}"));
+    assert_eq!(again.instructions, words, "\n{text}");
     let start = || {
         let mut module = Module::built_in(MODULES[pick as usize % 3]).unwrap();
         module.load_program(&words).ok()?;

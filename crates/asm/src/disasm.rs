@@ -12,7 +12,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
 
-use tmclsim_protocol::mnemonic::{format_with, layout, Operand};
+use tmclsim_protocol::mnemonic::{format_with, layout, shows_every_field, Operand};
 use tmclsim_protocol::{opcode as op, Command, Instruction};
 
 /// Column where the `// address` comments start.
@@ -21,15 +21,7 @@ const COMMENT_COLUMN: usize = 40;
 /// Whether the mnemonic form of the instruction encodes back to exactly
 /// these seven bytes.
 pub fn has_mnemonic_form(ins: Instruction) -> bool {
-    let (Some(_), Some(slots)) = (op::mnemonic(ins.opcode), layout(ins.opcode)) else { return false };
-    if Command::decode(ins).is_err() {
-        return false;
-    }
-    let uses = |f: fn(&Operand) -> bool| slots.iter().any(f);
-    let type_used = uses(|o| matches!(o, Operand::Type | Operand::TypeSymbol(_)));
-    let motor_used = uses(|o| matches!(o, Operand::Motor));
-    let value_used = uses(|o| matches!(o, Operand::Value | Operand::Address));
-    (type_used || ins.kind == 0) && (motor_used || ins.motor == 0) && (value_used || ins.value == 0)
+    op::mnemonic(ins.opcode).is_some() && layout(ins.opcode).is_some() && Command::decode(ins).is_ok() && shows_every_field(ins)
 }
 
 /// The jump target of an instruction written in mnemonic form.

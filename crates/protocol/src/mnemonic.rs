@@ -184,6 +184,16 @@ fn to_i32(v: i64) -> Option<i32> {
     if (i32::MIN as i64..=u32::MAX as i64).contains(&v) { Some(v as u32 as i32) } else { None }
 }
 
+/// Whether the operands of the instruction's mnemonic cover every non-zero
+/// field (a field the mnemonic has no operand for must be zero).
+pub fn shows_every_field(ins: Instruction) -> bool {
+    let layout = layout(ins.opcode).unwrap_or(&[]);
+    let shows = |f: fn(&Operand) -> bool| layout.iter().any(f);
+    (ins.kind == 0 || shows(|o| matches!(o, Operand::Type | Operand::TypeSymbol(_))))
+        && (ins.motor == 0 || shows(|o| matches!(o, Operand::Motor)))
+        && (ins.value == 0 || shows(|o| matches!(o, Operand::Value | Operand::Address)))
+}
+
 /// Formats an instruction as source text. `label` names jump targets;
 /// pass `|a| a.to_string()` for plain addresses.
 pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
@@ -191,13 +201,8 @@ pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
         return format!("#{} {} {} {}", ins.opcode, ins.kind, ins.motor, ins.value);
     };
     let layout = layout(ins.opcode).unwrap_or(&[]);
-    // A field the mnemonic does not show must be zero, or the text would
-    // not give the same instruction back: then the raw form.
-    let shows = |f: fn(&Operand) -> bool| layout.iter().any(f);
-    let hidden = (ins.kind != 0 && !shows(|o| matches!(o, Operand::Type | Operand::TypeSymbol(_))))
-        || (ins.motor != 0 && !shows(|o| matches!(o, Operand::Motor)))
-        || (ins.value != 0 && !shows(|o| matches!(o, Operand::Value | Operand::Address)));
-    if hidden {
+    if !shows_every_field(ins) {
+        // The text would not give the same instruction back.
         return format!("#{} {} {} {}", ins.opcode, ins.kind, ins.motor, ins.value);
     }
     let parts: Vec<String> = layout
