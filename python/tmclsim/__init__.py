@@ -22,7 +22,7 @@ test a served module. See the README beside this package.
 """
 
 import os
-from typing import Optional, Union
+from typing import Callable, Optional, Union
 
 from . import _tmclsim
 from ._tmclsim import (
@@ -70,12 +70,11 @@ def _switch(which: str) -> str:
 
 class WorldControls:
     """Convenience methods for the world around a module, each one line of
-    the control protocol (docs/world.md) sent through ``world(line)``."""
+    the control protocol (docs/world.md) sent through ``world(line)``,
+    which the native class mixed with this one (``Module``, ``Server``)
+    provides."""
 
-    def world(self, line: str) -> str:
-        """Runs one line of the control protocol (the native classes
-        provide it)."""
-        raise NotImplementedError
+    world: Callable[[str], str]
 
     def set_input(self, n: int, level: Union[bool, int]) -> None:
         """Drives digital input ``n`` high (true) or low."""

@@ -22,6 +22,30 @@ impl Stream for Box<dyn serialport::SerialPort> {
     }
 }
 
+/// Where a module is (a tmclsim server or a real module): TCP or a serial
+/// port, and its address.
+#[derive(clap::Args)]
+pub struct LinkArgs {
+    /// TCP address of the module (a tmclsim server or a serial-to-Ethernet bridge).
+    #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
+    pub tcp: Option<String>,
+    /// Serial port of the module (e.g. /dev/ttyACM0, or a tmclsim pty).
+    #[arg(long, value_name = "DEV")]
+    pub port: Option<String>,
+    /// Baud rate for --port.
+    #[arg(long, default_value_t = 9600)]
+    pub baud: u32,
+    /// Module address.
+    #[arg(long, default_value_t = 1)]
+    pub address: u8,
+}
+
+impl LinkArgs {
+    pub fn open(&self, timeout: Duration) -> Result<Client, String> {
+        Client::open(self.tcp.as_deref(), self.port.as_deref(), self.baud, self.address, timeout)
+    }
+}
+
 pub struct Client {
     stream: Box<dyn Stream>,
     pub address: u8,

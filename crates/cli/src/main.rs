@@ -133,18 +133,8 @@ pub struct WorldArgs {
 
 #[derive(Args)]
 pub struct SendArgs {
-    /// TCP address of the module (a tmclsim server or a serial-to-Ethernet bridge).
-    #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
-    pub tcp: Option<String>,
-    /// Serial port of the module (e.g. /dev/ttyACM0, or a tmclsim pty).
-    #[arg(long, value_name = "DEV")]
-    pub port: Option<String>,
-    /// Baud rate for --port.
-    #[arg(long, default_value_t = 9600)]
-    pub baud: u32,
-    /// Module address.
-    #[arg(long, default_value_t = 1)]
-    pub address: u8,
+    #[command(flatten)]
+    pub link: client::LinkArgs,
     /// How long to wait for the reply, in milliseconds.
     #[arg(long, value_name = "MS", default_value_t = 1000)]
     pub timeout: u64,

@@ -1,6 +1,6 @@
 //! `tmclsim send`: one command to any TMCL module, the reply decoded.
 
-use crate::client::{hex, Client};
+use crate::client::hex;
 use crate::SendArgs;
 use std::process::ExitCode;
 use tmclsim_protocol::{mnemonic, opcode, Reply, Request, Status};
@@ -8,8 +8,8 @@ use tmclsim_protocol::{mnemonic, opcode, Reply, Request, Status};
 pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     let line = args.command.join(" ");
     let ins = mnemonic::parse_line(&line).map_err(|e| format!("{line}: {e}"))?;
-    let mut client = Client::open(args.tcp.as_deref(), args.port.as_deref(), args.baud, args.address, crate::millis(args.timeout))?;
-    println!("request: {}  ({})", hex(&Request::new(args.address, ins).encode()), mnemonic::format(ins));
+    let mut client = args.link.open(crate::millis(args.timeout))?;
+    println!("request: {}  ({})", hex(&Request::new(args.link.address, ins).encode()), mnemonic::format(ins));
     if ins.opcode == opcode::FACTORY_DEFAULTS {
         client.send_only(ins)?;
         println!("(137 sends no reply)");
@@ -23,7 +23,7 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     }
     // 134 answers with the stored instruction in place of the module
     // address, unless it failed.
-    let failed = reply[1] == args.address && reply[2] < 100 && reply[3] == opcode::READ_MEMORY;
+    let failed = reply[1] == args.link.address && reply[2] < 100 && reply[3] == opcode::READ_MEMORY;
     if ins.opcode == opcode::READ_MEMORY && !failed {
         let stored = tmclsim_protocol::Instruction::from_bytes(reply[1..8].try_into().unwrap());
         println!("memory:  {}", mnemonic::format(stored));

@@ -1,7 +1,7 @@
 //! `tmclsim upload`: download a program to any TMCL module, real or
 //! virtual, verify it by reading it back with 134, optionally start it.
 
-use crate::client::{hex, Client};
+use crate::client::hex;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use tmclsim_asm::Program;
@@ -11,17 +11,8 @@ use tmclsim_protocol::{opcode, Instruction, Status};
 pub struct UploadArgs {
     /// TMCL source (.tmc) or binary (.bin, 8 bytes per instruction).
     pub program: PathBuf,
-    /// TCP address of the module.
-    #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
-    pub tcp: Option<String>,
-    /// Serial port of the module.
-    #[arg(long, value_name = "DEV")]
-    pub port: Option<String>,
-    #[arg(long, default_value_t = 9600)]
-    pub baud: u32,
-    /// Module address.
-    #[arg(long, default_value_t = 1)]
-    pub address: u8,
+    #[command(flatten)]
+    pub link: crate::client::LinkArgs,
     /// Profile to check the source against.
     #[arg(long, default_value = "tmcm-1141")]
     pub module: String,
@@ -43,7 +34,7 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
     } else {
         crate::asm::assemble(&args.program, &args.module)?.0.instructions
     };
-    let mut c = Client::open(args.tcp.as_deref(), args.port.as_deref(), args.baud, args.address, crate::millis(args.timeout))?;
+    let mut c = args.link.open(crate::millis(args.timeout))?;
     let ok = |r: tmclsim_protocol::Reply, what: &str| -> Result<(), String> {
         if r.status < 100 {
             let s = Status::from_code(r.status).map_or(r.status.to_string(), |s| s.to_string());
@@ -64,7 +55,7 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
     // Verify by reading every word back.
     for (a, w) in words.iter().enumerate() {
         let raw = c.exchange(Instruction::new(opcode::READ_MEMORY, 0, 0, a as i32))?;
-        if raw[1] == args.address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
+        if raw[1] == args.link.address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
             return Err(format!("read-back of word {a}: status {} (code protection?)", raw[2]));
         }
         let stored = Instruction::from_bytes(raw[1..8].try_into().unwrap());
