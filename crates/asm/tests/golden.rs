@@ -1,4 +1,4 @@
-//! The golden frames of /work/shared/reference/tmcm-1141-frames.md: each
+//! The golden frames of the TMCM-1141 firmware manual: each
 //! mnemonic assembles to the frame's seven instruction bytes, and its
 //! binary word carries the frame checksum minus the address byte (01).
 
