@@ -13,7 +13,8 @@ fuzz_target!(|data: &[u8]| {
     match assemble(source, "fuzz.tmc", &NoIncludes, Some(&profile)) {
         Ok(program) => {
             let text = program.disassemble();
-            let again = assemble(&text, "again.tmc", &NoIncludes, None).unwrap_or_else(|e| panic!("disassembly does not assemble: {e:?}\n{text}"));
+            let again =
+                assemble(&text, "again.tmc", &NoIncludes, None).unwrap_or_else(|e| panic!("disassembly does not assemble: {e:?}\n{text}"));
             assert_eq!(again.instructions, program.instructions, "\n{text}");
         }
         Err(diagnostics) => {

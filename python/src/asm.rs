@@ -1,7 +1,7 @@
 //! The assembler and disassembler: `Program`, `assemble`, `disassemble`.
 
 use crate::errors::{assembly_error, value_error};
-use crate::types::{instruction_from, Instruction};
+use crate::types::{Instruction, instruction_from};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes, PyString};
 use std::collections::BTreeMap;
@@ -52,7 +52,8 @@ pub fn program_from(obj: &Bound<'_, PyAny>, profile: Option<&Arc<Profile>>) -> P
     }
     if let Ok(text) = obj.cast::<PyString>() {
         let text = text.to_cow()?;
-        return tmclsim_asm::assemble(&text, "program.tmc", &FileResolver::new(), profile.map(|p| p.as_ref())).map_err(|d| assembly_error(py, &d));
+        return tmclsim_asm::assemble(&text, "program.tmc", &FileResolver::new(), profile.map(|p| p.as_ref()))
+            .map_err(|d| assembly_error(py, &d));
     }
     if obj.is_instance_of::<PyBytes>() || obj.is_instance_of::<PyByteArray>() {
         let bytes: Vec<u8> = obj.extract()?;
@@ -174,9 +175,16 @@ impl Program {
 /// ``AssemblyError`` with every diagnostic.
 #[pyfunction]
 #[pyo3(signature = (source, profile=Some("tmcm-1141"), file_name="program.tmc", include_path=None))]
-pub fn assemble(py: Python<'_>, source: &str, profile: Option<&str>, file_name: &str, include_path: Option<Vec<PathBuf>>) -> PyResult<Program> {
+pub fn assemble(
+    py: Python<'_>,
+    source: &str,
+    profile: Option<&str>,
+    file_name: &str,
+    include_path: Option<Vec<PathBuf>>,
+) -> PyResult<Program> {
     let profile = profile_by_name(profile)?;
-    let inner = tmclsim_asm::assemble(source, file_name, &resolver(include_path), profile.as_deref()).map_err(|d| assembly_error(py, &d))?;
+    let inner =
+        tmclsim_asm::assemble(source, file_name, &resolver(include_path), profile.as_deref()).map_err(|d| assembly_error(py, &d))?;
     Ok(Program { inner })
 }
 

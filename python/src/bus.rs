@@ -1,11 +1,11 @@
 //! `Bus`: several modules on one link, as on an RS485 bus.
 
 use crate::errors::value_error;
-use crate::module::{seconds_to_ns, served_error, Module};
-use crate::types::{command_from, ReplyKind, Reply};
+use crate::module::{Module, seconds_to_ns, served_error};
+use crate::types::{Reply, ReplyKind, command_from};
 use pyo3::prelude::*;
 use std::borrow::Cow;
-use tmclsim_protocol::{Request, FRAME_LEN};
+use tmclsim_protocol::{FRAME_LEN, Request};
 
 /// Several modules on one link: every frame reaches every module, the
 /// addressed one answers.
@@ -73,7 +73,8 @@ impl Bus {
     /// Puts nine bytes on the bus: every module sees them, the addressed
     /// one answers (None: nobody answered).
     fn send_frame(&self, py: Python<'_>, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
-        let frame: &[u8; FRAME_LEN] = frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
+        let frame: &[u8; FRAME_LEN] =
+            frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
         let mut answer = None;
         for m in &self.modules {
             let reply = m.bind(py).try_borrow_mut()?.handle_frame(frame)?;
@@ -88,7 +89,15 @@ impl Bus {
     /// Sends one command to ``address`` on the bus; ``command`` as in
     /// ``Module.send``.
     #[pyo3(signature = (address, command, r#type=None, motor=None, value=None))]
-    fn send(&self, py: Python<'_>, address: u8, command: &Bound<'_, PyAny>, r#type: Option<u8>, motor: Option<u8>, value: Option<i64>) -> PyResult<Option<Reply>> {
+    fn send(
+        &self,
+        py: Python<'_>,
+        address: u8,
+        command: &Bound<'_, PyAny>,
+        r#type: Option<u8>,
+        motor: Option<u8>,
+        value: Option<i64>,
+    ) -> PyResult<Option<Reply>> {
         let ins = command_from(command, r#type, motor, value)?;
         let frame = Request::new(address, ins).encode();
         let reply = self.send_frame(py, Cow::Borrowed(&frame))?;
@@ -138,7 +147,11 @@ impl Bus {
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {
-        let addresses: Vec<String> = self.modules.iter().map(|m| m.bind(py).try_borrow_mut().ok().and_then(|mut m| m.address_now().ok()).map_or("?".into(), |a| a.to_string())).collect();
+        let addresses: Vec<String> = self
+            .modules
+            .iter()
+            .map(|m| m.bind(py).try_borrow_mut().ok().and_then(|mut m| m.address_now().ok()).map_or("?".into(), |a| a.to_string()))
+            .collect();
         format!("<tmclsim.Bus addresses {}>", addresses.join(", "))
     }
 }

@@ -6,10 +6,10 @@
 //! reaches it through the server's lock; when the server stops, the
 //! module comes back.
 
-use crate::asm::{program_from, Program};
+use crate::asm::{Program, program_from};
 use crate::errors::{os_error, tmcl_error, value_error};
-use crate::names::{snake_case, Names};
-use crate::types::{command_from, ReplyKind, Registers, Reply};
+use crate::names::{Names, snake_case};
+use crate::types::{Registers, Reply, ReplyKind, command_from};
 use crate::world;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -22,7 +22,7 @@ use tmclsim_firmware::eeprom::save_atomic;
 use tmclsim_firmware::profile::{Access, Parameter};
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
-use tmclsim_protocol::{opcode, Instruction as Ins, Request, Status, FRAME_LEN};
+use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Request, Status, opcode};
 use tmclsim_server::SharedModule;
 
 /// Where the module is. (A served module needs no room: boxing the local
@@ -73,7 +73,8 @@ impl Module {
                 if module.eeprom_generation() != self.saved_generation {
                     self.saved_generation = module.eeprom_generation();
                     if let Some(path) = &self.eeprom_path {
-                        save_atomic(path, module.eeprom()).map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", path.display())))?;
+                        save_atomic(path, module.eeprom())
+                            .map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", path.display())))?;
                     }
                 }
                 Ok(r)
@@ -138,7 +139,9 @@ impl Module {
             Backend::Local { module, .. } => py.detach(|| module.advance(ns)),
             Backend::Served { shared, .. } => {
                 if !shared.is_stepped() {
-                    return Err(PyRuntimeError::new_err("the module is served in real time: set server.stepped = True to move virtual time by hand"));
+                    return Err(PyRuntimeError::new_err(
+                        "the module is served in real time: set server.stepped = True to move virtual time by hand",
+                    ));
                 }
                 let shared = shared.clone();
                 py.detach(|| shared.advance(ns));
@@ -171,9 +174,15 @@ impl Module {
         let detail = match (status, spec) {
             (Status::WrongType, None) => Some("the module has no such parameter".to_string()),
             (Status::WrongType, Some(p)) if write && !p.access.write => Some(format!("it is read-only (access {})", access_text(p.access))),
-            (Status::WrongType, Some(p)) if !write && !p.access.read => Some(format!("it cannot be read (access {})", access_text(p.access))),
-            (Status::InvalidValue, Some(p)) if write && motor_or_bank.is_none() => Some(format!("the value must be in {}…{}", p.min, p.max)),
-            (Status::InvalidValue, _) => motor_or_bank.map(|(what, n)| format!("{what} {n} does not exist on the {}", self.profile.module.name)),
+            (Status::WrongType, Some(p)) if !write && !p.access.read => {
+                Some(format!("it cannot be read (access {})", access_text(p.access)))
+            }
+            (Status::InvalidValue, Some(p)) if write && motor_or_bank.is_none() => {
+                Some(format!("the value must be in {}…{}", p.min, p.max))
+            }
+            (Status::InvalidValue, _) => {
+                motor_or_bank.map(|(what, n)| format!("{what} {n} does not exist on the {}", self.profile.module.name))
+            }
             _ => None,
         };
         if let Some(d) = detail {
@@ -197,7 +206,11 @@ impl Module {
     fn program_instruction(&mut self, py: Python<'_>, ins: Ins) -> PyResult<i32> {
         let outcome = self.with(|m| m.execute(ins))?;
         if outcome.status.is_error() {
-            return Err(tmcl_error(py, outcome.status, format!("{}: {} (status {})", tmclsim_protocol::mnemonic::format(ins), outcome.status.describe(), outcome.status.code())));
+            return Err(tmcl_error(
+                py,
+                outcome.status,
+                format!("{}: {} (status {})", tmclsim_protocol::mnemonic::format(ins), outcome.status.describe(), outcome.status.code()),
+            ));
         }
         Ok(outcome.value)
     }
@@ -388,7 +401,8 @@ impl Module {
     /// filter, checksum, download mode) and returns the nine bytes it
     /// answers, or None.
     fn send_frame(&mut self, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
-        let frame: &[u8; FRAME_LEN] = frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
+        let frame: &[u8; FRAME_LEN] =
+            frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
         self.handle_frame(frame)
     }
 
@@ -422,7 +436,13 @@ impl Module {
         match self.with(|m| m.get_axis_parameter(number, motor))? {
             Ok(v) => Ok(v),
             Err(status) => {
-                let text = self.explain(status, format!("GAP {number}, {motor}"), self.profile.axis_parameter(number), false, (motor >= self.profile.module.axes).then_some(("motor", motor)));
+                let text = self.explain(
+                    status,
+                    format!("GAP {number}, {motor}"),
+                    self.profile.axis_parameter(number),
+                    false,
+                    (motor >= self.profile.module.axes).then_some(("motor", motor)),
+                );
                 Err(tmcl_error(param.py(), status, text))
             }
         }
@@ -440,7 +460,13 @@ impl Module {
         match self.with(|m| m.set_axis_parameter(number, motor, word))? {
             Ok(()) => Ok(()),
             Err(status) => {
-                let text = self.explain(status, format!("SAP {number}, {motor}, {value}"), self.profile.axis_parameter(number), true, (motor >= self.profile.module.axes).then_some(("motor", motor)));
+                let text = self.explain(
+                    status,
+                    format!("SAP {number}, {motor}, {value}"),
+                    self.profile.axis_parameter(number),
+                    true,
+                    (motor >= self.profile.module.axes).then_some(("motor", motor)),
+                );
                 Err(tmcl_error(param.py(), status, text))
             }
         }
@@ -457,7 +483,13 @@ impl Module {
         match self.with(|m| m.get_global_parameter(number, bank))? {
             Ok(v) => Ok(v),
             Err(status) => {
-                let text = self.explain(status, format!("GGP {number}, {bank}"), self.profile.global_parameter(bank, number), false, (!self.profile.has_bank(bank)).then_some(("bank", bank)));
+                let text = self.explain(
+                    status,
+                    format!("GGP {number}, {bank}"),
+                    self.profile.global_parameter(bank, number),
+                    false,
+                    (!self.profile.has_bank(bank)).then_some(("bank", bank)),
+                );
                 Err(tmcl_error(param.py(), status, text))
             }
         }
@@ -474,7 +506,13 @@ impl Module {
         match self.with(|m| m.set_global_parameter(number, bank, word))? {
             Ok(()) => Ok(()),
             Err(status) => {
-                let text = self.explain(status, format!("SGP {number}, {bank}, {value}"), self.profile.global_parameter(bank, number), true, (!self.profile.has_bank(bank)).then_some(("bank", bank)));
+                let text = self.explain(
+                    status,
+                    format!("SGP {number}, {bank}, {value}"),
+                    self.profile.global_parameter(bank, number),
+                    true,
+                    (!self.profile.has_bank(bank)).then_some(("bank", bank)),
+                );
                 Err(tmcl_error(param.py(), status, text))
             }
         }
@@ -620,7 +658,8 @@ impl Module {
         let capacity = self.profile.module.program_memory;
         let loaded = self.with(|m| m.load_program(&program.instructions))?;
         if loaded.is_err() {
-            let message = format!("the program has {} instructions; the {} holds {capacity}", program.instructions.len(), self.profile.module.name);
+            let message =
+                format!("the program has {} instructions; the {} holds {capacity}", program.instructions.len(), self.profile.module.name);
             return Err(tmcl_error(py, Status::InvalidValue, message));
         }
         self.program_instruction(py, Ins::new(opcode::RESET_APPLICATION, 0, 0, 0))?;
@@ -802,7 +841,9 @@ impl Module {
     fn __repr__(&mut self) -> String {
         let place = if self.is_served() { "served" } else { "in process" };
         match self.with(|m| (m.address(), m.now_ns())) {
-            Ok((address, ns)) => format!("<tmclsim.Module {} address {address}, {place}, t = {:.6} s>", self.profile.module.name, ns as f64 * 1e-9),
+            Ok((address, ns)) => {
+                format!("<tmclsim.Module {} address {address}, {place}, t = {:.6} s>", self.profile.module.name, ns as f64 * 1e-9)
+            }
             Err(_) => format!("<tmclsim.Module {}>", self.profile.module.name),
         }
     }
@@ -813,7 +854,10 @@ impl Module {
         if motor < self.profile.module.axes as usize {
             Ok(())
         } else {
-            Err(value_error(format!("motor {motor} does not exist on the {} ({} axis)", self.profile.module.name, self.profile.module.axes)))
+            Err(value_error(format!(
+                "motor {motor} does not exist on the {} ({} axis)",
+                self.profile.module.name, self.profile.module.axes
+            )))
         }
     }
 }

@@ -52,7 +52,11 @@ impl Names {
     /// The number of the axis parameter with this name.
     pub fn axis(&self, name: &str) -> Result<u8, String> {
         let Some((full, numbers)) = self.axis.get(&key(name)) else {
-            return Err(format!("the {} has no axis parameter named '{name}'{}", self.module, suggest(name, self.axis.values().map(|v| v.0.as_str()))));
+            return Err(format!(
+                "the {} has no axis parameter named '{name}'{}",
+                self.module,
+                suggest(name, self.axis.values().map(|v| v.0.as_str()))
+            ));
         };
         match numbers.as_slice() {
             [n] => Ok(*n),
@@ -64,13 +68,22 @@ impl Names {
     /// when given, must agree.
     pub fn global(&self, name: &str, bank: Option<u8>) -> Result<(u8, u8), String> {
         let Some((full, places)) = self.global.get(&key(name)) else {
-            return Err(format!("the {} has no global parameter named '{name}'{}", self.module, suggest(name, self.global.values().map(|v| v.0.as_str()))));
+            return Err(format!(
+                "the {} has no global parameter named '{name}'{}",
+                self.module,
+                suggest(name, self.global.values().map(|v| v.0.as_str()))
+            ));
         };
         let matching: Vec<(u8, u8)> = places.iter().copied().filter(|(b, _)| bank.is_none_or(|want| *b == want)).collect();
         match matching.as_slice() {
             [one] => Ok(*one),
             [] => Err(format!("'{full}' is a parameter of bank {}, not of bank {}", places[0].0, bank.unwrap_or(0))),
-            many => Err(format!("'{full}' names global parameters {}…{} of bank {}: give the number", many[0].1, many[many.len() - 1].1, many[0].0)),
+            many => Err(format!(
+                "'{full}' names global parameters {}…{} of bank {}: give the number",
+                many[0].1,
+                many[many.len() - 1].1,
+                many[0].0
+            )),
         }
     }
 }

@@ -6,15 +6,15 @@
 
 use crate::bus::Bus;
 use crate::errors::{os_error, value_error};
-use crate::module::{seconds_to_ns, served_error, Module};
+use crate::module::{Module, seconds_to_ns, served_error};
 use crate::world;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 use std::net::{SocketAddr, ToSocketAddrs};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 use tmclsim_firmware::Module as FwModule;
 use tmclsim_server::{Endpoints, LinkFaults, ServerConfig, ServerHandle, SharedModule};
@@ -96,11 +96,7 @@ pub struct Server {
 
 impl Server {
     fn live(&self) -> PyResult<&Arc<SharedModule>> {
-        if self.handle.is_some() {
-            Ok(&self.shared)
-        } else {
-            Err(PyRuntimeError::new_err("the server is stopped"))
-        }
+        if self.handle.is_some() { Ok(&self.shared) } else { Err(PyRuntimeError::new_err("the server is stopped")) }
     }
 
     /// Stops serving and gives the modules back to their `Module` objects.
@@ -129,7 +125,15 @@ impl Drop for Server {
 impl Server {
     #[new]
     #[pyo3(signature = (target, tcp=Endpoint::On, pty=Endpoint::Off, control=Endpoint::On, stepped=false, wire_timing=false))]
-    fn py_new(py: Python<'_>, target: &Bound<'_, PyAny>, tcp: Endpoint, pty: Endpoint, control: Endpoint, stepped: bool, wire_timing: bool) -> PyResult<Server> {
+    fn py_new(
+        py: Python<'_>,
+        target: &Bound<'_, PyAny>,
+        tcp: Endpoint,
+        pty: Endpoint,
+        control: Endpoint,
+        stepped: bool,
+        wire_timing: bool,
+    ) -> PyResult<Server> {
         let modules: Vec<Py<Module>> = if let Ok(m) = target.cast::<Module>() {
             vec![m.clone().unbind()]
         } else if let Ok(bus) = target.cast::<Bus>() {
@@ -294,7 +298,15 @@ impl Server {
     /// ``delay_ms`` every reply, ``mute`` all replies; ``clear`` first
     /// removes every fault. Returns the faults in force.
     #[pyo3(signature = (drop=None, corrupt=None, delay_ms=None, mute=None, clear=false))]
-    fn link_faults<'py>(&self, py: Python<'py>, drop: Option<u32>, corrupt: Option<u32>, delay_ms: Option<u64>, mute: Option<bool>, clear: bool) -> PyResult<Bound<'py, PyDict>> {
+    fn link_faults<'py>(
+        &self,
+        py: Python<'py>,
+        drop: Option<u32>,
+        corrupt: Option<u32>,
+        delay_ms: Option<u64>,
+        mute: Option<bool>,
+        clear: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let shared = self.live()?;
         let mut f = if clear { LinkFaults::default() } else { shared.link_faults() };
         if let Some(n) = drop {
@@ -349,7 +361,13 @@ impl Server {
         if let Some(c) = self.control() {
             parts.push(format!("control {c}"));
         }
-        let state = if self.handle.is_none() { "stopped" } else if self.shared.is_stepped() { "stepped" } else { "real time" };
+        let state = if self.handle.is_none() {
+            "stopped"
+        } else if self.shared.is_stepped() {
+            "stepped"
+        } else {
+            "real time"
+        };
         format!("<tmclsim.Server {} module(s), {}, {state}>", self.modules.len(), parts.join(", "))
     }
 }

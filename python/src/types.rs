@@ -5,8 +5,8 @@ use crate::errors::{tmcl_error, value_error};
 use pyo3::prelude::*;
 use pyo3::types::{PyInt, PySequence, PyString};
 use std::borrow::Cow;
-use tmclsim_firmware::module::{error_flag, Compare};
-use tmclsim_protocol::{checksum, mnemonic, opcode, Instruction as Ins, Status, FRAME_LEN};
+use tmclsim_firmware::module::{Compare, error_flag};
+use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Status, checksum, mnemonic, opcode};
 
 /// What kind of frame a reply is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -27,7 +27,8 @@ impl ReplyKind {
             opcode::READ_MEMORY => {
                 // An error answer to 134 is a normal reply; a memory word
                 // that looks exactly like one cannot be told apart.
-                let normal_error = frame[1] == address && frame[3] == opcode::READ_MEMORY && frame[2] < 100 && checksum(&frame[..8]) == frame[8];
+                let normal_error =
+                    frame[1] == address && frame[3] == opcode::READ_MEMORY && frame[2] < 100 && checksum(&frame[..8]) == frame[8];
                 if normal_error { ReplyKind::Normal } else { ReplyKind::Memory }
             }
             _ => ReplyKind::Normal,
@@ -83,7 +84,8 @@ impl Reply {
     #[new]
     #[pyo3(signature = (raw, special=None))]
     fn py_new(raw: Cow<'_, [u8]>, special: Option<&str>) -> PyResult<Reply> {
-        let raw: [u8; FRAME_LEN] = raw.as_ref().try_into().map_err(|_| value_error(format!("a reply is {FRAME_LEN} bytes, not {}", raw.len())))?;
+        let raw: [u8; FRAME_LEN] =
+            raw.as_ref().try_into().map_err(|_| value_error(format!("a reply is {FRAME_LEN} bytes, not {}", raw.len())))?;
         let kind = match special {
             None => ReplyKind::Normal,
             Some("version") => ReplyKind::Version,
@@ -207,7 +209,9 @@ impl Reply {
     fn __repr__(&self) -> String {
         match self.kind {
             ReplyKind::Version => format!("<Reply version {:?} host={}>", String::from_utf8_lossy(&self.raw[1..]), self.raw[0]),
-            ReplyKind::Memory => format!("<Reply memory {} host={}>", exact_text(Ins::from_bytes(self.raw[1..8].try_into().unwrap())), self.raw[0]),
+            ReplyKind::Memory => {
+                format!("<Reply memory {} host={}>", exact_text(Ins::from_bytes(self.raw[1..8].try_into().unwrap())), self.raw[0])
+            }
             ReplyKind::Normal => format!(
                 "<Reply status={} ({}) value={} opcode={} module={} host={}>",
                 self.raw[2],
@@ -370,7 +374,9 @@ pub fn command_from(command: &Bound<'_, PyAny>, kind: Option<u8>, motor: Option<
         return Ok(Ins::new(opcode, kind.unwrap_or(0), motor.unwrap_or(0), wire_value(value.unwrap_or(0))?));
     }
     if kind.is_some() || motor.is_some() || value.is_some() {
-        return Err(pyo3::exceptions::PyTypeError::new_err("type, motor and value go with a numeric opcode: send(opcode, type, motor, value)"));
+        return Err(pyo3::exceptions::PyTypeError::new_err(
+            "type, motor and value go with a numeric opcode: send(opcode, type, motor, value)",
+        ));
     }
     instruction_from(command)
 }

@@ -9,7 +9,7 @@
 
 use std::sync::Arc;
 use tmclsim_firmware::Module;
-use tmclsim_server::{control, SharedModule};
+use tmclsim_server::{SharedModule, control};
 
 /// Whether a control line changes the link rather than a module's world.
 fn is_link_command(line: &str) -> bool {

@@ -5,16 +5,16 @@
 use std::collections::HashSet;
 
 use tmclsim_firmware::Profile;
-use tmclsim_protocol::{opcode as op, Instruction};
+use tmclsim_protocol::{Instruction, opcode as op};
 
+use crate::Program;
 use crate::check::check;
 use crate::diagnostic::{Diagnostic, Loc, Reporter};
 use crate::encoder::{encode, encode_raw};
 use crate::eval::Evaluator;
-use crate::include::{built_in, IncludeResolver};
+use crate::include::{IncludeResolver, built_in};
 use crate::lexer::strip_comments;
-use crate::parser::{parse_line, Body};
-use crate::Program;
+use crate::parser::{Body, parse_line};
 
 /// How deeply includes may nest (a cycle is reported before this).
 const MAX_INCLUDE_DEPTH: usize = 64;
@@ -104,7 +104,12 @@ impl Loader<'_> {
 /// Assembles a TMCL source text. `file_name` names it in diagnostics and
 /// is the base for relative `#include`s. With a profile, every instruction
 /// is also checked against that module.
-pub fn assemble(source: &str, file_name: &str, resolver: &dyn IncludeResolver, profile: Option<&Profile>) -> Result<Program, Vec<Diagnostic>> {
+pub fn assemble(
+    source: &str,
+    file_name: &str,
+    resolver: &dyn IncludeResolver,
+    profile: Option<&Profile>,
+) -> Result<Program, Vec<Diagnostic>> {
     let mut loader = Loader { resolver, reporter: Reporter::default(), statements: Vec::new(), stack: Vec::new(), seen: HashSet::new() };
     loader.load(resolver.key(file_name), file_name, source);
     let Loader { mut reporter, statements, .. } = loader;
@@ -149,7 +154,11 @@ pub fn assemble(source: &str, file_name: &str, resolver: &dyn IncludeResolver, p
             Body::Raw { fields, end_column, column } => {
                 let word = encode_raw(fields, *end_column, st.loc, &mut evaluator, &mut reporter).unwrap_or_default();
                 if profile.is_some() && op::is_control(word.opcode) {
-                    let message = format!("control command {} ({}) cannot be stored in a program: during download the module executes it", word.opcode, op::name(word.opcode));
+                    let message = format!(
+                        "control command {} ({}) cannot be stored in a program: during download the module executes it",
+                        word.opcode,
+                        op::name(word.opcode)
+                    );
                     reporter.error(st.loc, *column, message);
                 }
                 word
@@ -160,7 +169,10 @@ pub fn assemble(source: &str, file_name: &str, resolver: &dyn IncludeResolver, p
         if let Some(profile) = profile {
             let capacity = profile.module.program_memory as usize;
             if instructions.len() == capacity {
-                let message = format!("the program has more than {capacity} instructions; the program memory of the {} holds {capacity}", profile.module.name);
+                let message = format!(
+                    "the program has more than {capacity} instructions; the program memory of the {} holds {capacity}",
+                    profile.module.name
+                );
                 reporter.error(st.loc, first_column(&st.body), message);
             }
         }

@@ -3,7 +3,7 @@
 //! the seven bytes before it. It is a TMCL request frame without the
 //! address byte, so a host can download it word by word.
 
-use tmclsim_protocol::{checksum, Instruction};
+use tmclsim_protocol::{Instruction, checksum};
 
 /// Bytes per instruction in a binary file.
 pub const WORD_LEN: usize = 8;

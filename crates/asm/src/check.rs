@@ -8,8 +8,8 @@
 //! command with an error status (decisions.md rule 6) and skip it in a
 //! program (rule 21).
 
-use tmclsim_firmware::profile::{Access, Parameter, PortDirection};
 use tmclsim_firmware::Profile;
+use tmclsim_firmware::profile::{Access, Parameter, PortDirection};
 use tmclsim_protocol::opcode as op;
 
 use crate::encoder::Encoded;
@@ -235,7 +235,11 @@ impl<'a> Checker<'a> {
         }
         if self.profile.interrupt(number).is_none() {
             let known: Vec<String> = self.profile.interrupts.iter().filter(|i| i.number != 255).map(|i| i.number.to_string()).collect();
-            let message = format!("interrupt {number} does not exist on the {} (interrupts: {}; see Interrupts.inc)", self.module(), known.join(", "));
+            let message = format!(
+                "interrupt {number} does not exist on the {} (interrupts: {}; see Interrupts.inc)",
+                self.module(),
+                known.join(", ")
+            );
             self.report(self.e.type_column, message);
         }
     }
@@ -275,7 +279,8 @@ impl<'a> Checker<'a> {
             return;
         };
         if !port_ok {
-            let mut numbers: Vec<String> = ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Input).map(|p| p.number.to_string()).collect();
+            let mut numbers: Vec<String> =
+                ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Input).map(|p| p.number.to_string()).collect();
             if has(PortDirection::Output) {
                 numbers.push("255".into());
             }
@@ -293,7 +298,8 @@ impl<'a> Checker<'a> {
 
     /// GIO: an input, an output read back, or 255 (all lines of the bank).
     fn input(&mut self, port: u8, bank: u8) {
-        let in_bank: Vec<u8> = self.profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup).map(|p| p.number).collect();
+        let in_bank: Vec<u8> =
+            self.profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup).map(|p| p.number).collect();
         if in_bank.is_empty() {
             let message = format!("bank {bank} has no inputs or outputs on the {}", self.module());
             self.report(self.e.motor_column, message);

@@ -12,8 +12,8 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
 
-use tmclsim_protocol::mnemonic::{format_with, layout, shows_every_field, Operand};
-use tmclsim_protocol::{opcode as op, Command, Instruction};
+use tmclsim_protocol::mnemonic::{Operand, format_with, layout, shows_every_field};
+use tmclsim_protocol::{Command, Instruction, opcode as op};
 
 /// Column where the `// address` comments start.
 const COMMENT_COLUMN: usize = 40;
@@ -67,7 +67,12 @@ fn labels(instructions: &[Instruction], symbols: Option<&BTreeMap<String, u32>>)
 pub fn disassemble(instructions: &[Instruction], symbols: Option<&BTreeMap<String, u32>>) -> String {
     let labels = labels(instructions, symbols);
     let label_of = |address: i32| -> String {
-        u32::try_from(address).ok().and_then(|a| labels.get(&a)).and_then(|names| names.first()).cloned().unwrap_or_else(|| address.to_string())
+        u32::try_from(address)
+            .ok()
+            .and_then(|a| labels.get(&a))
+            .and_then(|names| names.first())
+            .cloned()
+            .unwrap_or_else(|| address.to_string())
     };
     let mut out = String::new();
     let _ = writeln!(out, "// TMCL program disassembled by tmclsim-asm: {} instruction(s).", instructions.len());
@@ -109,7 +114,12 @@ mod tests {
 
     #[test]
     fn labels_for_targets() {
-        let program = [Instruction::new(op::MVP, 0, 0, 100), Instruction::new(op::JA, 0, 0, 0), Instruction::new(op::JC, 5, 0, 2), Instruction::new(op::JA, 0, 0, 99)];
+        let program = [
+            Instruction::new(op::MVP, 0, 0, 100),
+            Instruction::new(op::JA, 0, 0, 0),
+            Instruction::new(op::JC, 5, 0, 2),
+            Instruction::new(op::JA, 0, 0, 99),
+        ];
         let text = disassemble(&program, None);
         assert!(text.contains("L0:\n    MVP ABS, 0, 100"), "{text}");
         assert!(text.contains("JA L0"), "{text}");

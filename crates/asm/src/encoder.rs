@@ -7,10 +7,10 @@
 //! has the type (`Command::decode`). What a particular module has is
 //! checked in `check.rs`.
 
-use tmclsim_protocol::mnemonic::{layout, Operand, CALC_OPS, CONDITIONS, ERROR_FLAGS, MOVE_MODES, RFS_ACTIONS, WAIT_CONDITIONS};
-use tmclsim_protocol::{opcode as op, Command, Instruction};
+use tmclsim_protocol::mnemonic::{CALC_OPS, CONDITIONS, ERROR_FLAGS, MOVE_MODES, Operand, RFS_ACTIONS, WAIT_CONDITIONS, layout};
+use tmclsim_protocol::{Command, Instruction, opcode as op};
 
-use crate::diagnostic::{suggestion, Loc, Reporter};
+use crate::diagnostic::{Loc, Reporter, suggestion};
 use crate::eval::{Evaluator, Expect, Reported};
 use crate::expr::Expr;
 
@@ -126,12 +126,20 @@ pub fn encode(
         let at = operands.get(slots.len()).map_or(end_column, |e| e.column);
         let message = match slots.len() {
             0 => format!("{name} takes no operands, found {}", operands.len()),
-            n => format!("{name} takes {n} operand{} ({}), found {}", if n == 1 { "" } else { "s" }, operand_summary(opcode), operands.len()),
+            n => {
+                format!("{name} takes {n} operand{} ({}), found {}", if n == 1 { "" } else { "s" }, operand_summary(opcode), operands.len())
+            }
         };
         reporter.error(loc, at, message);
         return Err(Reported);
     }
-    let mut out = Encoded { instruction: Instruction::new(opcode, 0, 0, 0), mnemonic_column: column, type_column: column, motor_column: column, value_column: column };
+    let mut out = Encoded {
+        instruction: Instruction::new(opcode, 0, 0, 0),
+        mnemonic_column: column,
+        type_column: column,
+        motor_column: column,
+        value_column: column,
+    };
     let mut failed = false;
     for (&slot, expr) in slots.iter().zip(operands) {
         let what = operand_name(opcode, slot);
@@ -166,13 +174,22 @@ pub fn encode(
 /// Evaluates one operand for its slot; the result fits the field (bytes
 /// 0…255, values as the 32-bit word).
 #[allow(clippy::too_many_arguments)]
-fn operand(opcode: u8, slot: Operand, what: &str, expr: &Expr, loc: Loc, evaluator: &mut Evaluator, reporter: &mut Reporter) -> Result<i64, Reported> {
+fn operand(
+    opcode: u8,
+    slot: Operand,
+    what: &str,
+    expr: &Expr,
+    loc: Loc,
+    evaluator: &mut Evaluator,
+    reporter: &mut Reporter,
+) -> Result<i64, Reported> {
     if let (Operand::TypeSymbol(table), Some(word)) = (slot, expr.as_name()) {
         if let Some(i) = table.iter().position(|s| s.eq_ignore_ascii_case(word)) {
             return Ok(i as i64);
         }
         if !evaluator.is_defined(word) {
-            let message = format!("'{word}' is not a {} ({}){}", table_name(table), table.join(", "), suggestion(word, table.iter().copied()));
+            let message =
+                format!("'{word}' is not a {} ({}){}", table_name(table), table.join(", "), suggestion(word, table.iter().copied()));
             reporter.error(loc, expr.column, message);
             return Err(Reported);
         }
@@ -232,7 +249,13 @@ fn wrong_type_message(opcode: u8, kind: u8) -> String {
 }
 
 /// Encodes a raw word (`#db opcode, type, motor, value`).
-pub fn encode_raw(fields: &[Expr], end_column: usize, loc: Loc, evaluator: &mut Evaluator, reporter: &mut Reporter) -> Result<Instruction, Reported> {
+pub fn encode_raw(
+    fields: &[Expr],
+    end_column: usize,
+    loc: Loc,
+    evaluator: &mut Evaluator,
+    reporter: &mut Reporter,
+) -> Result<Instruction, Reported> {
     if fields.len() != 4 {
         let at = fields.get(4).map_or(end_column, |e| e.column);
         reporter.error(loc, at, format!("a raw word is '#db opcode, type, motor, value' (4 fields), found {}", fields.len()));
@@ -282,7 +305,10 @@ mod tests {
 
     #[test]
     fn wrong_types() {
-        assert_eq!(wrong_type_message(op::CALC, 10), "SWAP cannot be used with CALC (valid: ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, LOAD)");
+        assert_eq!(
+            wrong_type_message(op::CALC, 10),
+            "SWAP cannot be used with CALC (valid: ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, LOAD)"
+        );
         assert!(wrong_type_message(op::MVP, 7).starts_with("7 is not a valid move mode for MVP"));
     }
 

@@ -9,8 +9,8 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use crate::diagnostic::{suggestion, Loc, Reporter};
-use crate::expr::{apply, Expr, ExprKind};
+use crate::diagnostic::{Loc, Reporter, suggestion};
+use crate::expr::{Expr, ExprKind, apply};
 
 /// An error that has already been reported.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -112,7 +112,11 @@ impl Evaluator {
 
     fn eval_inner(&mut self, expr: &Expr, loc: Loc, expect: Expect, reporter: &mut Reporter) -> Result<i64, Reported> {
         if self.depth > MAX_DEPTH {
-            reporter.error(loc, expr.column, format!("expression nested too deeply (more than {MAX_DEPTH} levels, counting constants defined through other constants)"));
+            reporter.error(
+                loc,
+                expr.column,
+                format!("expression nested too deeply (more than {MAX_DEPTH} levels, counting constants defined through other constants)"),
+            );
             return Err(Reported);
         }
         let fail = |reporter: &mut Reporter, column: usize, message: String| {
@@ -203,7 +207,7 @@ impl Evaluator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::parser::{parse_line, Body};
+    use crate::parser::{Body, parse_line};
 
     fn expr(text: &str) -> Expr {
         match parse_line(&format!("X = {text}")).0.body {

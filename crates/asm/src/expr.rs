@@ -124,7 +124,8 @@ impl<'t> ExprParser<'t> {
             if precedence < min_precedence {
                 break;
             }
-            let starts_new_operand = self.blank_separated && matches!(p, Punct::Plus | Punct::Minus) && token.space_before && !token.space_after;
+            let starts_new_operand =
+                self.blank_separated && matches!(p, Punct::Plus | Punct::Minus) && token.space_before && !token.space_after;
             if starts_new_operand {
                 break;
             }

@@ -229,13 +229,16 @@ mod tests {
         assert_eq!(t.iter().map(|t| t.column).collect::<Vec<_>>(), vec![1, 5, 7, 11, 14, 16, 17, 19]);
         assert_eq!(t[7].kind, TokenKind::Number(16));
         assert_eq!(kinds("#include x"), vec![TokenKind::Directive("include".into()), TokenKind::Ident("x".into())]);
-        assert_eq!(kinds("1<<2 0x1F 12ab"), vec![
-            TokenKind::Number(1),
-            TokenKind::Punct(Punct::ShiftLeft),
-            TokenKind::Number(2),
-            TokenKind::Number(31),
-            TokenKind::BadNumber("12ab".into()),
-        ]);
+        assert_eq!(
+            kinds("1<<2 0x1F 12ab"),
+            vec![
+                TokenKind::Number(1),
+                TokenKind::Punct(Punct::ShiftLeft),
+                TokenKind::Number(2),
+                TokenKind::Number(31),
+                TokenKind::BadNumber("12ab".into()),
+            ]
+        );
         assert_eq!(kinds("@ ä"), vec![TokenKind::Bad('@'), TokenKind::Bad('ä')]);
     }
 

@@ -39,7 +39,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 pub use assembler::assemble;
-pub use diagnostic::{render, Diagnostic};
+pub use diagnostic::{Diagnostic, render};
 pub use disasm::disassemble;
 pub use include::{FileResolver, IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
 pub use tmclsim_firmware::Profile;

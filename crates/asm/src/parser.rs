@@ -16,17 +16,33 @@
 //! Operands are separated by commas; a comma may be left out where that is
 //! unambiguous (`MVP ABS 2, 10000`, `JC NZ Label`, `SAP 4 0 1000`).
 
-use crate::expr::{punct_text, Expr, ExprParser, SyntaxError};
-use crate::lexer::{tokenize, Punct, Token, TokenKind};
+use crate::expr::{Expr, ExprParser, SyntaxError, punct_text};
+use crate::lexer::{Punct, Token, TokenKind, tokenize};
 
 /// What a line holds besides its labels.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Body {
     None,
-    Constant { name: String, column: usize, value: Option<Expr> },
-    Instruction { mnemonic: String, column: usize, operands: Vec<Expr>, end_column: usize },
-    Raw { column: usize, fields: Vec<Expr>, end_column: usize },
-    Include { file: String, column: usize },
+    Constant {
+        name: String,
+        column: usize,
+        value: Option<Expr>,
+    },
+    Instruction {
+        mnemonic: String,
+        column: usize,
+        operands: Vec<Expr>,
+        end_column: usize,
+    },
+    Raw {
+        column: usize,
+        fields: Vec<Expr>,
+        end_column: usize,
+    },
+    Include {
+        file: String,
+        column: usize,
+    },
     /// A line that would have been an instruction but has a syntax error
     /// (already reported). It still takes one word so that the addresses of
     /// the labels after it stay right.
@@ -64,12 +80,10 @@ fn parse_body(text: &str, tokens: &[Token], end_column: usize) -> BodyResult {
     let Some(first) = tokens.first() else { return Ok(Body::None) };
     let column = first.column;
     match &first.kind {
-        TokenKind::Ident(name) if tokens.get(1).is_some_and(|t| t.is(Punct::Equals)) => {
-            match whole_expression(&tokens[2..], end_column) {
-                Ok(value) => Ok(Body::Constant { name: name.clone(), column, value: Some(value) }),
-                Err(e) => Err((Body::Constant { name: name.clone(), column, value: None }, e)),
-            }
-        }
+        TokenKind::Ident(name) if tokens.get(1).is_some_and(|t| t.is(Punct::Equals)) => match whole_expression(&tokens[2..], end_column) {
+            Ok(value) => Ok(Body::Constant { name: name.clone(), column, value: Some(value) }),
+            Err(e) => Err((Body::Constant { name: name.clone(), column, value: None }, e)),
+        },
         TokenKind::Ident(name) => match operands(&tokens[1..], end_column) {
             Ok(operands) => Ok(Body::Instruction { mnemonic: name.clone(), column, operands, end_column }),
             Err(e) => Err((Body::BrokenInstruction, e)),
@@ -88,7 +102,9 @@ fn parse_body(text: &str, tokens: &[Token], end_column: usize) -> BodyResult {
             (column, "a line starts with an instruction, a label ('Name:') or a constant ('Name = value'), not a number".into()),
         )),
         TokenKind::Bad(c) => Err((Body::BrokenInstruction, (column, format!("unexpected character '{c}'")))),
-        TokenKind::Punct(p) => Err((Body::BrokenInstruction, (column, format!("unexpected '{}' at the start of an instruction", punct_text(*p))))),
+        TokenKind::Punct(p) => {
+            Err((Body::BrokenInstruction, (column, format!("unexpected '{}' at the start of an instruction", punct_text(*p)))))
+        }
     }
 }
 

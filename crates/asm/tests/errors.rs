@@ -4,7 +4,7 @@
 mod common;
 
 use common::{asm_1141, errors, tmcm_1141};
-use tmclsim_asm::{assemble, assemble_file, MemoryResolver};
+use tmclsim_asm::{MemoryResolver, assemble, assemble_file};
 
 fn one(source: &str, profile: bool) -> String {
     let e = errors(source, profile);
@@ -31,7 +31,10 @@ fn bad_operand_count() {
     assert_eq!(one("MST 0, 1", false), "prog.tmc:1:8: error: MST takes 1 operand (motor), found 2");
     assert_eq!(one("RSUB 1", false), "prog.tmc:1:6: error: RSUB takes no operands, found 1");
     assert_eq!(one("GAP 1", false), "prog.tmc:1:6: error: GAP takes 2 operands (parameter, motor), found 1");
-    assert_eq!(one("MVP ABS, 0   // no position", false), "prog.tmc:1:11: error: MVP takes 3 operands (ABS|REL|COORD, motor, position), found 2");
+    assert_eq!(
+        one("MVP ABS, 0   // no position", false),
+        "prog.tmc:1:11: error: MVP takes 3 operands (ABS|REL|COORD, motor, position), found 2"
+    );
 }
 
 #[test]
@@ -41,19 +44,37 @@ fn bad_symbol() {
         one("L: JC NX, L", false),
         "prog.tmc:1:7: error: 'NX' is not a condition (ZE, NZ, EQ, NE, GT, GE, LT, LE, ETO, EAL, EDV, EPO) (did you mean 'NZ'?)"
     );
-    assert_eq!(one("WAIT TICK, 0, 10", false), "prog.tmc:1:6: error: 'TICK' is not a wait condition (TICKS, POS, REFSW, LIMSW, RFS) (did you mean 'TICKS'?)");
-    assert_eq!(one("CALC SWAP, 1", false), "prog.tmc:1:6: error: SWAP cannot be used with CALC (valid: ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, LOAD)");
+    assert_eq!(
+        one("WAIT TICK, 0, 10", false),
+        "prog.tmc:1:6: error: 'TICK' is not a wait condition (TICKS, POS, REFSW, LIMSW, RFS) (did you mean 'TICKS'?)"
+    );
+    assert_eq!(
+        one("CALC SWAP, 1", false),
+        "prog.tmc:1:6: error: SWAP cannot be used with CALC (valid: ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, LOAD)"
+    );
     assert_eq!(one("MVP 3, 0, 1", false), "prog.tmc:1:5: error: 3 is not a valid move mode for MVP (valid: ABS, REL, COORD)");
-    assert_eq!(one("MVP ABS, REL, 51200", false), "prog.tmc:1:10: error: 'REL' is a move mode, not a motor number (MVP takes ABS|REL|COORD, motor, position)");
+    assert_eq!(
+        one("MVP ABS, REL, 51200", false),
+        "prog.tmc:1:10: error: 'REL' is a move mode, not a motor number (MVP takes ABS|REL|COORD, motor, position)"
+    );
 }
 
 #[test]
 fn value_out_of_range() {
     assert_eq!(one("SAP 256, 0, 1", false), "prog.tmc:1:5: error: parameter 256 is out of range 0...255");
     assert_eq!(one("SAP 4, -1, 1", false), "prog.tmc:1:8: error: motor -1 is out of range 0...255");
-    assert_eq!(one("SAP 4, 0, 4294967296", false), "prog.tmc:1:11: error: value 4294967296 does not fit in 32 bits (-2147483648...4294967295)");
-    assert_eq!(one("SAP 4, 0, 50000", true), "prog.tmc:1:11: error: value 50000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047");
-    assert_eq!(one("SGP 66, 0, 0", true), "prog.tmc:1:12: error: value 0 is out of range for global parameter 66 of bank 0 (Serial address): 1...255");
+    assert_eq!(
+        one("SAP 4, 0, 4294967296", false),
+        "prog.tmc:1:11: error: value 4294967296 does not fit in 32 bits (-2147483648...4294967295)"
+    );
+    assert_eq!(
+        one("SAP 4, 0, 50000", true),
+        "prog.tmc:1:11: error: value 50000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047"
+    );
+    assert_eq!(
+        one("SGP 66, 0, 0", true),
+        "prog.tmc:1:12: error: value 0 is out of range for global parameter 66 of bank 0 (Serial address): 1...255"
+    );
     assert_eq!(one("ROL 0, 51200", true), "prog.tmc:1:8: error: velocity 51200 is out of range -2047...2047");
     assert_eq!(one("X = 1 / 0\nSAP 4, 0, X", false), "prog.tmc:1:7: error: division by zero");
 }
@@ -64,7 +85,10 @@ fn unknown_parameter_and_other_module_checks() {
     assert_eq!(one("SAP 3, 0, 0", true), "prog.tmc:1:5: error: axis parameter 3 (Actual speed) cannot be written (access R)");
     assert_eq!(one("GGP 70, 0", true), "prog.tmc:1:5: error: global parameter 70 does not exist in bank 0 of the TMCM-1141");
     assert_eq!(one("SGP 1, 1, 0", true), "prog.tmc:1:8: error: bank 1 does not exist on the TMCM-1141 (banks: 0, 2, 3)");
-    assert_eq!(one("STGP 60, 2", true), "prog.tmc:1:6: error: global parameter 60 of bank 2 (User variables #56…#255) cannot be stored in or restored from the EEPROM (access RW)");
+    assert_eq!(
+        one("STGP 60, 2", true),
+        "prog.tmc:1:6: error: global parameter 60 of bank 2 (User variables #56…#255) cannot be stored in or restored from the EEPROM (access RW)"
+    );
     assert_eq!(one("MST 1", true), "prog.tmc:1:5: error: motor 1 does not exist on the TMCM-1141 (it has motor 0 only)");
     assert_eq!(one("MVP COORD, 1, 3", true), "prog.tmc:1:12: error: motor 1 does not exist on the TMCM-1141 (it has motor 0 only)");
     assert_eq!(one("MVP COORD, 0, 21", true), "prog.tmc:1:15: error: coordinate 21 does not exist on the TMCM-1141 (0...20)");
@@ -80,7 +104,9 @@ fn unknown_parameter_and_other_module_checks() {
     assert_eq!(one("SIO 0, 2, 2", true), "prog.tmc:1:11: error: SIO value 2 is out of range 0...1");
     assert_eq!(one("SIO 0, 1, 1", true), "prog.tmc:1:8: error: bank 1 has no outputs on the TMCM-1141 (SIO banks: 0, 2)");
     // What is valid: the special forms.
-    asm_1141("EI 255\nDI 255\nSIO 255, 2, 3\nSIO 255, 2, -1\nGIO 255, 0\nSIO 0, 0, 1\nGIO 1, 2\nSCO 0, 255, 0\nGCO 3, 255\nWAIT TICKS, 7, 1\nUF0 1, 2, 3\nSGP 0, 3, 4294967295");
+    asm_1141(
+        "EI 255\nDI 255\nSIO 255, 2, 3\nSIO 255, 2, -1\nGIO 255, 0\nSIO 0, 0, 1\nGIO 1, 2\nSCO 0, 255, 0\nGCO 3, 255\nWAIT TICKS, 7, 1\nUF0 1, 2, 3\nSGP 0, 3, 4294967295",
+    );
 }
 
 #[test]
@@ -95,9 +121,18 @@ fn program_memory_size() {
 
 #[test]
 fn duplicate_label_and_constant() {
-    assert_eq!(one("Loop:\n  STOP\nLoop: STOP\n", false), "prog.tmc:3:1: error: duplicate label 'Loop' (already defined as a label at prog.tmc:1:1)");
-    assert_eq!(one("Speed = 1\n Speed = 2\n", false), "prog.tmc:2:2: error: duplicate constant 'Speed' (already defined as a constant at prog.tmc:1:1)");
-    assert_eq!(one("Speed = 1\nSpeed: STOP\n", false), "prog.tmc:2:1: error: duplicate label 'Speed' (already defined as a constant at prog.tmc:1:1)");
+    assert_eq!(
+        one("Loop:\n  STOP\nLoop: STOP\n", false),
+        "prog.tmc:3:1: error: duplicate label 'Loop' (already defined as a label at prog.tmc:1:1)"
+    );
+    assert_eq!(
+        one("Speed = 1\n Speed = 2\n", false),
+        "prog.tmc:2:2: error: duplicate constant 'Speed' (already defined as a constant at prog.tmc:1:1)"
+    );
+    assert_eq!(
+        one("Speed = 1\nSpeed: STOP\n", false),
+        "prog.tmc:2:1: error: duplicate label 'Speed' (already defined as a constant at prog.tmc:1:1)"
+    );
 }
 
 #[test]
@@ -129,20 +164,26 @@ Start:
   JA Start
 ";
     let e = errors(source, true);
-    assert_eq!(e, [
-        "prog.tmc:2:3: error: unknown instruction 'MVPP' (did you mean 'MVP'?)",
-        "prog.tmc:4:6: error: unknown label 'Strat' (did you mean 'Start'?)",
-        "prog.tmc:5:13: error: value 50000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047",
-    ]);
+    assert_eq!(
+        e,
+        [
+            "prog.tmc:2:3: error: unknown instruction 'MVPP' (did you mean 'MVP'?)",
+            "prog.tmc:4:6: error: unknown label 'Strat' (did you mean 'Start'?)",
+            "prog.tmc:5:13: error: value 50000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047",
+        ]
+    );
     // Several errors on one line, and a syntax error that does not shift
     // the addresses of later labels.
     let e = errors("SAP Foo, Bar, 1\nMVP ABS, 0,, 1\nEnd: JA End2\n", false);
-    assert_eq!(e, [
-        "prog.tmc:1:5: error: unknown constant or label 'Foo'",
-        "prog.tmc:1:10: error: unknown constant or label 'Bar'",
-        "prog.tmc:2:12: error: missing operand before ','",
-        "prog.tmc:3:9: error: unknown label 'End2' (did you mean 'End'?)",
-    ]);
+    assert_eq!(
+        e,
+        [
+            "prog.tmc:1:5: error: unknown constant or label 'Foo'",
+            "prog.tmc:1:10: error: unknown constant or label 'Bar'",
+            "prog.tmc:2:12: error: missing operand before ','",
+            "prog.tmc:3:9: error: unknown label 'End2' (did you mean 'End'?)",
+        ]
+    );
 }
 
 #[test]
@@ -178,6 +219,9 @@ fn unreadable_file() {
 
 #[test]
 fn range_errors_point_at_the_start_of_the_operand() {
-    assert_eq!(one("Speed = 1500\nSAP 4, 0, Speed * 2", true), "prog.tmc:2:11: error: value 3000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047");
+    assert_eq!(
+        one("Speed = 1500\nSAP 4, 0, Speed * 2", true),
+        "prog.tmc:2:11: error: value 3000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047"
+    );
     assert_eq!(one("SAP 4, 0, 1 + 2 / (3 - 3)", false), "prog.tmc:1:17: error: division by zero");
 }

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{asm, errors, example_programs, tmcm_1141};
-use tmclsim_asm::{assemble, assemble_file, render, MemoryResolver, NoIncludes};
+use tmclsim_asm::{MemoryResolver, NoIncludes, assemble, assemble_file, render};
 
 #[test]
 fn every_manual_example_assembles_for_the_tmcm_1141() {
@@ -109,17 +109,25 @@ fn interrupt_example_with_include_equals_the_numeric_one() {
 /// printed, and what the assembler says about them.
 #[test]
 fn the_manuals_misprints_are_reported() {
-    assert_eq!(errors("Loop:\n  MVP ABS, REL, 51200\n  DJNZ 42, Loop\n", false), [
-        "prog.tmc:2:12: error: 'REL' is a move mode, not a motor number (MVP takes ABS|REL|COORD, motor, position)"
-    ]);
-    assert_eq!(errors("SAP 4, 0, 50000 //define maximum positioning speed\nSAP 5, 0, 10000\n", true), [
-        "prog.tmc:1:11: error: value 50000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047",
-        "prog.tmc:2:11: error: value 10000 is out of range for axis parameter 5 (Maximum acceleration): 1...2047",
-    ]);
-    assert_eq!(errors("SIO 3, 2, 1\n", true), ["prog.tmc:1:5: error: SIO port 3 does not exist in bank 2 of the TMCM-1141 (ports: 0, 1, 255)"]);
-    assert_eq!(errors("STAP 6, 0\n", true), [
-        "prog.tmc:1:6: error: axis parameter 6 (Maximum current) cannot be stored in or restored from the EEPROM (access RW)"
-    ]);
+    assert_eq!(
+        errors("Loop:\n  MVP ABS, REL, 51200\n  DJNZ 42, Loop\n", false),
+        ["prog.tmc:2:12: error: 'REL' is a move mode, not a motor number (MVP takes ABS|REL|COORD, motor, position)"]
+    );
+    assert_eq!(
+        errors("SAP 4, 0, 50000 //define maximum positioning speed\nSAP 5, 0, 10000\n", true),
+        [
+            "prog.tmc:1:11: error: value 50000 is out of range for axis parameter 4 (Maximum positioning speed): 1...2047",
+            "prog.tmc:2:11: error: value 10000 is out of range for axis parameter 5 (Maximum acceleration): 1...2047",
+        ]
+    );
+    assert_eq!(
+        errors("SIO 3, 2, 1\n", true),
+        ["prog.tmc:1:5: error: SIO port 3 does not exist in bank 2 of the TMCM-1141 (ports: 0, 1, 255)"]
+    );
+    assert_eq!(
+        errors("STAP 6, 0\n", true),
+        ["prog.tmc:1:6: error: axis parameter 6 (Maximum current) cannot be stored in or restored from the EEPROM (access RW)"]
+    );
     // Without the include file, the symbolic names are unknown.
     let e = assemble("VECT TI_TIMER0, 5\n", "prog.tmc", &MemoryResolver::new(), None).unwrap_err();
     assert_eq!(e[0].to_string(), "prog.tmc:1:6: error: unknown constant or label 'TI_TIMER0'");

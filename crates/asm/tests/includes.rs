@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use common::tmcm_1141;
-use tmclsim_asm::{assemble, assemble_file, render, MemoryResolver};
+use tmclsim_asm::{MemoryResolver, assemble, assemble_file, render};
 
 fn includes_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/includes")

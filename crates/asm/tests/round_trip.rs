@@ -8,7 +8,7 @@ mod common;
 use std::collections::BTreeMap;
 
 use common::Rng;
-use tmclsim_asm::{assemble, disassemble, render, Instruction, NoIncludes, Program};
+use tmclsim_asm::{Instruction, NoIncludes, Program, assemble, disassemble, render};
 use tmclsim_protocol::{mnemonic, opcode};
 
 fn reassemble(instructions: &[Instruction], symbols: Option<&BTreeMap<String, u32>>) -> Program {

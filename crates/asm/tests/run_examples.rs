@@ -183,4 +183,3 @@ fn download_over_frames_and_read_back_match_the_binary() {
         assert_eq!(&f[1..8], &w.to_bytes(), "word {a}");
     }
 }
-

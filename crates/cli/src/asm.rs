@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use tmclsim_asm::{assemble_file, disassemble, render, Program};
+use tmclsim_asm::{Program, assemble_file, disassemble, render};
 use tmclsim_firmware::Profile;
 
 #[derive(clap::Args)]

@@ -5,8 +5,8 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::Module;
-use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::Request;
+use tmclsim_protocol::mnemonic::parse_line;
 
 /// The command mix every measurement uses.
 const MIX: &[&str] = &["GAP 1, 0", "SAP 4, 0, 1500", "GGP 66, 0", "GIO 0, 0", "MVP ABS, 0, 5000", "GAP 8, 0"];
@@ -30,7 +30,11 @@ pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
     }
     let dt = t.elapsed();
     std::hint::black_box(sink);
-    println!("| in-process `handle_frame` | {n} | {:.1} M commands/s ({:.1} ns each) |", n as f64 / dt.as_secs_f64() / 1e6, dt.as_nanos() as f64 / n as f64);
+    println!(
+        "| in-process `handle_frame` | {n} | {:.1} M commands/s ({:.1} ns each) |",
+        n as f64 / dt.as_secs_f64() / 1e6,
+        dt.as_nanos() as f64 / n as f64
+    );
 
     programs()?;
 
@@ -122,7 +126,8 @@ fn report(name: &str, link: &mut (impl Read + Write), frames: &[[u8; 9]], n: usi
 /// The program interpreter and the assembler.
 fn programs() -> Result<(), String> {
     let profile = tmclsim_firmware::Profile::built_in("tmcm-1141")?;
-    let asm = |src: &str| tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d));
+    let asm =
+        |src: &str| tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d));
     // A compute-only loop: 3 instructions per turn, never ending.
     let compute = asm("Loop:\n  CALC ADD, 1\n  COMP 2000000000\n  JC LT, Loop\n  STOP\n")?;
     let mut m = Module::new(profile.clone());
@@ -132,7 +137,11 @@ fn programs() -> Result<(), String> {
     m.advance(3_600_000_000_000);
     let wall = t.elapsed().as_secs_f64();
     let n = m.program().executed;
-    println!("| VM, compute-only loop, 1 h of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |", n as f64 / wall / 1e6, 3600.0 / wall);
+    println!(
+        "| VM, compute-only loop, 1 h of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
+        n as f64 / wall / 1e6,
+        3600.0 / wall
+    );
     // The manual's 2.4 program (moves and WAIT POS) for an hour.
     let motion = asm(FIRST_STEPS)?;
     let mut m = Module::new(profile.clone());
@@ -142,9 +151,15 @@ fn programs() -> Result<(), String> {
     m.advance(3_600_000_000_000);
     let wall = t.elapsed().as_secs_f64();
     let n = m.program().executed;
-    println!("| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |", 3600.0 / wall, wall * 1e3);
+    println!(
+        "| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |",
+        3600.0 / wall,
+        wall * 1e3
+    );
     // A busy motion loop: GAP/COMP/JC polling while the motor moves.
-    let polling = asm("Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n")?;
+    let polling = asm(
+        "Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n",
+    )?;
     let mut m = Module::new(profile.clone());
     m.load_program(&polling.instructions).map_err(|s| s.to_string())?;
     m.start_program();
@@ -152,7 +167,11 @@ fn programs() -> Result<(), String> {
     m.advance(600_000_000_000);
     let wall = t.elapsed().as_secs_f64();
     let n = m.program().executed;
-    println!("| VM, polling motion loop (GAP 8/JC), 10 min of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |", n as f64 / wall / 1e6, 600.0 / wall);
+    println!(
+        "| VM, polling motion loop (GAP 8/JC), 10 min of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
+        n as f64 / wall / 1e6,
+        600.0 / wall
+    );
     // The assembler.
     let mut src = String::from("Speed = 1000\nAccel = Speed / 2 + 3\n");
     let lines = 50_000;

@@ -4,7 +4,7 @@
 
 use std::io::{Read, Write};
 use std::time::{Duration, Instant};
-use tmclsim_protocol::{Instruction, Reply, Request, FRAME_LEN};
+use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Request};
 
 trait Stream: Read + Write {
     fn set_deadline(&mut self, left: Duration) -> std::io::Result<()>;
@@ -61,7 +61,9 @@ impl Client {
                 s.set_nodelay(true).ok();
                 Box::new(s)
             }
-            (None, Some(dev)) => Box::new(serialport::new(dev, baud).timeout(timeout).open().map_err(|e| format!("cannot open {dev}: {e}"))?),
+            (None, Some(dev)) => {
+                Box::new(serialport::new(dev, baud).timeout(timeout).open().map_err(|e| format!("cannot open {dev}: {e}"))?)
+            }
             _ => return Err("give --tcp HOST:PORT or --port DEVICE".into()),
         };
         Ok(Client { stream, address, timeout })

@@ -95,7 +95,13 @@ pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
         for k in 0..l.count {
             let tcp = l.tcp.map(|a| SocketAddr::new(a.ip(), a.port() + if a.port() == 0 { 0 } else { k as u16 }));
             let pty = l.pty.as_ref().map(|p| if l.count > 1 { PathBuf::from(format!("{}-{k}", p.display())) } else { p.clone() });
-            out.push(Link { tcp, pty, modules: modules.clone(), world: l.world.clone().unwrap_or_else(|| f.world.clone()), wire_timing: l.wire_timing });
+            out.push(Link {
+                tcp,
+                pty,
+                modules: modules.clone(),
+                world: l.world.clone().unwrap_or_else(|| f.world.clone()),
+                wire_timing: l.wire_timing,
+            });
         }
     }
     Ok(out)
@@ -136,11 +142,10 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     }
     let server = tmclsim_server::start_fleet(specs).map_err(|e| format!("cannot serve the fleet: {e}"))?;
     println!("tmclsim: fleet of {total} modules on {} links is serving", server.links().len());
-    if let Some(first) = server.links().first() {
-        if let Some(a) = first.endpoints.pytrinamic_args() {
+    if let Some(first) = server.links().first()
+        && let Some(a) = first.endpoints.pytrinamic_args() {
             println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (first link)");
         }
-    }
     use std::io::Write;
     let _ = std::io::stdout().flush();
     crate::serve::wait_for_signal();
@@ -216,12 +221,23 @@ pub fn bench(args: FleetBenchArgs) -> Result<ExitCode, String> {
     let n = rtt.len();
     let pct = |p: f64| rtt.get(((n as f64 * p) as usize).min(n.saturating_sub(1))).copied().unwrap_or_default();
     let cpu = (cpu1.0 + cpu1.1).saturating_sub(cpu0.0 + cpu0.1);
-    println!("tmclsim fleet-bench: {modules} modules on {} links, {} commands/s each, {:.1} s, {} cores", rtt_links(&args.fleet), args.rate, wall.as_secs_f64(), std::thread::available_parallelism().map_or(1, |n| n.get()));
+    println!(
+        "tmclsim fleet-bench: {modules} modules on {} links, {} commands/s each, {:.1} s, {} cores",
+        rtt_links(&args.fleet),
+        args.rate,
+        wall.as_secs_f64(),
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    );
     println!();
     println!("| measurement | result |");
     println!("|---|---|");
     println!("| commands | {n} ({:.0}/s), {errors} errors or timeouts |", n as f64 / wall.as_secs_f64());
-    println!("| round trip | p50 {:.0} µs, p99 {:.0} µs, max {:.0} µs |", us(pct(0.5)), us(pct(0.99)), us(rtt.last().copied().unwrap_or_default()));
+    println!(
+        "| round trip | p50 {:.0} µs, p99 {:.0} µs, max {:.0} µs |",
+        us(pct(0.5)),
+        us(pct(0.99)),
+        us(rtt.last().copied().unwrap_or_default())
+    );
     println!("| server | {stats} |");
     println!("| server CPU | {:.1} % of one core |", cpu.as_secs_f64() / wall.as_secs_f64() * 100.0);
     println!("| server memory | {} KiB resident, {:.1} KiB per module |", rss_kib, rss_kib as f64 / modules.max(1) as f64);
@@ -266,7 +282,8 @@ async fn drive(links: Vec<Link>, rate: f64, duration: Duration) -> Result<(Vec<D
                 let frame = tmclsim_protocol::Request::new(address, ins).encode();
                 let t = std::time::Instant::now();
                 let mut reply = [0u8; 9];
-                let ok = s.write_all(&frame).await.is_ok() && tokio::time::timeout(Duration::from_secs(1), s.read_exact(&mut reply)).await.is_ok_and(|r| r.is_ok());
+                let ok = s.write_all(&frame).await.is_ok()
+                    && tokio::time::timeout(Duration::from_secs(1), s.read_exact(&mut reply)).await.is_ok_and(|r| r.is_ok());
                 if ok {
                     rtt.push(t.elapsed());
                 } else {

@@ -176,7 +176,10 @@ fn main() -> ExitCode {
 
 fn profile(name: &str) -> Result<ExitCode, String> {
     let p = tmclsim_firmware::Profile::built_in(name)?;
-    println!("{}: {} axis(es), {} program words, firmware V{}.{:02}", p.module.name, p.module.axes, p.module.program_memory, p.module.firmware[0], p.module.firmware[1]);
+    println!(
+        "{}: {} axis(es), {} program words, firmware V{}.{:02}",
+        p.module.name, p.module.axes, p.module.program_memory, p.module.firmware[0], p.module.firmware[1]
+    );
     println!("\nAxis parameters (* = default assumed, not stated by the manual)");
     for q in p.axis_parameters() {
         let mark = if q.default_source == tmclsim_firmware::profile::DefaultSource::Assumed { "*" } else { " " };

@@ -7,8 +7,8 @@ use std::io::{BufRead, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::Module;
+use tmclsim_firmware::program::RunMode;
 use tmclsim_protocol::mnemonic;
 
 #[derive(clap::Args)]
@@ -183,13 +183,21 @@ fn inspect(m: &Module) {
     println!("  stack {:?}  interrupt handler {}", p.stack, if p.handler.is_some() { "active" } else { "none" });
     for a in 0..m.profile().module.axes as usize {
         let axis = m.axis(a);
-        println!("  axis {a}: position {} speed {} target {} mode {:?}", m.actual_position(a), m.actual_speed(a), axis.target_word, axis.motion.mode);
+        println!(
+            "  axis {a}: position {} speed {} target {} mode {:?}",
+            m.actual_position(a),
+            m.actual_speed(a),
+            axis.target_word,
+            axis.motion.mode
+        );
     }
     println!("  outputs {:#b}", m.outputs());
-    let vars: Vec<String> = (0..m.profile().module.user_variables as usize).filter_map(|i| {
-        let v = m.user_variable_value(i);
-        (v != 0).then(|| format!("{i}={v}"))
-    }).collect();
+    let vars: Vec<String> = (0..m.profile().module.user_variables as usize)
+        .filter_map(|i| {
+            let v = m.user_variable_value(i);
+            (v != 0).then(|| format!("{i}={v}"))
+        })
+        .collect();
     if !vars.is_empty() {
         println!("  user variables {}", vars.join(" "));
     }
@@ -201,7 +209,12 @@ enum Debug {
 }
 
 /// The interactive debugger: one command per line.
-fn debugger(m: &mut Module, program: &tmclsim_asm::Program, lines: &mut impl Iterator<Item = std::io::Result<String>>, end: u64) -> Result<Debug, String> {
+fn debugger(
+    m: &mut Module,
+    program: &tmclsim_asm::Program,
+    lines: &mut impl Iterator<Item = std::io::Result<String>>,
+    end: u64,
+) -> Result<Debug, String> {
     m.pause_program();
     println!("debugger: s[tep] [N], c[ontinue], i[nspect], l[ist], b[reak] LABEL|ADDR, d[elete] LABEL|ADDR, q[uit]");
     loop {

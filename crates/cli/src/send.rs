@@ -1,9 +1,9 @@
 //! `tmclsim send`: one command to any TMCL module, the reply decoded.
 
-use crate::client::hex;
 use crate::SendArgs;
+use crate::client::hex;
 use std::process::ExitCode;
-use tmclsim_protocol::{mnemonic, opcode, Reply, Request, Status};
+use tmclsim_protocol::{Reply, Request, Status, mnemonic, opcode};
 
 pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     let line = args.command.join(" ");

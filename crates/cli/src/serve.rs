@@ -84,7 +84,8 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
             Ok(tmclsim_ethercat::Slave::new(m, 1 + i as u32))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let handle = tmclsim_server::ethercat::serve(iface, tmclsim_ethercat::Segment::new(slaves)).map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
+    let handle = tmclsim_server::ethercat::serve(iface, tmclsim_ethercat::Segment::new(slaves))
+        .map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
     println!("tmclsim: {} virtual TMCM-1310 EtherCAT slave(s) on {iface}", args.slaves);
     println!("connect with: an EtherCAT master on {iface}'s peer, e.g. pysoem: master.open(\"<peer interface>\")");
     use std::io::Write;
@@ -169,7 +170,7 @@ fn send_target(ep: &tmclsim_server::Endpoints) -> String {
 pub(crate) fn wait_for_signal() {
     let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().expect("signal runtime");
     rt.block_on(async {
-        use tokio::signal::unix::{signal, SignalKind};
+        use tokio::signal::unix::{SignalKind, signal};
         let mut term = signal(SignalKind::terminate()).expect("SIGTERM handler");
         let mut hup = signal(SignalKind::hangup()).expect("SIGHUP handler");
         tokio::select! {

@@ -5,7 +5,7 @@ use crate::client::hex;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use tmclsim_asm::Program;
-use tmclsim_protocol::{opcode, Instruction, Status};
+use tmclsim_protocol::{Instruction, Status, opcode};
 
 #[derive(clap::Args)]
 pub struct UploadArgs {
@@ -60,7 +60,12 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
         }
         let stored = Instruction::from_bytes(raw[1..8].try_into().unwrap());
         if stored != *w {
-            return Err(format!("word {a} reads back as {} ({}), not {}", tmclsim_protocol::mnemonic::format(stored), hex(&raw), tmclsim_protocol::mnemonic::format(*w)));
+            return Err(format!(
+                "word {a} reads back as {} ({}), not {}",
+                tmclsim_protocol::mnemonic::format(stored),
+                hex(&raw),
+                tmclsim_protocol::mnemonic::format(*w)
+            ));
         }
     }
     println!("uploaded and verified {} instructions", words.len());

@@ -76,7 +76,7 @@ fn noise(seed: &mut u64, offset: u64, buf: &mut [u8], sum: &mut u8) -> u64 {
         } else {
             *b = *seed as u8;
             *sum = sum.wrapping_add(*b);
-            if (offset + i as u64) % 9 == 0 && *b == 1 {
+            if (offset + i as u64).is_multiple_of(9) && *b == 1 {
                 ours += 1;
             }
         }
@@ -161,7 +161,11 @@ fn idle_connections_up_to_the_limit() {
     let mut b = [0u8; 1];
     assert_eq!(extra.read(&mut b).unwrap_or(0), 0, "closed by the server");
     std::thread::sleep(Duration::from_millis(100));
-    assert!(server.log.lock().unwrap().iter().any(|l| l.contains("refusing connection") && l.contains("20 connections")), "{:?}", server.log.lock().unwrap());
+    assert!(
+        server.log.lock().unwrap().iter().any(|l| l.contains("refusing connection") && l.contains("20 connections")),
+        "{:?}",
+        server.log.lock().unwrap()
+    );
     drop(idle);
     std::thread::sleep(Duration::from_millis(200));
     server.check();

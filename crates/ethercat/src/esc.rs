@@ -249,7 +249,11 @@ impl Esc {
         }
         // Reading the last byte of the input mailbox empties it.
         let sm = self.sync_manager(1);
-        if sm.enabled && self.mailbox_full[1] && addr + out.len() >= sm.start as usize + sm.len as usize && addr < sm.start as usize + sm.len as usize {
+        if sm.enabled
+            && self.mailbox_full[1]
+            && addr + out.len() >= sm.start as usize + sm.len as usize
+            && addr < sm.start as usize + sm.len as usize
+        {
             self.mailbox_full[1] = false;
             self.events.mailbox_read = true;
             self.update_sm_status();
@@ -310,7 +314,8 @@ impl Esc {
         match command {
             0 => {}
             1 => {
-                let word = u32::from_le_bytes(self.mem[reg::EEPROM_ADDRESS as usize..reg::EEPROM_ADDRESS as usize + 4].try_into().unwrap()) as usize;
+                let word = u32::from_le_bytes(self.mem[reg::EEPROM_ADDRESS as usize..reg::EEPROM_ADDRESS as usize + 4].try_into().unwrap())
+                    as usize;
                 for i in 0..4 {
                     let v = self.sii.get(word + i).copied().unwrap_or(0xFFFF);
                     wr16(&mut self.mem, reg::EEPROM_DATA + 2 * i as u16, v);

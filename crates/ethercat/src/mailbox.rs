@@ -138,7 +138,9 @@ mod tests {
 
     #[test]
     fn requests_parse_back() {
-        for sdo in [Sdo::Download { index: 0x2000, subindex: 0, data: vec![1, 2, 3, 4, 5, 6, 7, 8] }, Sdo::Upload { index: 0x1018, subindex: 1 }] {
+        for sdo in
+            [Sdo::Download { index: 0x2000, subindex: 0, data: vec![1, 2, 3, 4, 5, 6, 7, 8] }, Sdo::Upload { index: 0x1018, subindex: 1 }]
+        {
             let mut m = request(3, &sdo);
             m.resize(128, 0);
             assert_eq!(parse(&m), Ok(Some((3, sdo))));

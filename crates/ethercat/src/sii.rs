@@ -28,7 +28,8 @@ pub const BOOT_MAILBOX_IN_LEN: u16 = 40;
 /// write (outputs), buffered read (inputs).
 pub const SM_CONTROL: [u8; 4] = [0x26, 0x22, 0x64, 0x20];
 /// (start, length) of SyncManagers 0…3.
-pub const SM_LAYOUT: [(u16, u16); 4] = [(MAILBOX_OUT, MAILBOX_LEN), (MAILBOX_IN, MAILBOX_LEN), (OUTPUTS, OUTPUTS_LEN), (INPUTS, INPUTS_LEN)];
+pub const SM_LAYOUT: [(u16, u16); 4] =
+    [(MAILBOX_OUT, MAILBOX_LEN), (MAILBOX_IN, MAILBOX_LEN), (OUTPUTS, OUTPUTS_LEN), (INPUTS, INPUTS_LEN)];
 
 /// Mailbox protocols: CoE (TMCL is carried by SDOs of object 0x2000).
 pub const MAILBOX_PROTOCOLS: u16 = 0x0004;
@@ -93,7 +94,8 @@ pub fn image(serial: u32) -> Vec<u16> {
     w[0x3F] = 0x0001; // … version 1
     // Strings: 1 name, 2 group, 3 image, 4 order, 5 RxPDO, 6 TxPDO,
     // 7 "Controller mode", 8 "Set-point", 9… the input names.
-    let mut strings: Vec<&str> = vec!["TMCM-1310", "Stepper", "TMCM-1310", "TMCM-1310-CL", "Outputs", "Inputs", "Controller mode", "Set-point"];
+    let mut strings: Vec<&str> =
+        vec!["TMCM-1310", "Stepper", "TMCM-1310", "TMCM-1310-CL", "Outputs", "Inputs", "Controller mode", "Set-point"];
     strings.extend(INPUT_NAMES);
     let mut s = vec![strings.len() as u8];
     for t in &strings {

@@ -2,12 +2,12 @@
 //! machine's checks, process data to and from the module, the TMCL
 //! mailbox, the process data watchdog.
 
-use crate::esc::{code, state, Esc};
+use crate::esc::{Esc, code, state};
 use crate::mailbox::{self, Sdo};
 use crate::sii;
-use tmclsim_firmware::module::Special;
 use tmclsim_firmware::Module;
-use tmclsim_protocol::{opcode, Command, Instruction, Status};
+use tmclsim_firmware::module::Special;
+use tmclsim_protocol::{Command, Instruction, Status, opcode};
 
 /// Status code 8 over EtherCAT: the parameter is password protected.
 pub const PASSWORD_PROTECTED: u8 = 8;
@@ -214,7 +214,9 @@ impl Slave {
                 self.tmcl_reply = self.tmcl(&data);
                 mailbox::download_response(counter, mailbox::TMCL_OBJECT, 0)
             }
-            Sdo::Upload { index: mailbox::TMCL_OBJECT, subindex: 0 } => mailbox::upload_response(counter, mailbox::TMCL_OBJECT, 0, &self.tmcl_reply),
+            Sdo::Upload { index: mailbox::TMCL_OBJECT, subindex: 0 } => {
+                mailbox::upload_response(counter, mailbox::TMCL_OBJECT, 0, &self.tmcl_reply)
+            }
             Sdo::Upload { index, subindex } => match self.object(index, subindex) {
                 Ok(data) => mailbox::upload_response(counter, index, subindex, &data),
                 Err(code) => mailbox::abort_response(counter, index, subindex, code),
@@ -276,7 +278,9 @@ impl Slave {
         let ins = Instruction::new(req[1], req[2], req[3], i32::from_be_bytes([req[4], req[5], req[6], req[7]]));
         let host = self.module.host_address();
         let address = self.module.address();
-        let protected = matches!(ins.opcode, opcode::SGP | opcode::STGP | opcode::AGP | opcode::RSGP) && ins.motor == 0 && PROTECTED_GLOBALS.contains(&ins.kind);
+        let protected = matches!(ins.opcode, opcode::SGP | opcode::STGP | opcode::AGP | opcode::RSGP)
+            && ins.motor == 0
+            && PROTECTED_GLOBALS.contains(&ins.kind);
         let (status, value, special) = if protected {
             (PASSWORD_PROTECTED, ins.value, None)
         } else if self.module.program().download.is_some() && !opcode::is_control(ins.opcode) {
@@ -307,4 +311,3 @@ impl Slave {
         [host, address, status, ins.opcode, v[0], v[1], v[2], v[3]]
     }
 }
-

@@ -1,10 +1,10 @@
 //! Direct-mode commands through `Module::handle_frame`, in-process.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use tmclsim_firmware::Module;
-use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::Request;
+use tmclsim_protocol::mnemonic::parse_line;
 
 fn frames(lines: &[&str]) -> Vec<[u8; 9]> {
     lines.iter().map(|l| Request::new(1, parse_line(l).unwrap()).encode()).collect()

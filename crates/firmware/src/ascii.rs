@@ -10,8 +10,8 @@
 //! none (10). Only the commands the module permits in ASCII mode run;
 //! `RUN` and `STOP` start and stop the TMCL program.
 
-use crate::module::{gp, Module};
-use tmclsim_protocol::{mnemonic, Instruction, Status};
+use crate::module::{Module, gp};
+use tmclsim_protocol::{Instruction, Status, mnemonic};
 
 /// Longest line kept; the rest of a longer line is dropped.
 const MAX_LINE: usize = 128;
@@ -49,7 +49,11 @@ impl Module {
     /// One character from the link in ASCII mode; what the module sends
     /// back (echo, reply) is appended to `out`.
     pub fn ascii_byte(&mut self, byte: u8, out: &mut Vec<u8>) {
-        let addressed = |m: &Module, line: &[u8]| line.first().is_some_and(|&c| c == address_char(m.address()) || (m.secondary_address() != 0 && c == address_char(m.secondary_address())));
+        let addressed = |m: &Module, line: &[u8]| {
+            line.first().is_some_and(|&c| {
+                c == address_char(m.address()) || (m.secondary_address() != 0 && c == address_char(m.secondary_address()))
+            })
+        };
         match byte {
             CR => {
                 let line = std::mem::take(&mut self.ascii_line.buf);

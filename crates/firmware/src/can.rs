@@ -9,8 +9,8 @@
 //! ID, GP 83 secondary ID, GP 70 reply ID) use them; the others use their
 //! serial address (GP 66, GP 87) and the host address (GP 76).
 
-use crate::module::{gp, Module, Special};
-use tmclsim_protocol::{opcode, Instruction, Status};
+use crate::module::{Module, Special, gp};
+use tmclsim_protocol::{Instruction, Status, opcode};
 
 /// GP numbers of the CAN identifiers on modules that have them.
 const CAN_REPLY_ID: u8 = 70;
@@ -73,7 +73,8 @@ impl Module {
         self.heartbeat_tripped = false;
         let d = frame.data;
         let ins = Instruction::new(d[0], d[1], d[2], i32::from_be_bytes([d[3], d[4], d[5], d[6]]));
-        let outcome = if self.program.download.is_some() && !opcode::is_control(ins.opcode) { self.download_word(ins) } else { self.execute(ins) };
+        let outcome =
+            if self.program.download.is_some() && !opcode::is_control(ins.opcode) { self.download_word(ins) } else { self.execute(ins) };
         let reply_id = self.can_reply_id();
         let reply = match outcome.special {
             Special::Silent => return None,

@@ -20,7 +20,7 @@
 //! - Torque mode (SAP 14, mA): the driver sets that current; the motor runs
 //!   at the speed where its torque equals the load.
 
-use crate::module::{ap, error_flag, Module};
+use crate::module::{Module, ap, error_flag};
 use crate::motion::{self, RampMode};
 use crate::program::Source;
 
@@ -265,7 +265,11 @@ impl Module {
         let axis = &self.axes[m];
         let p = &axis.params;
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        let torque_ma = if axis.closed_loop.torque_mode { (p[cl::TORQUE_TARGET as usize] as f64).clamp(-FULL_SCALE_MA, FULL_SCALE_MA) } else { axis.closed_loop.scale / 100.0 * FULL_SCALE_MA };
+        let torque_ma = if axis.closed_loop.torque_mode {
+            (p[cl::TORQUE_TARGET as usize] as f64).clamp(-FULL_SCALE_MA, FULL_SCALE_MA)
+        } else {
+            axis.closed_loop.scale / 100.0 * FULL_SCALE_MA
+        };
         Some(match param {
             ap::ACTUAL_POSITION if self.closed_loop_on(m) => self.measured_position(m).round() as i32,
             ap::POSITION_REACHED => self.closed_loop_target_reached(m) as i32,
@@ -273,7 +277,13 @@ impl Module {
             cl::VELOCITY_REACHED => self.velocity_reached(m) as i32,
             cl::STATUS_WORD => self.status_word(m),
             cl::TORQUE_ACTUAL => torque_ma.round() as i32,
-            cl::SCALE_ACTUAL | cl::TARGET_SCALE => if axis.closed_loop.torque_mode { (torque_ma.abs() / FULL_SCALE_MA * 100.0).round() as i32 } else { axis.closed_loop.scale.round() as i32 },
+            cl::SCALE_ACTUAL | cl::TARGET_SCALE => {
+                if axis.closed_loop.torque_mode {
+                    (torque_ma.abs() / FULL_SCALE_MA * 100.0).round() as i32
+                } else {
+                    axis.closed_loop.scale.round() as i32
+                }
+            }
             cl::MEASURED_VELOCITY => motion::velocity_internal(axis.closed_loop.rotor_velocity, pd).round() as i32,
             cl::INIT_FLAG => self.closed_loop_on(m) as i32,
             ap::ENCODER_POSITION => self.closed_loop_encoder(m),
@@ -294,7 +304,9 @@ impl Module {
         if !self.closed_loop_on(m) {
             return self.actual_position(m) == axis.target_word;
         }
-        axis.motion.mode != RampMode::Velocity && axis.motion.v == 0.0 && (axis.target_word as f64 - self.measured_position(m)).abs() <= window.max(0.5)
+        axis.motion.mode != RampMode::Velocity
+            && axis.motion.v == 0.0
+            && (axis.target_word as f64 - self.measured_position(m)).abs() <= window.max(0.5)
     }
 
     fn velocity_reached(&self, m: usize) -> bool {

@@ -17,7 +17,7 @@
 //!   stop, the motor loses steps: the position counter goes on, the
 //!   carriage does not.
 
-use crate::module::{ap, error_flag, gp, Module};
+use crate::module::{Module, ap, error_flag, gp};
 use crate::program::Source;
 
 /// Full steps per second at which the motor has no torque left.
@@ -48,13 +48,19 @@ impl Module {
     /// The driver is switched off (no torque).
     pub(crate) fn driver_off(&self, m: usize) -> bool {
         let f = self.world.axes[m].faults;
-        let toff_zero = self.profile.axis_parameter(ap::CHOPPER_OFF_TIME).is_some() && self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0;
+        let toff_zero =
+            self.profile.axis_parameter(ap::CHOPPER_OFF_TIME).is_some() && self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0;
         let shutdown_pin = match self.profile.global_parameter(0, gp::SHUTDOWN_PIN).map(|_| self.globals[0][gp::SHUTDOWN_PIN as usize]) {
             Some(1) => self.world.shutdown_input,
             Some(2) => !self.world.shutdown_input,
             _ => false,
         };
-        self.world.temperature >= SHUTDOWN_C || f.short_a || f.short_b || self.world.supply_decivolts < UNDERVOLTAGE_DV || toff_zero || shutdown_pin
+        self.world.temperature >= SHUTDOWN_C
+            || f.short_a
+            || f.short_b
+            || self.world.supply_decivolts < UNDERVOLTAGE_DV
+            || toff_zero
+            || shutdown_pin
     }
 
     /// AP 209: the encoder's count scaled by the prescaler (AP 210; the
@@ -86,11 +92,11 @@ impl Module {
             closed_loop
                 || will_move
                     && (!self.world.axes[m].loads.is_empty()
-                    || (has(ap::STOP_ON_STALL) && p[ap::STOP_ON_STALL as usize] > 0)
-                    || (has(ap::STALL_THRESHOLD) && p[ap::STALL_THRESHOLD as usize] > 0)
-                    || (has(ap::SMART_ENERGY_HYSTERESIS_START) && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
-                    || (has(ap::MAX_ENCODER_DEVIATION) && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
-                    || self.driver_off(m))
+                        || (has(ap::STOP_ON_STALL) && p[ap::STOP_ON_STALL as usize] > 0)
+                        || (has(ap::STALL_THRESHOLD) && p[ap::STALL_THRESHOLD as usize] > 0)
+                        || (has(ap::SMART_ENERGY_HYSTERESIS_START) && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
+                        || (has(ap::MAX_ENCODER_DEVIATION) && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
+                        || self.driver_off(m))
         })
     }
 
@@ -151,16 +157,21 @@ impl Module {
         let p = self.axes[m].params;
         let v_int = self.actual_speed(m).abs();
         // coolStep regulates above its threshold speed, when enabled.
-        let semin = if self.profile.axis_parameter(ap::SMART_ENERGY_HYSTERESIS_START).is_some() { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
+        let semin = if self.profile.axis_parameter(ap::SMART_ENERGY_HYSTERESIS_START).is_some() {
+            p[ap::SMART_ENERGY_HYSTERESIS_START as usize]
+        } else {
+            0
+        };
         let cool = semin > 0 && moving && v_int >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
         if cool {
             let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
-            let min = if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
+            let min =
+                if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
             let mut cs = self.axes[m].driver.cool_scale.unwrap_or(max);
             let per_measurement = if p[ap::STALLGUARD_FILTER as usize] == 1 { 4.0 } else { 1.0 };
             let measurements = (moved.abs() / self.microsteps(m) / per_measurement).min(256.0);
-            let lower = (semin * 32) as i32;
-            let upper = ((semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32) as i32;
+            let lower = semin * 32;
+            let upper = (semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32;
             let up = [1.0, 2.0, 4.0, 8.0][p[ap::SMART_ENERGY_CURRENT_UP_STEP as usize].clamp(0, 3) as usize];
             let down_every = [32.0, 8.0, 2.0, 1.0][p[ap::SMART_ENERGY_CURRENT_DOWN_STEP as usize].clamp(0, 3) as usize];
             let mut count = self.axes[m].driver.down_count;

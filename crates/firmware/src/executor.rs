@@ -4,11 +4,11 @@
 //! shared with the program interpreter, which passes `Origin::Program` so
 //! that reads load the accumulator and branch commands are allowed.
 
-use crate::module::{ap, error_flag, gp, Compare, Module, Origin, Outcome, Special};
+use crate::module::{Compare, Module, Origin, Outcome, Special, ap, error_flag, gp};
 use crate::motion::RampMode;
-use crate::reference_search::{ReferenceSearch, Switch};
 use crate::profile::{Parameter, PortDirection};
-use tmclsim_protocol::{opcode, CalcOp, Command, ErrorFlag, Instruction, MoveMode, RfsAction, Status};
+use crate::reference_search::{ReferenceSearch, Switch};
+use tmclsim_protocol::{CalcOp, Command, ErrorFlag, Instruction, MoveMode, RfsAction, Status, opcode};
 
 type Exec = Result<i32, Status>;
 
@@ -281,8 +281,14 @@ impl Module {
                 Ok(echo)
             }
             UserFunction { .. } => Err(Status::NotAvailable),
-            StopApplication | RunApplication { .. } | StepApplication | ResetApplication | EnterDownload { .. } | ExitDownload
-            | ReadMemory { .. } | ApplicationStatus { .. } => unreachable!("handled in execute"),
+            StopApplication
+            | RunApplication { .. }
+            | StepApplication
+            | ResetApplication
+            | EnterDownload { .. }
+            | ExitDownload
+            | ReadMemory { .. }
+            | ApplicationStatus { .. } => unreachable!("handled in execute"),
             Rfs { action, motor } => {
                 let m = self.motor(motor)?;
                 match action {
@@ -461,8 +467,8 @@ impl Module {
             axis.params[ap::RAMP_MODE as usize] = RampMode::Position as i32;
         }
         self.set_target(m, target);
-        if let Some((every, mask)) = self.event_arm {
-            if mask & (1 << m) != 0 {
+        if let Some((every, mask)) = self.event_arm
+            && mask & (1 << m) != 0 {
                 self.axes[m].notify_on_arrival = true;
                 if !every {
                     self.event_arm = None;
@@ -473,7 +479,6 @@ impl Module {
                     self.push_event(1 << m);
                 }
             }
-        }
         Ok(())
     }
 
@@ -585,7 +590,8 @@ impl Module {
     /// RFS START with the mode of AP 193.
     fn start_reference_search(&mut self, m: usize) -> Result<(), Status> {
         let mode = self.axes[m].params[ap::REFERENCE_SEARCH_MODE as usize];
-        let rfs = if self.profile.module.motion_controller == "TMC428" { ReferenceSearch::new_tmc428(mode) } else { ReferenceSearch::new(mode) };
+        let rfs =
+            if self.profile.module.motion_controller == "TMC428" { ReferenceSearch::new_tmc428(mode) } else { ReferenceSearch::new(mode) };
         let rfs = rfs.ok_or(Status::InvalidValue)?;
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
@@ -767,7 +773,10 @@ impl Module {
         let run = p[ap::MAX_CURRENT as usize].clamp(0, 255) as u32;
         if axis.motion.v != 0.0 {
             let slow = p[ap::SMART_ENERGY_SLOW_RUN_CURRENT as usize].clamp(0, 255) as u32;
-            if p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0 && slow > 0 && self.actual_speed(m).abs() < p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize] {
+            if p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0
+                && slow > 0
+                && self.actual_speed(m).abs() < p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize]
+            {
                 return slow;
             }
             let boost = p[ap::BOOST_CURRENT as usize].clamp(0, 255) as u32;

@@ -2,10 +2,10 @@
 //! time, with WAIT, subroutines and interrupts; and the control commands
 //! (128–135) that load, start, step and inspect programs.
 
-use crate::module::{error_flag, gp, Compare, Module, Origin, Outcome, Special};
-use crate::program::{Context, RunMode, Source, TraceRecord, Wait, STACK_DEPTH};
+use crate::module::{Compare, Module, Origin, Outcome, Special, error_flag, gp};
+use crate::program::{Context, RunMode, STACK_DEPTH, Source, TraceRecord, Wait};
 use tmclsim_protocol::frame::memory_reply;
-use tmclsim_protocol::{opcode, Command, Condition, Instruction, Status, WaitCondition};
+use tmclsim_protocol::{Command, Condition, Instruction, Status, WaitCondition, opcode};
 
 /// Ten milliseconds: one WAIT tick.
 const TICK_NS: u64 = 10_000_000;
@@ -438,11 +438,10 @@ impl Module {
         if !self.program.is_running() {
             return;
         }
-        if let Some(n) = self.profile.interrupt_for(source) {
-            if self.interrupts_enabled[n as usize] {
+        if let Some(n) = self.profile.interrupt_for(source)
+            && self.interrupts_enabled[n as usize] {
                 self.program.set_pending(n);
             }
-        }
     }
 
     /// Interrupts that depend on motion are enabled: the world must then be
@@ -454,7 +453,9 @@ impl Module {
                 self.interrupts_enabled[i.number as usize]
                     && matches!(
                         Source::from_symbol(&i.symbol),
-                        Some(Source::TargetReached(_) | Source::StopLeft(_) | Source::StopRight(_) | Source::Stall(_) | Source::Deviation(_))
+                        Some(
+                            Source::TargetReached(_) | Source::StopLeft(_) | Source::StopRight(_) | Source::Stall(_) | Source::Deviation(_)
+                        )
                     )
             })
     }

@@ -1,16 +1,16 @@
 //! A virtual TMCL module: profile, state, EEPROM, motion and world, driven
 //! by `handle_frame` (or `execute`) and `advance`.
 
+use crate::driver::Driver;
 use crate::eeprom::Eeprom;
 use crate::motion::{self, Motion, RampMode};
 use crate::profile::Profile;
 use crate::program::{Program, RunMode, Source};
-use crate::driver::Driver;
 use crate::reference_search::ReferenceSearch;
 use crate::world::World;
 use std::sync::Arc;
 use tmclsim_protocol::frame::version_string_reply;
-use tmclsim_protocol::{opcode, Reply, Request, Status, FRAME_LEN};
+use tmclsim_protocol::{FRAME_LEN, Reply, Request, Status, opcode};
 
 /// Axis parameter numbers the firmware gives a meaning to.
 pub mod ap {
@@ -452,7 +452,8 @@ impl Module {
         self.tick_offset_ms = 0;
         // Program memory from the EEPROM; the interpreter starts afresh.
         let words = self.program.memory.len();
-        let (trace, breakpoints, instruction_ns) = (self.program.trace.take(), std::mem::take(&mut self.program.breakpoints), self.program.instruction_ns);
+        let (trace, breakpoints, instruction_ns) =
+            (self.program.trace.take(), std::mem::take(&mut self.program.breakpoints), self.program.instruction_ns);
         self.program = Program::new(words);
         self.program.trace = trace.map(|_| Vec::new());
         self.program.breakpoints = breakpoints;
@@ -465,10 +466,12 @@ impl Module {
         self.program.download_pointer = self.program.length() as u16;
         self.program.next_ns = self.now_ns;
         self.last_inputs = self.world.digital_inputs;
-        self.last_switches = (0..self.axes.len()).map(|m| {
-            let (l, r, _) = self.switches(m);
-            (l, r)
-        }).collect();
+        self.last_switches = (0..self.axes.len())
+            .map(|m| {
+                let (l, r, _) = self.switches(m);
+                (l, r)
+            })
+            .collect();
         for m in 0..self.axes.len() {
             self.closed_loop_power_on(m);
         }
@@ -500,11 +503,8 @@ impl Module {
             return Some(Reply::new(host, request.address, Status::WrongChecksum, 0, 0).encode());
         }
         let ins = request.instruction;
-        let outcome = if self.program.download.is_some() && !opcode::is_control(ins.opcode) {
-            self.download_word(ins)
-        } else {
-            self.execute(ins)
-        };
+        let outcome =
+            if self.program.download.is_some() && !opcode::is_control(ins.opcode) { self.download_word(ins) } else { self.execute(ins) };
         let reply = match outcome.special {
             Special::Silent => return None,
             Special::Frame(f) => f,
@@ -551,7 +551,6 @@ impl Module {
         version_string_reply(self.host_address(), &self.profile.version_text())
     }
 
-
     // ----- time -------------------------------------------------------
 
     /// Advances virtual time by `dt_ns` nanoseconds: the program runs its
@@ -583,11 +582,10 @@ impl Module {
             // The next moment something happens on its own.
             let mut t = end;
             let mut at = |x: Option<u64>| {
-                if let Some(x) = x {
-                    if x > self.now_ns {
+                if let Some(x) = x
+                    && x > self.now_ns {
                         t = t.min(x);
                     }
-                }
             };
             at(self.heartbeat_deadline());
             at(timer);
@@ -616,14 +614,13 @@ impl Module {
             self.advance_axis(motor, dt);
         }
         self.now_ns = t;
-        if let Some(deadline) = self.heartbeat_deadline() {
-            if self.now_ns >= deadline {
+        if let Some(deadline) = self.heartbeat_deadline()
+            && self.now_ns >= deadline {
                 self.heartbeat_tripped = true;
                 for motor in 0..self.axes.len() {
                     self.motor_stop(motor);
                 }
             }
-        }
         self.look_at_inputs();
     }
 
@@ -688,12 +685,11 @@ impl Module {
         }
         let mut next = self.heartbeat_deadline();
         for (motor, axis) in self.axes.iter().enumerate() {
-            if axis.notify_on_arrival {
-                if let Some(t) = self.time_to_rest(motor) {
+            if axis.notify_on_arrival
+                && let Some(t) = self.time_to_rest(motor) {
                     let t = self.now_ns + (t * 1e9).ceil() as u64;
                     next = Some(next.map_or(t, |n| n.min(t)));
                 }
-            }
         }
         next
     }

@@ -192,7 +192,14 @@ impl Motion {
     /// of `x`) where a switch changes state; a phase ends there so that the
     /// caller can re-evaluate the switches. With `until_crossing` the step
     /// ends at the first threshold reached.
-    pub fn advance(&mut self, mut dt: f64, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops, thresholds: &[f64], until_crossing: bool) -> Step {
+    pub fn advance(
+        &mut self,
+        mut dt: f64,
+        ramp: &Ramp,
+        stops: &mut dyn FnMut(f64) -> Stops,
+        thresholds: &[f64],
+        until_crossing: bool,
+    ) -> Step {
         let mut step = Step::default();
         let mut elapsed = 0.0;
         for _ in 0..MAX_PHASES {
@@ -212,12 +219,11 @@ impl Motion {
                 // dust in the speed (a motor a hair short of its target
                 // with speed left).
                 let tc = self.crossing(phase.shape, th, t).map(|tc| if t - tc < 1e-9 { t } else { tc });
-                if let Some(tc) = tc {
-                    if tc < t || crossing.is_none() && tc <= t {
+                if let Some(tc) = tc
+                    && (tc < t || crossing.is_none() && tc <= t) {
                         t = tc;
                         crossing = Some(th);
                     }
-                }
             }
             let was_moving = self.v != 0.0;
             self.integrate(phase.shape, t);

@@ -243,15 +243,7 @@ impl Profile {
         if file.module.axes == 0 {
             return Err("a module has at least one axis".into());
         }
-        Ok(Profile {
-            module: file.module,
-            axis,
-            global,
-            ports: file.port,
-            interrupts: file.interrupt,
-            opcode_set,
-            ascii_set,
-        })
+        Ok(Profile { module: file.module, axis, global, ports: file.port, interrupts: file.interrupt, opcode_set, ascii_set })
     }
 
     /// A built-in profile by name (`tmcm-1141`, case-insensitive, the
@@ -260,7 +252,8 @@ impl Profile {
         let key = name.to_ascii_lowercase();
         let key = if key.starts_with("tmcm-") { key } else { format!("tmcm-{key}") };
         // Each built-in profile is parsed once per process and shared.
-        static PARSED: [std::sync::OnceLock<Result<Arc<Profile>, String>>; BUILT_IN.len()] = [const { std::sync::OnceLock::new() }; BUILT_IN.len()];
+        static PARSED: [std::sync::OnceLock<Result<Arc<Profile>, String>>; BUILT_IN.len()] =
+            [const { std::sync::OnceLock::new() }; BUILT_IN.len()];
         let i = BUILT_IN
             .iter()
             .position(|(n, _)| *n == key)
@@ -349,7 +342,10 @@ mod tests {
         assert_eq!(p.module.axes, 1);
         // Table 16 has 59 rows.
         assert_eq!(p.axis_parameters().count(), 59);
-        for n in [0u8, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 130, 135, 138, 140, 149, 150, 153, 154, 193, 194, 195, 196, 197, 200, 204, 206, 207, 208, 214, 254] {
+        for n in [
+            0u8, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 130, 135, 138, 140, 149, 150, 153, 154, 193, 194, 195, 196, 197, 200, 204, 206,
+            207, 208, 214, 254,
+        ] {
             assert!(p.axis_parameter(n).is_some(), "AP {n}");
         }
         for n in 160..=184 {
@@ -407,7 +403,9 @@ mod tests {
     fn bad_profiles_are_rejected_with_a_reason() {
         assert!(Profile::from_toml("nonsense").is_err());
         let base = BUILT_IN[0].1;
-        let dup = format!("{base}\n[[axis_parameter]]\nnumber = 4\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\ndefault_source = \"assumed\"\n");
+        let dup = format!(
+            "{base}\n[[axis_parameter]]\nnumber = 4\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\ndefault_source = \"assumed\"\n"
+        );
         assert!(Profile::from_toml(&dup).unwrap_err().contains("twice"));
     }
 }

@@ -70,7 +70,9 @@ impl ReferenceSearch {
     /// switch, then the reference (home) switch in the negative direction,
     /// zero at its edge. AP 196 gets the distance in modes 2 and 3.
     pub fn new_tmc428(mode: i32) -> Option<ReferenceSearch> {
-        let edge = |s: Switch, dir: f64| vec![(seek(s, true, dir, true), false), (seek(s, false, -dir, false), true), (seek(s, true, dir, false), true)];
+        let edge = |s: Switch, dir: f64| {
+            vec![(seek(s, true, dir, true), false), (seek(s, false, -dir, false), true), (seek(s, true, dir, false), true)]
+        };
         let (seeks, result) = match mode {
             1 => (edge(Switch::Left, -1.0), Result_::Edge),
             2 => ([edge(Switch::Right, 1.0), edge(Switch::Left, -1.0)].concat(), Result_::TwoSwitches),
@@ -93,7 +95,9 @@ impl ReferenceSearch {
         // The switch searched for the zero point, and the other one.
         let (near, far, toward) = if right { (Switch::Right, Switch::Left, 1.0) } else { (Switch::Left, Switch::Right, -1.0) };
         // Find a stop switch's edge: in fast, out slow, in slow (marked).
-        let edge = |s: Switch, dir: f64| vec![(seek(s, true, dir, true), false), (seek(s, false, -dir, false), true), (seek(s, true, dir, false), true)];
+        let edge = |s: Switch, dir: f64| {
+            vec![(seek(s, true, dir, true), false), (seek(s, false, -dir, false), true), (seek(s, true, dir, false), true)]
+        };
         // Its far edge: through it slowly, back in slowly (marked).
         let far_edge = |s: Switch, dir: f64| vec![(seek(s, false, dir, false), true), (seek(s, true, -dir, false), true)];
         let (seeks, result) = match base {
@@ -107,7 +111,10 @@ impl ReferenceSearch {
                 // direction.
                 let (dir, stop) = if base == 5 { (-1.0, Switch::Left) } else { (1.0, Switch::Right) };
                 let first = Seek { reverse_on: Some(stop), ..seek(Switch::Home, true, dir, true) };
-                (vec![(first, false), (seek(Switch::Home, false, -dir, false), true), (seek(Switch::Home, true, dir, false), true)], Result_::Edge)
+                (
+                    vec![(first, false), (seek(Switch::Home, false, -dir, false), true), (seek(Switch::Home, true, dir, false), true)],
+                    Result_::Edge,
+                )
             }
             _ => {
                 // 7: negative, 8: positive (chapter 7.1), ignoring the stop
@@ -145,13 +152,12 @@ impl ReferenceSearch {
         let mut changed = false;
         while let Some(&(s, mark)) = self.seeks.get(self.next) {
             let probe = x + self.dir * 1e-6;
-            if let Some(stop) = s.reverse_on {
-                if stop_is_ahead(stop, self.dir) && state(stop, probe) {
+            if let Some(stop) = s.reverse_on
+                && stop_is_ahead(stop, self.dir) && state(stop, probe) {
                     self.dir = -self.dir;
                     changed = true;
                     continue;
                 }
-            }
             if state(s.switch, probe) != s.active {
                 break;
             }

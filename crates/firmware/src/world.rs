@@ -122,7 +122,14 @@ impl World {
     /// 40 °C.
     pub fn free(axes: usize) -> World {
         let axis = AxisWorld { fullsteps_per_rev: 200.0, encoder_counts: Some(2000.0), ..AxisWorld::default() };
-        World { axes: vec![axis; axes], digital_inputs: 0, analog_inputs: vec![0; 8], supply_decivolts: 240, temperature: 40.0, shutdown_input: false }
+        World {
+            axes: vec![axis; axes],
+            digital_inputs: 0,
+            analog_inputs: vec![0; 8],
+            supply_decivolts: 240,
+            temperature: 40.0,
+            shutdown_input: false,
+        }
     }
 
     /// The built-in world: every axis a linear stage of ±1 050 000 µsteps

@@ -4,7 +4,7 @@
 
 use tmclsim_firmware::Module;
 use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{checksum, Instruction, Reply, Request, Status};
+use tmclsim_protocol::{Instruction, Reply, Request, Status, checksum};
 
 fn module() -> Module {
     Module::built_in("tmcm-1141").unwrap()
@@ -121,7 +121,7 @@ fn every_table_16_parameter_obeys_its_access_and_range() {
         assert_eq!(get.status, if p.access.read { 100 } else { 3 }, "GAP {n}");
         if p.access.write {
             let max = p.max.min(i32::MAX as i64);
-            if !matches!(n, 0 | 1 | 2) {
+            if !matches!(n, 0..=2) {
                 assert_eq!(status(&mut m, &format!("SAP {n}, 0, {max}")), 100, "SAP {n} max");
                 assert_eq!(value(&mut m, &format!("GAP {n}, 0")), max as i32, "GAP {n} after SAP");
             }

@@ -1,8 +1,8 @@
 //! stallGuard2, coolStep, stop on stall, driver faults and lost steps
 //! against the load model of docs/world.md.
 
-use tmclsim_firmware::world::Load;
 use tmclsim_firmware::Module;
+use tmclsim_firmware::world::Load;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
 
@@ -77,7 +77,8 @@ fn stall_stops_above_ap181_but_not_below() {
 fn stall_interrupt_fires() {
     let mut m = module();
     send(&mut m, "SAP 181, 0, 100");
-    let words: Vec<_> = ["VECT 15, 5", "EI 15", "EI 255", "ROR 0, 500", "JA 4", "CALCV ADD, 9, 1", "RETI"].iter().map(|l| parse_line(l).unwrap()).collect();
+    let words: Vec<_> =
+        ["VECT 15, 5", "EI 15", "EI 255", "ROR 0, 500", "JA 4", "CALCV ADD, 9, 1", "RETI"].iter().map(|l| parse_line(l).unwrap()).collect();
     m.load_program(&words).unwrap();
     m.start_program();
     m.advance(500 * MS);

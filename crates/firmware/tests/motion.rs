@@ -2,8 +2,8 @@
 //! (decisions.md rules 23–25): durations, exact final positions, velocity
 //! ramps, limit switches.
 
-use tmclsim_firmware::motion::{self, Motion, Ramp};
 use tmclsim_firmware::Module;
+use tmclsim_firmware::motion::{self, Motion, Ramp};
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
 
@@ -49,7 +49,13 @@ fn mvp_durations_match_the_closed_form() {
     ];
     for (vmax, a, vmin, rd, pd, dist) in cases {
         let mut m = Module::built_in("tmcm-1141").unwrap();
-        for line in [format!("SAP 4, 0, {vmax}"), format!("SAP 5, 0, {a}"), format!("SAP 130, 0, {vmin}"), format!("SAP 153, 0, {rd}"), format!("SAP 154, 0, {pd}")] {
+        for line in [
+            format!("SAP 4, 0, {vmax}"),
+            format!("SAP 5, 0, {a}"),
+            format!("SAP 130, 0, {vmin}"),
+            format!("SAP 153, 0, {rd}"),
+            format!("SAP 154, 0, {pd}"),
+        ] {
             send(&mut m, &line);
         }
         send(&mut m, &format!("MVP ABS, 0, {dist}"));

@@ -1,8 +1,8 @@
 //! Standalone programs on the virtual TMCM-1141: download, control
 //! commands, every flow command, WAIT, interrupts, persistence.
 
-use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::Module;
+use tmclsim_firmware::program::RunMode;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Instruction, Reply, Request};
 
@@ -180,7 +180,21 @@ fn wait_ticks_and_accumulator_ticks() {
 fn wait_pos_and_timeout_sets_eto() {
     let mut m = module();
     // Move far with a timeout of 10 ticks: ETO is set, JC ETO jumps.
-    run(&mut m, &["MVP ABS, 0, 10000000", "WAIT POS, 0, 10", "JC ETO, 4", "STOP", "CALCV LOAD, 40, 1", "CLE ETO", "JC ETO, 3", "CALCV LOAD, 41, 1", "STOP"], 200);
+    run(
+        &mut m,
+        &[
+            "MVP ABS, 0, 10000000",
+            "WAIT POS, 0, 10",
+            "JC ETO, 4",
+            "STOP",
+            "CALCV LOAD, 40, 1",
+            "CLE ETO",
+            "JC ETO, 3",
+            "CALCV LOAD, 41, 1",
+            "STOP",
+        ],
+        200,
+    );
     assert_eq!(var(&mut m, 40), 1);
     assert_eq!(var(&mut m, 41), 1, "CLE cleared the flag");
     // WAIT POS without timeout ends when the motor arrives.
@@ -385,7 +399,10 @@ fn random_programs_never_panic_or_hang() {
         let words: Vec<Instruction> = (0..64)
             .map(|_| {
                 let r = next();
-                let opcode = [1u8, 2, 3, 4, 5, 6, 9, 10, 14, 15, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28, 33, 36, 37, 38, 40, 45, 48, 49, 55, 56, 57, 80, 200][(r % 33) as usize];
+                let opcode = [
+                    1u8, 2, 3, 4, 5, 6, 9, 10, 14, 15, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28, 33, 36, 37, 38, 40, 45, 48, 49, 55, 56, 57,
+                    80, 200,
+                ][(r % 33) as usize];
                 Instruction::new(opcode, (r >> 8) as u8 % 16, (r >> 16) as u8 % 3, ((r >> 24) as i32) % 70)
             })
             .collect();
@@ -404,7 +421,17 @@ fn random_programs_never_panic_or_hang() {
 fn one_long_advance_equals_many_short_ones() {
     for far in [20_000, 100_000] {
         let far_line = format!("MVP ABS, 0, {far}");
-        let program = ["SAP 4, 0, 2047", far_line.as_str(), "WAIT POS, 0, 0", "MVP ABS, 0, 0", "WAIT POS, 0, 0", "GGP 51, 2", "CALC ADD, 1", "AGP 51, 2", "JA 1"];
+        let program = [
+            "SAP 4, 0, 2047",
+            far_line.as_str(),
+            "WAIT POS, 0, 0",
+            "MVP ABS, 0, 0",
+            "WAIT POS, 0, 0",
+            "GGP 51, 2",
+            "CALC ADD, 1",
+            "AGP 51, 2",
+            "JA 1",
+        ];
         let stage = || {
             let profile = tmclsim_firmware::Profile::built_in("tmcm-1141").unwrap();
             Module::with_world(profile, tmclsim_firmware::Eeprom::new("TMCM-1141"), tmclsim_firmware::World::stage(1))

@@ -152,7 +152,8 @@ fn stop_and_status() {
 fn wait_rfs_in_a_program() {
     let mut m = stage(0);
     send(&mut m, "SAP 193, 0, 1");
-    let words: Vec<_> = ["RFS START, 0", "WAIT RFS, 0, 0", "GAP 197, 0", "AGP 9, 2", "STOP"].iter().map(|l| parse_line(l).unwrap()).collect();
+    let words: Vec<_> =
+        ["RFS START, 0", "WAIT RFS, 0, 0", "GAP 197, 0", "AGP 9, 2", "STOP"].iter().map(|l| parse_line(l).unwrap()).collect();
     m.load_program(&words).unwrap();
     m.start_program();
     m.advance(600_000 * MS);

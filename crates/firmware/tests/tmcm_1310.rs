@@ -132,7 +132,10 @@ fn deviation_interrupt_fires() {
     setup(&mut m, true);
     send(&mut m, "SAP 125, 0, 2000");
     // (No CALCV on the 1310: the handler counts with GGP/CALC/AGP.)
-    let words: Vec<_> = ["VECT 21, 5", "EI 21", "EI 255", "MVP ABS, 0, 200000", "JA 4", "GGP 7, 2", "CALC ADD, 1", "AGP 7, 2", "RETI"].iter().map(|l| parse_line(l).unwrap()).collect();
+    let words: Vec<_> = ["VECT 21, 5", "EI 21", "EI 255", "MVP ABS, 0, 200000", "JA 4", "GGP 7, 2", "CALC ADD, 1", "AGP 7, 2", "RETI"]
+        .iter()
+        .map(|l| parse_line(l).unwrap())
+        .collect();
     m.load_program(&words).unwrap();
     m.start_program();
     m.advance(200 * MS);

@@ -71,7 +71,24 @@ fn golden_frames_of_the_351_manual() {
 #[test]
 fn commands_the_351_lacks_answer_status_2() {
     let mut m = module();
-    for line in ["EI 0", "DI 0", "VECT 0, 5", "RETI", "CALCVV ADD, 1, 2", "CALCV ADD, 1, 2", "MVPA ABS, 0", "RST 0", "DJNZ 1, 0", "ROLA 0", "RORA 0", "SIV 1", "GIV", "AIV", "CALL ZE, 0", "#138 1 0 1"] {
+    for line in [
+        "EI 0",
+        "DI 0",
+        "VECT 0, 5",
+        "RETI",
+        "CALCVV ADD, 1, 2",
+        "CALCV ADD, 1, 2",
+        "MVPA ABS, 0",
+        "RST 0",
+        "DJNZ 1, 0",
+        "ROLA 0",
+        "RORA 0",
+        "SIV 1",
+        "GIV",
+        "AIV",
+        "CALL ZE, 0",
+        "#138 1 0 1",
+    ] {
         assert_eq!(reply(&mut m, line).status, 2, "{line}");
     }
     assert_eq!(reply(&mut m, "GAP 1, 3").status, 4, "three axes: 0…2");
@@ -110,9 +127,9 @@ fn mvp_coord_masks_interpolated_and_not() {
         let mut arrival = [None; 3];
         for step in 1..=20_000 {
             m.advance(MS);
-            for a in 0..3 {
-                if arrival[a].is_none() && send(&mut m, &format!("GAP 8, {a}")) == 1 {
-                    arrival[a] = Some(step);
+            for (a, arrived) in arrival.iter_mut().enumerate() {
+                if arrived.is_none() && send(&mut m, &format!("GAP 8, {a}")) == 1 {
+                    *arrived = Some(step);
                 }
             }
         }
@@ -240,7 +257,11 @@ fn stall_detection_ap205_ap206() {
 
 #[test]
 fn encoder_prescaler_and_deviation_stop() {
-    let mut m = Module::with_world(tmclsim_firmware::Profile::built_in("tmcm-351").unwrap(), tmclsim_firmware::Eeprom::new("TMCM-351"), World::free(3));
+    let mut m = Module::with_world(
+        tmclsim_firmware::Profile::built_in("tmcm-351").unwrap(),
+        tmclsim_firmware::Eeprom::new("TMCM-351"),
+        World::free(3),
+    );
     // The manual's encoder demo setup: 2000-line encoder, 64 µsteps, 68672 = ×6.4.
     send(&mut m, "SAP 210, 0, 68672");
     send(&mut m, "SAP 209, 0, 0");

@@ -169,73 +169,230 @@ impl ErrorFlag {
 /// Every TMCL command of the three modules, typed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Command {
-    Ror { motor: u8, velocity: i32 },
-    Rol { motor: u8, velocity: i32 },
-    Mst { motor: u8 },
-    Mvp { mode: MoveMode, motor: u8, value: i32 },
-    Sap { param: u8, motor: u8, value: i32 },
-    Gap { param: u8, motor: u8 },
-    Stap { param: u8, motor: u8 },
-    Rsap { param: u8, motor: u8 },
-    Sgp { param: u8, bank: u8, value: i32 },
-    Ggp { param: u8, bank: u8 },
-    Stgp { param: u8, bank: u8 },
-    Rsgp { param: u8, bank: u8 },
-    Rfs { action: RfsAction, motor: u8 },
-    Sio { port: u8, bank: u8, value: i32 },
-    Gio { port: u8, bank: u8 },
-    Calc { op: CalcOp, value: i32 },
-    Comp { value: i32 },
-    Jc { condition: Condition, address: i32 },
-    Ja { address: i32 },
-    Csub { address: i32 },
+    Ror {
+        motor: u8,
+        velocity: i32,
+    },
+    Rol {
+        motor: u8,
+        velocity: i32,
+    },
+    Mst {
+        motor: u8,
+    },
+    Mvp {
+        mode: MoveMode,
+        motor: u8,
+        value: i32,
+    },
+    Sap {
+        param: u8,
+        motor: u8,
+        value: i32,
+    },
+    Gap {
+        param: u8,
+        motor: u8,
+    },
+    Stap {
+        param: u8,
+        motor: u8,
+    },
+    Rsap {
+        param: u8,
+        motor: u8,
+    },
+    Sgp {
+        param: u8,
+        bank: u8,
+        value: i32,
+    },
+    Ggp {
+        param: u8,
+        bank: u8,
+    },
+    Stgp {
+        param: u8,
+        bank: u8,
+    },
+    Rsgp {
+        param: u8,
+        bank: u8,
+    },
+    Rfs {
+        action: RfsAction,
+        motor: u8,
+    },
+    Sio {
+        port: u8,
+        bank: u8,
+        value: i32,
+    },
+    Gio {
+        port: u8,
+        bank: u8,
+    },
+    Calc {
+        op: CalcOp,
+        value: i32,
+    },
+    Comp {
+        value: i32,
+    },
+    Jc {
+        condition: Condition,
+        address: i32,
+    },
+    Ja {
+        address: i32,
+    },
+    Csub {
+        address: i32,
+    },
     Rsub,
-    Ei { interrupt: u8 },
-    Di { interrupt: u8 },
-    Wait { condition: WaitCondition, motor: u8, ticks: i32 },
+    Ei {
+        interrupt: u8,
+    },
+    Di {
+        interrupt: u8,
+    },
+    Wait {
+        condition: WaitCondition,
+        motor: u8,
+        ticks: i32,
+    },
     Stop,
-    Sac { bus: u8, count: u8, value: i32 },
-    Sco { coordinate: u8, motor: u8, value: i32 },
-    Gco { coordinate: u8, motor: u8 },
-    Cco { coordinate: u8, motor: u8 },
-    CalcX { op: CalcOp },
-    Aap { param: u8, motor: u8 },
-    Agp { param: u8, bank: u8 },
-    Cle { flag: ErrorFlag },
-    Vect { interrupt: u8, address: i32 },
+    Sac {
+        bus: u8,
+        count: u8,
+        value: i32,
+    },
+    Sco {
+        coordinate: u8,
+        motor: u8,
+        value: i32,
+    },
+    Gco {
+        coordinate: u8,
+        motor: u8,
+    },
+    Cco {
+        coordinate: u8,
+        motor: u8,
+    },
+    CalcX {
+        op: CalcOp,
+    },
+    Aap {
+        param: u8,
+        motor: u8,
+    },
+    Agp {
+        param: u8,
+        bank: u8,
+    },
+    Cle {
+        flag: ErrorFlag,
+    },
+    Vect {
+        interrupt: u8,
+        address: i32,
+    },
     Reti,
-    Aco { coordinate: u8, motor: u8 },
+    Aco {
+        coordinate: u8,
+        motor: u8,
+    },
     /// var1 in the motor/bank byte, var2 in the value.
-    CalcVV { op: CalcOp, var1: u8, var2: i32 },
-    CalcVA { op: CalcOp, var: u8 },
-    CalcAV { op: CalcOp, var: u8 },
-    CalcVX { op: CalcOp, var: u8 },
-    CalcXV { op: CalcOp, var: u8 },
-    CalcV { op: CalcOp, var: u8, value: i32 },
-    Mvpa { mode: MoveMode, motor: u8 },
-    Rst { address: i32 },
-    Djnz { var: u8, address: i32 },
-    Rola { motor: u8 },
-    Rora { motor: u8 },
-    Siv { value: i32 },
+    CalcVV {
+        op: CalcOp,
+        var1: u8,
+        var2: i32,
+    },
+    CalcVA {
+        op: CalcOp,
+        var: u8,
+    },
+    CalcAV {
+        op: CalcOp,
+        var: u8,
+    },
+    CalcVX {
+        op: CalcOp,
+        var: u8,
+    },
+    CalcXV {
+        op: CalcOp,
+        var: u8,
+    },
+    CalcV {
+        op: CalcOp,
+        var: u8,
+        value: i32,
+    },
+    Mvpa {
+        mode: MoveMode,
+        motor: u8,
+    },
+    Rst {
+        address: i32,
+    },
+    Djnz {
+        var: u8,
+        address: i32,
+    },
+    Rola {
+        motor: u8,
+    },
+    Rora {
+        motor: u8,
+    },
+    Siv {
+        value: i32,
+    },
     Giv,
     Aiv,
-    UserFunction { number: u8, kind: u8, motor: u8, value: i32 },
-    Call { condition: Condition, address: i32 },
+    UserFunction {
+        number: u8,
+        kind: u8,
+        motor: u8,
+        value: i32,
+    },
+    Call {
+        condition: Condition,
+        address: i32,
+    },
     StopApplication,
     /// `None`: continue from the current address.
-    RunApplication { from: Option<i32> },
+    RunApplication {
+        from: Option<i32>,
+    },
     StepApplication,
     ResetApplication,
-    EnterDownload { address: i32 },
+    EnterDownload {
+        address: i32,
+    },
     ExitDownload,
-    ReadMemory { address: i32 },
-    ApplicationStatus { kind: u8 },
-    FirmwareVersion { binary: bool },
-    FactoryDefaults { key: i32 },
-    TargetReachedEvent { every_move: bool, mask: i32 },
+    ReadMemory {
+        address: i32,
+    },
+    ApplicationStatus {
+        kind: u8,
+    },
+    FirmwareVersion {
+        binary: bool,
+    },
+    FactoryDefaults {
+        key: i32,
+    },
+    TargetReachedEvent {
+        every_move: bool,
+        mask: i32,
+    },
     AsciiMode,
-    Reset { key: i32 },
+    Reset {
+        key: i32,
+    },
 }
 
 /// Why seven bytes are not a command.
@@ -323,11 +480,7 @@ impl Command {
             op::RSUB => Command::Rsub,
             op::EI => Command::Ei { interrupt: kind },
             op::DI => Command::Di { interrupt: kind },
-            op::WAIT => Command::Wait {
-                condition: WaitCondition::from_code(kind).ok_or(wrong)?,
-                motor,
-                ticks: value,
-            },
+            op::WAIT => Command::Wait { condition: WaitCondition::from_code(kind).ok_or(wrong)?, motor, ticks: value },
             op::STOP => Command::Stop,
             op::SAC => Command::Sac { bus: kind, count: motor, value },
             op::SCO => Command::Sco { coordinate: kind, motor, value },
@@ -475,10 +628,7 @@ impl Command {
     /// Branch and flow commands: program-only (decisions.md rule 7).
     pub fn is_program_only(&self) -> bool {
         use Command::*;
-        matches!(
-            self,
-            Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti
-        )
+        matches!(self, Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti)
     }
 }
 

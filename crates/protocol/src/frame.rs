@@ -32,12 +32,7 @@ impl Instruction {
     }
 
     pub fn from_bytes(b: &[u8; 7]) -> Self {
-        Instruction {
-            opcode: b[0],
-            kind: b[1],
-            motor: b[2],
-            value: i32::from_be_bytes([b[3], b[4], b[5], b[6]]),
-        }
+        Instruction { opcode: b[0], kind: b[1], motor: b[2], value: i32::from_be_bytes([b[3], b[4], b[5], b[6]]) }
     }
 }
 
@@ -63,15 +58,8 @@ impl Request {
     /// Splits a frame into its fields; `Err` carries the request anyway so a
     /// module can answer a checksum error with its own address.
     pub fn decode(frame: &[u8; FRAME_LEN]) -> Result<Request, Request> {
-        let request = Request {
-            address: frame[0],
-            instruction: Instruction::from_bytes(frame[1..8].try_into().unwrap()),
-        };
-        if checksum(&frame[..8]) == frame[8] {
-            Ok(request)
-        } else {
-            Err(request)
-        }
+        let request = Request { address: frame[0], instruction: Instruction::from_bytes(frame[1..8].try_into().unwrap()) };
+        if checksum(&frame[..8]) == frame[8] { Ok(request) } else { Err(request) }
     }
 }
 

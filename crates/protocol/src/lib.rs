@@ -15,5 +15,5 @@ pub mod slcan;
 pub mod status;
 
 pub use command::{CalcOp, Command, Condition, DecodeError, ErrorFlag, MoveMode, RfsAction, WaitCondition};
-pub use frame::{checksum, Instruction, Reply, Request, FRAME_LEN};
+pub use frame::{FRAME_LEN, Instruction, Reply, Request, checksum};
 pub use status::Status;

@@ -45,8 +45,9 @@ pub fn layout(opcode: u8) -> Option<&'static [Operand]> {
         op::MVP => &[MODE, Motor, Value],
         op::MVPA => &[MODE, Motor],
         op::SAP | op::SGP | op::SIO | op::SCO | op::SAC => &[Type, Motor, Value],
-        op::GAP | op::STAP | op::RSAP | op::GGP | op::STGP | op::RSGP | op::GIO | op::GCO | op::CCO | op::ACO
-        | op::AAP | op::AGP => &[Type, Motor],
+        op::GAP | op::STAP | op::RSAP | op::GGP | op::STGP | op::RSGP | op::GIO | op::GCO | op::CCO | op::ACO | op::AAP | op::AGP => {
+            &[Type, Motor]
+        }
         op::RFS => &[TypeSymbol(RFS_ACTIONS), Motor],
         op::CALC => &[CALC, Value],
         op::COMP | op::SIV => &[Value],
@@ -147,7 +148,12 @@ pub fn parse_line(line: &str) -> Result<Instruction, ParseError> {
         let byte = |k: usize| -> Result<u8, ParseError> {
             u8::try_from(n[k]).map_err(|_| err(fields[k].0, format!("{} does not fit in a byte", n[k])))
         };
-        return Ok(Instruction::new(byte(0)?, byte(1)?, byte(2)?, to_i32(n[3]).ok_or_else(|| err(fields[3].0, "value out of 32-bit range".into()))?));
+        return Ok(Instruction::new(
+            byte(0)?,
+            byte(1)?,
+            byte(2)?,
+            to_i32(n[3]).ok_or_else(|| err(fields[3].0, "value out of 32-bit range".into()))?,
+        ));
     }
     let opcode = op::from_mnemonic(head).ok_or_else(|| err(c0, format!("unknown command '{head}'")))?;
     let layout = layout(opcode).expect("every mnemonic has a layout");

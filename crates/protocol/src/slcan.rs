@@ -13,11 +13,18 @@ pub enum SlcanCommand {
     /// `sxxyy`: bit timing registers.
     BitTiming,
     /// `O` (or `L`, listen only).
-    Open { listen_only: bool },
+    Open {
+        listen_only: bool,
+    },
     /// `C`.
     Close,
     /// `t`/`T`: a data frame; `r`/`R`: a remote frame.
-    Transmit { id: u32, extended: bool, remote: bool, data: Vec<u8> },
+    Transmit {
+        id: u32,
+        extended: bool,
+        remote: bool,
+        data: Vec<u8>,
+    },
     /// `V`, `v`: version; `N`: serial number; `F`: status flags.
     Version,
     SerialNumber,

@@ -70,7 +70,13 @@ fn open(iface: &str) -> io::Result<(libc::c_int, libc::c_int)> {
             return Err(e);
         }
         let tv = libc::timeval { tv_sec: 0, tv_usec: 100_000 };
-        libc::setsockopt(fd, libc::SOL_SOCKET, libc::SO_RCVTIMEO, &tv as *const _ as *const libc::c_void, std::mem::size_of::<libc::timeval>() as u32);
+        libc::setsockopt(
+            fd,
+            libc::SOL_SOCKET,
+            libc::SO_RCVTIMEO,
+            &tv as *const _ as *const libc::c_void,
+            std::mem::size_of::<libc::timeval>() as u32,
+        );
         Ok((fd, index as i32))
     }
 }
@@ -115,7 +121,14 @@ pub fn serve(iface: &str, segment: Segment) -> io::Result<EthercatHandle> {
                 to.sll_family = libc::AF_PACKET as u16;
                 to.sll_ifindex = index;
                 to.sll_halen = 6;
-                libc::sendto(fd, frame.as_ptr().cast(), frame.len(), 0, &to as *const _ as *const libc::sockaddr, std::mem::size_of::<libc::sockaddr_ll>() as u32);
+                libc::sendto(
+                    fd,
+                    frame.as_ptr().cast(),
+                    frame.len(),
+                    0,
+                    &to as *const _ as *const libc::sockaddr,
+                    std::mem::size_of::<libc::sockaddr_ll>() as u32,
+                );
             }
         }
         // SAFETY: the thread owns the descriptor.

@@ -5,14 +5,14 @@
 //! host closing and reopening the port. The slave is put in raw mode (no
 //! echo, no line editing) as a USB/RS485 serial port behaves.
 
-use crate::shared::SharedModule;
 use crate::ServerConfig;
+use crate::shared::SharedModule;
 use std::io;
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd, RawFd};
 use std::path::{Path, PathBuf};
 use std::pin::Pin;
 use std::sync::Arc;
-use std::task::{ready, Context, Poll};
+use std::task::{Context, Poll, ready};
 use tokio::io::unix::AsyncFd;
 use tokio::io::{AsyncRead, AsyncWrite, ReadBuf};
 use tokio::sync::watch;
@@ -56,7 +56,7 @@ impl Pty {
                     return Err(io::Error::new(
                         io::ErrorKind::AlreadyExists,
                         format!("{} exists and is not a symlink; not replacing it", link.display()),
-                    ))
+                    ));
                 }
                 Err(_) => {}
             }

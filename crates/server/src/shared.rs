@@ -6,10 +6,10 @@ use crate::faults::LinkFaults;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
-use tmclsim_firmware::eeprom::save_atomic;
 use tmclsim_firmware::Module;
+use tmclsim_firmware::eeprom::save_atomic;
 use tmclsim_protocol::FRAME_LEN;
-use tokio::sync::{mpsc, Notify};
+use tokio::sync::{Notify, mpsc};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
 type EventSink = mpsc::UnboundedSender<[u8; FRAME_LEN]>;
@@ -50,7 +50,11 @@ pub struct Stats {
 
 impl Stats {
     pub fn add(self, o: Stats) -> Stats {
-        Stats { frames: self.frames + o.frames, missed_deadlines: self.missed_deadlines + o.missed_deadlines, max_lateness_ns: self.max_lateness_ns.max(o.max_lateness_ns) }
+        Stats {
+            frames: self.frames + o.frames,
+            missed_deadlines: self.missed_deadlines + o.missed_deadlines,
+            max_lateness_ns: self.max_lateness_ns.max(o.max_lateness_ns),
+        }
     }
 }
 
@@ -292,7 +296,12 @@ impl SharedModule {
     }
 
     /// Handles a CAN frame: every module sees it, those it is for answer.
-    pub(crate) fn handle_can(&self, link: u64, sink: &EventSink, frame: &tmclsim_firmware::can::CanFrame) -> Vec<tmclsim_firmware::can::CanFrame> {
+    pub(crate) fn handle_can(
+        &self,
+        link: u64,
+        sink: &EventSink,
+        frame: &tmclsim_firmware::can::CanFrame,
+    ) -> Vec<tmclsim_firmware::can::CanFrame> {
         let mut s = self.lock();
         let now = self.now_ns();
         let mut replies = Vec::new();
@@ -359,11 +368,10 @@ impl SharedModule {
                 }
             }
             if n.module.eeprom_generation() != n.saved_generation {
-                if let Some(path) = &n.eeprom {
-                    if let Err(e) = save_atomic(path, n.module.eeprom()) {
+                if let Some(path) = &n.eeprom
+                    && let Err(e) = save_atomic(path, n.module.eeprom()) {
                         eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
                     }
-                }
                 n.saved_generation = n.module.eeprom_generation();
             }
         }

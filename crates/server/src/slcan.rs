@@ -52,11 +52,10 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedModule>, mut stop: watch::Re
                 }
             }
             Some(event) = events.recv() => {
-                if open {
-                    if let Some(f) = module.event_as_can(&event) {
+                if open
+                    && let Some(f) = module.event_as_can(&event) {
                         out.push_str(&slcan::received(f.id, f.bytes()));
                     }
-                }
             }
             _ = stop.changed() => return,
         }

@@ -1,9 +1,9 @@
 //! TCP: every connection is a link of its own to the same module.
 
-use crate::shared::SharedModule;
 use crate::ServerConfig;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use crate::shared::SharedModule;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use tokio::net::TcpListener;
 use tokio::sync::watch;
 

@@ -7,7 +7,7 @@ use std::time::Duration;
 use tmclsim_firmware::{Eeprom, Module, Profile, World};
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
-use tmclsim_server::{start, ServerConfig};
+use tmclsim_server::{ServerConfig, start};
 
 #[test]
 fn control_lines_change_the_world_and_the_link() {

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use tmclsim_firmware::Module;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
-use tmclsim_server::{start, ServerConfig, ServerHandle};
+use tmclsim_server::{ServerConfig, ServerHandle, start};
 
 fn serve_tcp() -> ServerHandle {
     let config = ServerConfig { tcp: Some("127.0.0.1:0".parse().unwrap()), ..ServerConfig::default() };

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use tmclsim_asm::{assemble, MemoryResolver, Profile, Program};
+use tmclsim_asm::{MemoryResolver, Profile, Program, assemble};
 
 pub fn tmcm_1141() -> Arc<Profile> {
     Profile::built_in("tmcm-1141").expect("built-in profile")
