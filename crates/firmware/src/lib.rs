@@ -5,7 +5,9 @@
 //! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
 
 pub mod ascii;
+pub mod bus;
 pub mod can;
+pub mod clock;
 pub mod closed_loop;
 pub mod driver;
 pub mod eeprom;
@@ -16,9 +18,13 @@ pub mod motion;
 pub mod profile;
 pub mod program;
 pub mod reference_search;
+pub mod snapshot;
 pub mod world;
+pub mod world_command;
 pub mod world_file;
 
+pub use bus::Bus;
+pub use clock::Clock;
 pub use eeprom::Eeprom;
 pub use module::{Module, Outcome, Special};
 pub use profile::Profile;
