@@ -168,14 +168,13 @@ impl Features {
                     None => "serial addresses (GP 66/87 id, GP 76 reply id)".to_string(),
                 },
             ),
-            (
-                "baud_rates",
-                format!(
-                    "{} bit/s (GP 65 codes 0…{})",
-                    self.baud_rates.iter().map(u32::to_string).collect::<Vec<_>>().join(", "),
-                    self.baud_rates.len().saturating_sub(1)
-                ),
-            ),
+            ("baud_rates", {
+                let rates = self.baud_rates.iter().map(u32::to_string).collect::<Vec<_>>().join(", ");
+                match self.baud_rates.len() {
+                    1 => format!("{rates} bit/s (every GP 65 code)"),
+                    n => format!("{rates} bit/s (GP 65 codes 0…{})", n - 1),
+                }
+            }),
             ("full_scale_current_ma", format!("{} mA RMS", self.full_scale_current_ma)),
         ]
     }
