@@ -271,6 +271,15 @@ impl Module {
         self.profile.module.name.clone()
     }
 
+    /// What makes this module differ from the others, as its profile's
+    /// ``[features]`` table says: ``{"reference_search": "tmc429",
+    /// "closed_loop": "false", …}`` (values as ``tmclsim profile`` prints
+    /// them).
+    #[getter]
+    fn features(&self) -> BTreeMap<&'static str, String> {
+        self.profile.features.list().into_iter().collect()
+    }
+
     /// How many motors the module has.
     #[getter]
     fn axes(&self) -> u8 {

@@ -146,6 +146,9 @@ class Module:
     def profile(self) -> str:
         """The module's name, e.g. ``"TMCM-1141"``."""
     @property
+    def features(self) -> Dict[str, str]:
+        """The profile's ``[features]`` table (reference search family, closed loop, CAN ids, …)."""
+    @property
     def axes(self) -> int: ...
     @property
     def address(self) -> int:

@@ -4,7 +4,7 @@
 
 use std::collections::HashSet;
 
-use tmclsim_firmware::Profile;
+use tmclsim_profile::Profile;
 use tmclsim_protocol::{Instruction, opcode as op};
 
 use crate::Program;

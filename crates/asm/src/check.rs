@@ -8,8 +8,8 @@
 //! command with an error status (decisions.md rule 6) and skip it in a
 //! program (rule 21).
 
-use tmclsim_firmware::Profile;
-use tmclsim_firmware::profile::{Access, Parameter, PortDirection};
+use tmclsim_profile::Profile;
+use tmclsim_profile::{Access, Parameter, PortDirection};
 use tmclsim_protocol::opcode as op;
 
 use crate::encoder::Encoded;

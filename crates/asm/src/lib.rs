@@ -42,7 +42,7 @@ pub use assembler::assemble;
 pub use diagnostic::{Diagnostic, render};
 pub use disasm::disassemble;
 pub use include::{FileResolver, IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
-pub use tmclsim_firmware::Profile;
+pub use tmclsim_profile::Profile;
 pub use tmclsim_protocol::Instruction;
 
 /// An assembled program.

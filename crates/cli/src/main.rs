@@ -29,7 +29,7 @@ enum Command {
     Serve(ServeArgs),
     /// Send one command to a TMCL module (real or virtual) and print the reply.
     Send(SendArgs),
-    /// List a module profile: every parameter with access, range and default.
+    /// List a module profile: its features, then every parameter with access, range and default.
     Profile(ProfileArgs),
     /// Measure commands per second in-process and round trips over TCP and the pty.
     Bench(BenchArgs),
@@ -180,6 +180,10 @@ fn profile(name: &str) -> Result<ExitCode, String> {
         "{}: {} axis(es), {} program words, firmware V{}.{:02}",
         p.module.name, p.module.axes, p.module.program_memory, p.module.firmware[0], p.module.firmware[1]
     );
+    println!("\nFeatures");
+    for (key, value) in p.features.list() {
+        println!("  {key:<28} {value}");
+    }
     println!("\nAxis parameters (* = default assumed, not stated by the manual)");
     for q in p.axis_parameters() {
         let mark = if q.default_source == tmclsim_firmware::profile::DefaultSource::Assumed { "*" } else { " " };

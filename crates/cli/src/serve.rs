@@ -65,8 +65,8 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
 /// EtherCAT: TMCM-1310 slaves on a network interface.
 fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
     let profile = Profile::built_in(&args.module)?;
-    if profile.module.name != "TMCM-1310" {
-        return Err(format!("EtherCAT is the TMCM-1310's; {} has none", profile.module.name));
+    if !profile.features.ethercat {
+        return Err(format!("{} is no EtherCAT slave (its profile's features say ethercat = false)", profile.module.name));
     }
     if args.slaves == 0 || args.slaves > 256 {
         return Err("--slaves takes 1…256".into());
@@ -80,7 +80,7 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
         .collect::<Result<Vec<_>, String>>()?;
     let handle = tmclsim_server::ethercat::serve(iface, tmclsim_ethercat::Segment::new(slaves))
         .map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
-    println!("tmclsim: {} virtual TMCM-1310 EtherCAT slave(s) on {iface}", args.slaves);
+    println!("tmclsim: {} virtual {} EtherCAT slave(s) on {iface}", args.slaves, profile.module.name);
     println!("connect with: an EtherCAT master on {iface}'s peer, e.g. pysoem: master.open(\"<peer interface>\")");
     use std::io::Write;
     let _ = std::io::stdout().flush();
@@ -91,11 +91,11 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
 }
 
 /// The serial address, and on modules with their own CAN identifier
-/// (GP 71) that too.
+/// (features `[features.can]`, GP 71 on the TMCM-351) that too.
 fn set_addresses(m: &mut Module, address: u8) {
     m.set_address(address);
-    if m.profile().global_parameter(0, 71).is_some() {
-        let _ = m.set_global_parameter(71, 0, address as i32);
+    if let Some(can) = m.profile().features.can {
+        let _ = m.set_global_parameter(can.id, 0, address as i32);
     }
 }
 

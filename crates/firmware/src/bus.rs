@@ -145,7 +145,7 @@ impl Bus {
                 answer.delay_ns = answer.delay_ns.max(m.reply_delay_ns());
                 if self.wire_timing {
                     // Request and reply, 10 bits a byte.
-                    answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / baud_rate(m) as u64;
+                    answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / m.profile().baud_rate(m.baud_rate_code()) as u64;
                 }
             }
         }
@@ -248,21 +248,6 @@ impl Bus {
     /// A picture of every module, in bus order.
     pub fn snapshot(&self) -> Vec<ModuleSnapshot> {
         self.modules.iter().map(ModuleSnapshot::of).collect()
-    }
-}
-
-/// Bits per second of a module's link (GP 65).
-fn baud_rate(m: &Module) -> u32 {
-    match m.baud_rate_code() {
-        1 => 14_400,
-        2 => 19_200,
-        3 => 28_800,
-        4 => 38_400,
-        5 => 57_600,
-        6 => 76_800,
-        7 => 115_200,
-        8 => 230_400,
-        _ => 9_600,
     }
 }
 

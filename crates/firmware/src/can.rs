@@ -5,17 +5,13 @@
 //! address][status][opcode][value]`. 136 type 0 answers with the eight
 //! characters of the version; 134 with the stored instruction.
 //!
-//! Identifiers: modules with their own CAN parameters (TMCM-351: GP 71 CAN
-//! ID, GP 83 secondary ID, GP 70 reply ID) use them; the others use their
-//! serial address (GP 66, GP 87) and the host address (GP 76).
+//! Identifiers: modules whose profile names CAN identifier parameters
+//! (features `[features.can]`; TMCM-351: GP 71 CAN ID, GP 83 secondary ID,
+//! GP 70 reply ID) use them; the others use their serial address (GP 66,
+//! GP 87) and the host address (GP 76).
 
 use crate::module::{Module, Special, gp};
 use tmclsim_protocol::{Instruction, Status, opcode};
-
-/// GP numbers of the CAN identifiers on modules that have them.
-const CAN_REPLY_ID: u8 = 70;
-const CAN_ID: u8 = 71;
-const CAN_SECONDARY_ID: u8 = 83;
 
 /// A CAN frame: 11-bit identifier and up to 8 data bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,15 +35,11 @@ impl CanFrame {
 }
 
 impl Module {
-    fn has_can_ids(&self) -> bool {
-        self.profile.global_parameter(0, CAN_ID).is_some()
-    }
-
     /// The identifiers this module answers to.
     pub fn can_ids(&self) -> (u32, Option<u32>) {
-        if self.has_can_ids() {
-            let secondary = self.globals[0][CAN_SECONDARY_ID as usize] as u32;
-            (self.globals[0][CAN_ID as usize] as u32, (secondary != 0).then_some(secondary))
+        if let Some(can) = self.profile.features.can {
+            let secondary = self.globals[0][can.secondary_id as usize] as u32;
+            (self.globals[0][can.id as usize] as u32, (secondary != 0).then_some(secondary))
         } else {
             let secondary = self.secondary_address() as u32;
             (self.address() as u32, (secondary != 0).then_some(secondary))
@@ -56,7 +48,10 @@ impl Module {
 
     /// The identifier of this module's replies.
     pub fn can_reply_id(&self) -> u32 {
-        if self.has_can_ids() { self.globals[0][CAN_REPLY_ID as usize] as u32 } else { self.host_address() as u32 }
+        match self.profile.features.can {
+            Some(can) => self.globals[0][can.reply_id as usize] as u32,
+            None => self.host_address() as u32,
+        }
     }
 
     /// Handles a CAN frame; `None` when it is not for this module (or

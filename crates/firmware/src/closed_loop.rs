@@ -24,8 +24,6 @@ use crate::module::{Module, ap, error_flag};
 use crate::motion::{self, RampMode};
 use crate::program::Source;
 
-/// The module's current for 100 % (TMCM-1310: 3 A RMS).
-pub const FULL_SCALE_MA: f64 = 3000.0;
 /// Current scale reserve above what the load needs (%).
 pub const RESERVE_PERCENT: f64 = 20.0;
 
@@ -77,9 +75,15 @@ pub struct ClosedLoop {
 }
 
 impl Module {
-    /// The module has closed-loop parameters.
+    /// The module can run in closed loop (features `closed_loop`).
     pub(crate) fn has_closed_loop(&self) -> bool {
-        self.profile.axis_parameter(cl::MODE).is_some()
+        self.profile.features.closed_loop
+    }
+
+    /// The module's current for 100 % (features `full_scale_current_ma`),
+    /// mA RMS.
+    fn full_scale_ma(&self) -> f64 {
+        self.profile.features.full_scale_current_ma as f64
     }
 
     pub(crate) fn closed_loop_on(&self, m: usize) -> bool {
@@ -168,7 +172,7 @@ impl Module {
             let speed_factor = (1.0 - self.axes[m].motion.v.abs() / self.microsteps(m) / crate::driver::CORNER_FULLSTEPS).max(0.01);
             let needed = load / speed_factor + RESERVE_PERCENT;
             let scale = if self.axes[m].closed_loop.torque_mode {
-                (p[cl::TORQUE_TARGET as usize] as f64).abs() / FULL_SCALE_MA * 100.0
+                (p[cl::TORQUE_TARGET as usize] as f64).abs() / self.full_scale_ma() * 100.0
             } else if p[cl::SCALE_ENABLE as usize] == 1 {
                 needed.clamp(lo.min(hi), hi)
             } else {
@@ -246,7 +250,7 @@ impl Module {
     pub(crate) fn torque_mode_velocity(&self, m: usize) -> f64 {
         let p = &self.axes[m].params;
         let target = p[cl::TORQUE_TARGET as usize] as f64;
-        let percent = (target.abs() / FULL_SCALE_MA * 100.0).min(100.0);
+        let percent = (target.abs() / self.full_scale_ma() * 100.0).min(100.0);
         let load = self.world.axes[m].load_at(self.mechanical_position(m), self.now_ns as f64 * 1e-9);
         if self.driver_off(m) || percent <= load {
             return 0.0;
@@ -266,20 +270,20 @@ impl Module {
         let p = &axis.params;
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let torque_ma = if axis.closed_loop.torque_mode {
-            (p[cl::TORQUE_TARGET as usize] as f64).clamp(-FULL_SCALE_MA, FULL_SCALE_MA)
+            (p[cl::TORQUE_TARGET as usize] as f64).clamp(-self.full_scale_ma(), self.full_scale_ma())
         } else {
-            axis.closed_loop.scale / 100.0 * FULL_SCALE_MA
+            axis.closed_loop.scale / 100.0 * self.full_scale_ma()
         };
         Some(match param {
             ap::ACTUAL_POSITION if self.closed_loop_on(m) => self.measured_position(m).round() as i32,
             ap::POSITION_REACHED => self.closed_loop_target_reached(m) as i32,
-            cl::MAX_POSSIBLE_CURRENT => FULL_SCALE_MA as i32,
+            cl::MAX_POSSIBLE_CURRENT => self.full_scale_ma() as i32,
             cl::VELOCITY_REACHED => self.velocity_reached(m) as i32,
             cl::STATUS_WORD => self.status_word(m),
             cl::TORQUE_ACTUAL => torque_ma.round() as i32,
             cl::SCALE_ACTUAL | cl::TARGET_SCALE => {
                 if axis.closed_loop.torque_mode {
-                    (torque_ma.abs() / FULL_SCALE_MA * 100.0).round() as i32
+                    (torque_ma.abs() / self.full_scale_ma() * 100.0).round() as i32
                 } else {
                     axis.closed_loop.scale.round() as i32
                 }

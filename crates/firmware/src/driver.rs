@@ -17,7 +17,8 @@
 //!   stop, the motor loses steps: the position counter goes on, the
 //!   carriage does not.
 
-use crate::module::{Module, ap, error_flag, gp};
+use crate::module::{Module, ap, error_flag};
+use crate::profile::StallDetection;
 use crate::program::Source;
 
 /// Full steps per second at which the motor has no torque left.
@@ -48,9 +49,8 @@ impl Module {
     /// The driver is switched off (no torque).
     pub(crate) fn driver_off(&self, m: usize) -> bool {
         let f = self.world.axes[m].faults;
-        let toff_zero =
-            self.profile.axis_parameter(ap::CHOPPER_OFF_TIME).is_some() && self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0;
-        let shutdown_pin = match self.profile.global_parameter(0, gp::SHUTDOWN_PIN).map(|_| self.globals[0][gp::SHUTDOWN_PIN as usize]) {
+        let toff_zero = self.profile.features.chopper_off_disables_driver && self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0;
+        let shutdown_pin = match self.profile.features.shutdown_pin.map(|n| self.globals[0][n as usize]) {
             Some(1) => self.world.shutdown_input,
             Some(2) => !self.world.shutdown_input,
             _ => false,
@@ -82,7 +82,7 @@ impl Module {
         (0..self.axes.len()).any(|m| {
             let axis = &self.axes[m];
             let p = &axis.params;
-            let has = |n: u8| self.profile.axis_parameter(n).is_some();
+            let f = &self.profile.features;
             let will_move = axis.motion.v != 0.0
                 || match axis.motion.mode {
                     crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
@@ -92,10 +92,10 @@ impl Module {
             closed_loop
                 || will_move
                     && (!self.world.axes[m].loads.is_empty()
-                        || (has(ap::STOP_ON_STALL) && p[ap::STOP_ON_STALL as usize] > 0)
-                        || (has(ap::STALL_THRESHOLD) && p[ap::STALL_THRESHOLD as usize] > 0)
-                        || (has(ap::SMART_ENERGY_HYSTERESIS_START) && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
-                        || (has(ap::MAX_ENCODER_DEVIATION) && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
+                        || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
+                        || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
+                        || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
+                        || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
                         || self.driver_off(m))
         })
     }
@@ -157,11 +157,7 @@ impl Module {
         let p = self.axes[m].params;
         let v_int = self.actual_speed(m).abs();
         // coolStep regulates above its threshold speed, when enabled.
-        let semin = if self.profile.axis_parameter(ap::SMART_ENERGY_HYSTERESIS_START).is_some() {
-            p[ap::SMART_ENERGY_HYSTERESIS_START as usize]
-        } else {
-            0
-        };
+        let semin = if self.profile.features.coolstep { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
         let cool = semin > 0 && moving && v_int >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
         if cool {
             let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
@@ -195,7 +191,7 @@ impl Module {
         }
         let scale = self.current_scale(m);
         let margin = self.margin(m, scale);
-        if self.profile.axis_parameter(ap::STALLGUARD_THRESHOLD).is_some() {
+        if self.profile.features.stall_detection == StallDetection::Stallguard2 {
             if moving {
                 self.axes[m].driver.load_value = self.stallguard(m, margin);
             }
@@ -206,7 +202,7 @@ impl Module {
                 self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
                 self.raise(Source::Stall(m as u8));
             }
-        } else if self.profile.axis_parameter(ap::STALL_THRESHOLD).is_some() {
+        } else if self.profile.features.stall_detection == StallDetection::Tmc249 {
             // TMC249 load indicator (TMCM-351): 0…7, higher is more load;
             // a reading above AP 205 (not 0) stops the motor.
             if moving {
@@ -236,7 +232,7 @@ impl Module {
         // Encoder deviation (AP 212): the motor stops when the position
         // counter and the encoder drift apart further than allowed.
         let limit = p[ap::MAX_ENCODER_DEVIATION as usize];
-        if limit > 0 && moving && self.profile.axis_parameter(ap::MAX_ENCODER_DEVIATION).is_some() {
+        if limit > 0 && moving && self.profile.features.encoder_deviation_stop {
             let deviation = (self.actual_position(m) as i64 - self.encoder_position(m) as i64).abs();
             if deviation > limit as i64 {
                 self.stop_now(m);

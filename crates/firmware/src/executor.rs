@@ -6,7 +6,7 @@
 
 use crate::module::{Compare, Module, Origin, Outcome, Special, ap, error_flag, gp};
 use crate::motion::RampMode;
-use crate::profile::{Parameter, PortDirection};
+use crate::profile::{Encoder, Parameter, PortDirection, PortRole, ReferenceSearchFamily};
 use crate::reference_search::{ReferenceSearch, Switch};
 use tmclsim_protocol::{CalcOp, Command, ErrorFlag, Instruction, MoveMode, RfsAction, Status, opcode};
 
@@ -488,7 +488,7 @@ impl Module {
     fn for_group(&mut self, motor: u8, mut f: impl FnMut(&mut Module, u8) -> Result<(), Status>) -> Result<(), Status> {
         let m = self.motor(motor)?;
         f(self, motor)?;
-        if self.profile.axis_parameter(ap::GROUP_INDEX).is_some() {
+        if self.profile.features.motion_groups {
             let group = self.axes[m].params[ap::GROUP_INDEX as usize];
             if group != 0 {
                 for other in 0..self.axes.len() {
@@ -556,9 +556,10 @@ impl Module {
         Ok(answer as i32)
     }
 
-    /// GP 73 on modules that have it: the configuration EEPROM is locked.
+    /// The lock parameter (features `eeprom_lock`, GP 73 on the TMCM-351)
+    /// reads 1: the configuration EEPROM is locked.
     pub(crate) fn eeprom_locked(&self) -> bool {
-        self.profile.global_parameter(0, gp::EEPROM_LOCK).is_some() && self.globals[0][gp::EEPROM_LOCK as usize] == 1
+        self.profile.features.eeprom_lock.is_some_and(|n| self.globals[0][n as usize] == 1)
     }
 
     fn clear_motion_errors(&mut self, m: usize) {
@@ -591,8 +592,10 @@ impl Module {
     /// RFS START with the mode of AP 193.
     fn start_reference_search(&mut self, m: usize) -> Result<(), Status> {
         let mode = self.axes[m].params[ap::REFERENCE_SEARCH_MODE as usize];
-        let rfs =
-            if self.profile.module.motion_controller == "TMC428" { ReferenceSearch::new_tmc428(mode) } else { ReferenceSearch::new(mode) };
+        let rfs = match self.profile.features.reference_search {
+            ReferenceSearchFamily::Tmc429 => ReferenceSearch::new(mode),
+            ReferenceSearchFamily::Tmc428 => ReferenceSearch::new_tmc428(mode),
+        };
         let rfs = rfs.ok_or(Status::InvalidValue)?;
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
@@ -757,7 +760,7 @@ impl Module {
             ap::HOME_SWITCH => self.switches(m).2 as i32,
             ap::ACTUAL_CURRENT => self.current_scale(m).round() as i32,
             ap::LOAD_VALUE => self.axes[m].driver.load_value,
-            ap::ENCODER_POSITION if self.profile.axis_parameter(ap::ENCODER_POSITION).is_some() => self.encoder_position(m),
+            ap::ENCODER_POSITION if self.profile.features.encoder != Encoder::None => self.encoder_position(m),
             ap::DRIVER_ERROR_FLAGS => self.driver_flags(m),
             ap::EXTENDED_ERROR_FLAGS => {
                 // Cleared by reading.
@@ -813,7 +816,7 @@ impl Module {
             return Err(Status::InvalidValue);
         }
         let auto = spec.access.auto;
-        if (bank, param) == (0, gp::EEPROM_LOCK) {
+        if bank == 0 && self.profile.features.eeprom_lock == Some(param) {
             // 1234 locks, 4321 unlocks; the state itself is kept.
             let locked = match value {
                 1234 => 1,
@@ -951,8 +954,7 @@ impl Module {
         Ok(match p.direction {
             PortDirection::Output => (self.outputs >> port & 1) as i32,
             _ if p.max == 1 => self.world.digital(port) as i32,
-            // The supply voltage channel is the one with a 0.1 V unit.
-            _ if p.unit.as_deref().is_some_and(|u| u.contains('V')) => self.world.supply_decivolts as i32,
+            _ if p.role == Some(PortRole::Supply) => self.world.supply_decivolts as i32,
             _ => self.world.analog_inputs.get(port as usize).copied().unwrap_or(0) as i32,
         })
     }

@@ -1,5 +1,6 @@
-//! The TMCL firmware as software: module profiles, the command executor,
-//! EEPROM, the TMC429 motion model and the simulated world.
+//! The TMCL firmware as software: the command executor, EEPROM, the TMC429
+//! motion model and the simulated world, for the module profiles of
+//! `tmclsim-profile` (re-exported as [`profile`]).
 //!
 //! Pure and deterministic: a [`Module`] changes only through
 //! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
@@ -15,7 +16,7 @@ pub mod executor;
 mod interpreter;
 pub mod module;
 pub mod motion;
-pub mod profile;
+pub use tmclsim_profile as profile;
 pub mod program;
 pub mod reference_search;
 pub mod snapshot;

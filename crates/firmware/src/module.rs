@@ -380,11 +380,11 @@ impl Module {
     /// Power cycle: RAM from factory defaults, then what the EEPROM holds.
     pub fn power_on(&mut self) {
         let profile = self.profile.clone();
-        if profile.global_parameter(0, gp::EEPROM_MAGIC).is_some() {
-            // Any magic but 0xE4 re-initialises the EEPROM (TMCM-351 GP 64).
-            if self.eeprom.global(0, gp::EEPROM_MAGIC).is_some_and(|v| v != 0xE4) {
+        if let Some(magic) = profile.features.eeprom_magic {
+            // Any other stored magic re-initialises the EEPROM (TMCM-351: GP 64, 0xE4).
+            if self.eeprom.global(0, magic.parameter).is_some_and(|v| v != magic.value) {
                 self.eeprom.clear();
-                self.eeprom.set_global(0, gp::EEPROM_MAGIC, 0xE4);
+                self.eeprom.set_global(0, magic.parameter, magic.value);
                 self.eeprom_generation += 1;
             }
         }

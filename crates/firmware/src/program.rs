@@ -43,38 +43,7 @@ pub struct Context {
 }
 
 /// What raises an interrupt, derived from the profile's interrupt table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Source {
-    Timer(u8),
-    TargetReached(u8),
-    Stall(u8),
-    StopLeft(u8),
-    StopRight(u8),
-    InputChange(u8),
-    Deviation(u8),
-}
-
-impl Source {
-    /// Reads the interrupt's source from its symbol (`TI_TIMER0`,
-    /// `TI_TARGET0`, `TI_STALL0`, `TI_STOPLEFT0`, `TI_STOPRIGHT0`,
-    /// `TI_INPUTCHANGE3`, `TI_DEVIATION0`).
-    pub fn from_symbol(symbol: &str) -> Option<Source> {
-        let s = symbol.strip_prefix("TI_")?;
-        let digits = s.trim_start_matches(|c: char| c.is_ascii_alphabetic());
-        let name = &s[..s.len() - digits.len()];
-        let n: u8 = digits.parse().ok()?;
-        Some(match name {
-            "TIMER" => Source::Timer(n),
-            "TARGET" => Source::TargetReached(n),
-            "STALL" => Source::Stall(n),
-            "STOPLEFT" => Source::StopLeft(n),
-            "STOPRIGHT" => Source::StopRight(n),
-            "INPUTCHANGE" => Source::InputChange(n),
-            "DEVIATION" => Source::Deviation(n),
-            _ => return None,
-        })
-    }
-}
+pub use crate::profile::InterruptSource as Source;
 
 /// One executed instruction, for `--trace` and the debugger.
 #[derive(Clone, Debug, PartialEq)]

@@ -3,6 +3,15 @@
 //! A profile is loaded from a TOML file (`profiles/*.toml`, schema in
 //! `profiles/README.md`) and indexed for constant-time lookups by the
 //! executor. The built-in profiles are compiled into the binary.
+//!
+//! Everything that tells one module from another is here: its parameter
+//! tables, ports and interrupts, and its [`Features`] (which reference
+//! search, stall detection, encoder, CAN identifiers, EEPROM lock, …). The
+//! firmware and the assembler read them; neither knows module names.
+
+mod features;
+
+pub use features::{CanIds, EepromMagic, Encoder, Features, ReferenceSearchFamily, StallDetection};
 
 use serde::Deserialize;
 use std::sync::Arc;
@@ -91,6 +100,14 @@ pub enum PortDirection {
     Pullup,
 }
 
+/// What an input channel measures, where that is more than a pin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PortRole {
+    /// The supply voltage, in 0.1 V.
+    Supply,
+}
+
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Port {
@@ -104,6 +121,9 @@ pub struct Port {
     pub default: i64,
     #[serde(default)]
     pub unit: Option<String>,
+    /// What the channel measures (`None`: a plain digital or analog input).
+    #[serde(default)]
+    pub role: Option<PortRole>,
     #[serde(default)]
     pub note: Option<String>,
 }
@@ -164,10 +184,46 @@ struct ProfileFile {
     module: ModuleInfo,
     axis_parameter: Vec<ParameterRow>,
     global_parameter: Vec<ParameterRow>,
+    features: Features,
     #[serde(default)]
     port: Vec<Port>,
     #[serde(default)]
     interrupt: Vec<Interrupt>,
+}
+
+/// What raises an interrupt, read from the symbols of a profile's interrupt
+/// table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InterruptSource {
+    Timer(u8),
+    TargetReached(u8),
+    Stall(u8),
+    StopLeft(u8),
+    StopRight(u8),
+    InputChange(u8),
+    Deviation(u8),
+}
+
+impl InterruptSource {
+    /// Reads the interrupt's source from its symbol (`TI_TIMER0`,
+    /// `TI_TARGET0`, `TI_STALL0`, `TI_STOPLEFT0`, `TI_STOPRIGHT0`,
+    /// `TI_INPUTCHANGE3`, `TI_DEVIATION0`).
+    pub fn from_symbol(symbol: &str) -> Option<InterruptSource> {
+        let s = symbol.strip_prefix("TI_")?;
+        let digits = s.trim_start_matches(|c: char| c.is_ascii_alphabetic());
+        let name = &s[..s.len() - digits.len()];
+        let n: u8 = digits.parse().ok()?;
+        Some(match name {
+            "TIMER" => InterruptSource::Timer(n),
+            "TARGET" => InterruptSource::TargetReached(n),
+            "STALL" => InterruptSource::Stall(n),
+            "STOPLEFT" => InterruptSource::StopLeft(n),
+            "STOPRIGHT" => InterruptSource::StopRight(n),
+            "INPUTCHANGE" => InterruptSource::InputChange(n),
+            "DEVIATION" => InterruptSource::Deviation(n),
+            _ => return None,
+        })
+    }
 }
 
 /// Number of global parameter banks (0…3).
@@ -177,6 +233,8 @@ pub const BANKS: usize = 4;
 #[derive(Debug)]
 pub struct Profile {
     pub module: ModuleInfo,
+    /// What this module can do, beyond its parameter tables.
+    pub features: Features,
     axis: Vec<Option<Parameter>>,
     global: [Vec<Option<Parameter>>; BANKS],
     pub ports: Vec<Port>,
@@ -243,7 +301,18 @@ impl Profile {
         if file.module.axes == 0 {
             return Err("a module has at least one axis".into());
         }
-        Ok(Profile { module: file.module, axis, global, ports: file.port, interrupts: file.interrupt, opcode_set, ascii_set })
+        let profile = Profile {
+            module: file.module,
+            features: file.features,
+            axis,
+            global,
+            ports: file.port,
+            interrupts: file.interrupt,
+            opcode_set,
+            ascii_set,
+        };
+        profile.features.check(&profile)?;
+        Ok(profile)
     }
 
     /// A built-in profile by name (`tmcm-1141`, case-insensitive, the
@@ -304,8 +373,15 @@ impl Profile {
 
     /// The interrupt number of a source, by the symbols of the interrupt
     /// table.
-    pub fn interrupt_for(&self, source: crate::program::Source) -> Option<u8> {
-        self.interrupts.iter().find(|i| crate::program::Source::from_symbol(&i.symbol) == Some(source)).map(|i| i.number)
+    pub fn interrupt_for(&self, source: InterruptSource) -> Option<u8> {
+        self.interrupts.iter().find(|i| InterruptSource::from_symbol(&i.symbol) == Some(source)).map(|i| i.number)
+    }
+
+    /// Bits per second of a GP 65 baud rate code (features `baud_rates`);
+    /// codes the module does not have give the first rate.
+    pub fn baud_rate(&self, code: i32) -> u32 {
+        let rates = &self.features.baud_rates;
+        usize::try_from(code).ok().and_then(|i| rates.get(i)).copied().unwrap_or(rates[0])
     }
 
     /// Looks an axis parameter up by name (case-insensitive).
