@@ -143,9 +143,10 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     let server = tmclsim_server::start_fleet(specs).map_err(|e| format!("cannot serve the fleet: {e}"))?;
     println!("tmclsim: fleet of {total} modules on {} links is serving", server.links().len());
     if let Some(first) = server.links().first()
-        && let Some(a) = first.endpoints.pytrinamic_args() {
-            println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (first link)");
-        }
+        && let Some(a) = first.endpoints.pytrinamic_args()
+    {
+        println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (first link)");
+    }
     use std::io::Write;
     let _ = std::io::stdout().flush();
     crate::serve::wait_for_signal();

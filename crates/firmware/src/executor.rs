@@ -468,17 +468,18 @@ impl Module {
         }
         self.set_target(m, target);
         if let Some((every, mask)) = self.event_arm
-            && mask & (1 << m) != 0 {
-                self.axes[m].notify_on_arrival = true;
-                if !every {
-                    self.event_arm = None;
-                }
-                if self.axes[m].motion.x == self.axes[m].motion.target && self.axes[m].motion.v == 0.0 {
-                    // Already there: the event follows at once.
-                    self.axes[m].notify_on_arrival = false;
-                    self.push_event(1 << m);
-                }
+            && mask & (1 << m) != 0
+        {
+            self.axes[m].notify_on_arrival = true;
+            if !every {
+                self.event_arm = None;
             }
+            if self.axes[m].motion.x == self.axes[m].motion.target && self.axes[m].motion.v == 0.0 {
+                // Already there: the event follows at once.
+                self.axes[m].notify_on_arrival = false;
+                self.push_event(1 << m);
+            }
+        }
         Ok(())
     }
 

@@ -439,9 +439,10 @@ impl Module {
             return;
         }
         if let Some(n) = self.profile.interrupt_for(source)
-            && self.interrupts_enabled[n as usize] {
-                self.program.set_pending(n);
-            }
+            && self.interrupts_enabled[n as usize]
+        {
+            self.program.set_pending(n);
+        }
     }
 
     /// Interrupts that depend on motion are enabled: the world must then be

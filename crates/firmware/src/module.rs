@@ -583,9 +583,10 @@ impl Module {
             let mut t = end;
             let mut at = |x: Option<u64>| {
                 if let Some(x) = x
-                    && x > self.now_ns {
-                        t = t.min(x);
-                    }
+                    && x > self.now_ns
+                {
+                    t = t.min(x);
+                }
             };
             at(self.heartbeat_deadline());
             at(timer);
@@ -615,12 +616,13 @@ impl Module {
         }
         self.now_ns = t;
         if let Some(deadline) = self.heartbeat_deadline()
-            && self.now_ns >= deadline {
-                self.heartbeat_tripped = true;
-                for motor in 0..self.axes.len() {
-                    self.motor_stop(motor);
-                }
+            && self.now_ns >= deadline
+        {
+            self.heartbeat_tripped = true;
+            for motor in 0..self.axes.len() {
+                self.motor_stop(motor);
             }
+        }
         self.look_at_inputs();
     }
 
@@ -686,10 +688,11 @@ impl Module {
         let mut next = self.heartbeat_deadline();
         for (motor, axis) in self.axes.iter().enumerate() {
             if axis.notify_on_arrival
-                && let Some(t) = self.time_to_rest(motor) {
-                    let t = self.now_ns + (t * 1e9).ceil() as u64;
-                    next = Some(next.map_or(t, |n| n.min(t)));
-                }
+                && let Some(t) = self.time_to_rest(motor)
+            {
+                let t = self.now_ns + (t * 1e9).ceil() as u64;
+                next = Some(next.map_or(t, |n| n.min(t)));
+            }
         }
         next
     }

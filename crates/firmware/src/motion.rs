@@ -220,10 +220,11 @@ impl Motion {
                 // with speed left).
                 let tc = self.crossing(phase.shape, th, t).map(|tc| if t - tc < 1e-9 { t } else { tc });
                 if let Some(tc) = tc
-                    && (tc < t || crossing.is_none() && tc <= t) {
-                        t = tc;
-                        crossing = Some(th);
-                    }
+                    && (tc < t || crossing.is_none() && tc <= t)
+                {
+                    t = tc;
+                    crossing = Some(th);
+                }
             }
             let was_moving = self.v != 0.0;
             self.integrate(phase.shape, t);

@@ -153,11 +153,13 @@ impl ReferenceSearch {
         while let Some(&(s, mark)) = self.seeks.get(self.next) {
             let probe = x + self.dir * 1e-6;
             if let Some(stop) = s.reverse_on
-                && stop_is_ahead(stop, self.dir) && state(stop, probe) {
-                    self.dir = -self.dir;
-                    changed = true;
-                    continue;
-                }
+                && stop_is_ahead(stop, self.dir)
+                && state(stop, probe)
+            {
+                self.dir = -self.dir;
+                changed = true;
+                continue;
+            }
             if state(s.switch, probe) != s.active {
                 break;
             }

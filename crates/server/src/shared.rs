@@ -369,9 +369,10 @@ impl SharedModule {
             }
             if n.module.eeprom_generation() != n.saved_generation {
                 if let Some(path) = &n.eeprom
-                    && let Err(e) = save_atomic(path, n.module.eeprom()) {
-                        eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
-                    }
+                    && let Err(e) = save_atomic(path, n.module.eeprom())
+                {
+                    eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
+                }
                 n.saved_generation = n.module.eeprom_generation();
             }
         }
