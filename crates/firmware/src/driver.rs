@@ -75,31 +75,6 @@ impl Module {
         ((counts * factor).round() as i64 + self.axes[m].encoder_offset) as i32
     }
 
-    /// Some moving axis has something the driver must look at often: a
-    /// load, stall detection, coolStep, an encoder deviation limit, or a
-    /// driver that is off.
-    pub(crate) fn driver_watches(&self) -> bool {
-        (0..self.axes.len()).any(|m| {
-            let axis = &self.axes[m];
-            let p = &axis.params;
-            let has = |n: u8| self.profile.axis_parameter(n).is_some();
-            let will_move = axis.motion.v != 0.0
-                || match axis.motion.mode {
-                    crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
-                    _ => axis.motion.x != axis.motion.target,
-                };
-            let closed_loop = self.has_closed_loop() && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6);
-            closed_loop
-                || will_move
-                    && (!self.world.axes[m].loads.is_empty()
-                        || (has(ap::STOP_ON_STALL) && p[ap::STOP_ON_STALL as usize] > 0)
-                        || (has(ap::STALL_THRESHOLD) && p[ap::STALL_THRESHOLD as usize] > 0)
-                        || (has(ap::SMART_ENERGY_HYSTERESIS_START) && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
-                        || (has(ap::MAX_ENCODER_DEVIATION) && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
-                        || self.driver_off(m))
-        })
-    }
-
     /// AP 208.
     pub(crate) fn driver_flags(&self, m: usize) -> i32 {
         let f = self.world.axes[m].faults;

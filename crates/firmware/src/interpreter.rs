@@ -195,38 +195,8 @@ impl Module {
         self.execute_next();
     }
 
-    /// Runs instructions due at `now` (and pure ones after them, up to
-    /// `limit`) without moving the world; returns when the world must catch
-    /// up, the program stops or waits.
-    pub(crate) fn run_batch(&mut self, limit: u64) {
-        loop {
-            self.take_interrupt();
-            let pc = self.program.pc;
-            if !self.program.breakpoints.is_empty() && self.program.breakpoints.contains(&pc) && self.program.hit_breakpoint != Some(pc) {
-                self.program.hit_breakpoint = Some(pc);
-                self.program.mode = RunMode::Step;
-                return;
-            }
-            self.program.hit_breakpoint = None;
-            let Some(ins) = self.program.memory.get(pc as usize).copied() else {
-                self.program.mode = RunMode::Stop;
-                return;
-            };
-            // With the trace on, every instruction sees the world of its
-            // own moment (positions in the trace are exact).
-            let pure = is_pure(ins) && self.program.trace.is_none();
-            if !pure && self.program.next_ns > self.now_ns {
-                return;
-            }
-            self.execute_next();
-            if !self.program.is_running() || self.program.wait.is_some() || !pure || self.program.next_ns > limit {
-                return;
-            }
-        }
-    }
-
     /// Executes the word at the program counter at time `program.next_ns`.
-    fn execute_next(&mut self) {
+    pub(crate) fn execute_next(&mut self) {
         let pc = self.program.pc;
         let Some(ins) = self.program.memory.get(pc as usize).copied() else {
             self.program.mode = RunMode::Stop;
@@ -354,59 +324,6 @@ impl Module {
         }
     }
 
-    /// Ends a WAIT whose condition holds or whose time is up.
-    pub(crate) fn check_wait(&mut self) {
-        let Some(w) = self.program.wait else { return };
-        let m = w.motor as usize;
-        let met = match w.condition {
-            WaitCondition::Ticks => w.until_ns.is_none_or(|u| self.now_ns >= u),
-            WaitCondition::Position => self.actual_position(m) == self.axes[m].target_word && self.axes[m].motion.v == 0.0,
-            WaitCondition::ReferenceSwitch => self.switches(m).2,
-            WaitCondition::LimitSwitch => {
-                let (l, r, _) = self.switches(m);
-                l || r
-            }
-            WaitCondition::ReferenceSearch => !self.reference_search_active(m),
-        };
-        if met {
-            self.program.wait = None;
-        } else if w.condition != WaitCondition::Ticks && w.until_ns.is_some_and(|u| self.now_ns >= u) {
-            self.registers.errors |= error_flag::TIMEOUT;
-            self.program.wait = None;
-        }
-        if self.program.wait.is_none() {
-            self.program.next_ns = self.program.next_ns.max(self.now_ns);
-        }
-    }
-
-    /// When the world must be looked at again for the WAIT in progress.
-    pub(crate) fn wait_horizon(&self) -> Option<u64> {
-        let w = self.program.wait?;
-        let mut t = w.until_ns;
-        let m = w.motor as usize;
-        let poll = self.now_ns + 1_000_000;
-        let candidate = match w.condition {
-            WaitCondition::Ticks => None,
-            WaitCondition::Position => {
-                // The ramp is known in closed form: wake up when it ends.
-                let ramp = self.ramp(m);
-                let mut stops = |x: f64| self.stops_at(m, x);
-                match self.axes[m].motion.time_to_rest(&ramp, &mut stops) {
-                    // At rest off the target (a switch stopped it): nothing
-                    // changes by itself; only the timeout ends the wait.
-                    Some(s) if s <= 0.0 => None,
-                    Some(s) => Some(self.now_ns + (s * 1e9).ceil() as u64),
-                    None => Some(poll),
-                }
-            }
-            _ => Some(poll),
-        };
-        if let Some(c) = candidate {
-            t = Some(t.map_or(c, |u| u.min(c)));
-        }
-        t
-    }
-
     /// Enters the handler of the most urgent pending interrupt, if the
     /// program may take one now (decisions.md rule 22).
     /// An enabled interrupt with a vector is pending and may be taken.
@@ -444,71 +361,4 @@ impl Module {
             self.program.set_pending(n);
         }
     }
-
-    /// Interrupts that depend on motion are enabled: the world must then be
-    /// looked at often (every millisecond) even while the program waits.
-    pub(crate) fn motion_interrupts_armed(&self) -> bool {
-        self.interrupts_global
-            && self.program.is_running()
-            && self.profile.interrupts.iter().any(|i| {
-                self.interrupts_enabled[i.number as usize]
-                    && matches!(
-                        Source::from_symbol(&i.symbol),
-                        Some(
-                            Source::TargetReached(_) | Source::StopLeft(_) | Source::StopRight(_) | Source::Stall(_) | Source::Deviation(_)
-                        )
-                    )
-            })
-    }
-
-    /// Timer interrupts: fire those due, return the next firing time.
-    pub(crate) fn run_timers(&mut self) -> Option<u64> {
-        let mut next = None;
-        for t in 0..3u8 {
-            let Some(n) = self.profile.interrupt_for(Source::Timer(t)) else { continue };
-            let period_ms = self.globals[3][n as usize] as u32 as u64;
-            if !self.program.is_running() || period_ms == 0 || !self.interrupts_enabled[n as usize] {
-                self.program.timers[t as usize] = None;
-                continue;
-            }
-            let period = period_ms * 1_000_000;
-            let due = *self.program.timers[t as usize].get_or_insert(self.now_ns + period);
-            if self.now_ns >= due {
-                self.program.set_pending(n);
-                let behind = (self.now_ns - due) / period + 1;
-                self.program.timers[t as usize] = Some(due + behind * period);
-            }
-            let d = self.program.timers[t as usize].expect("set above");
-            next = Some(next.map_or(d, |x: u64| x.min(d)));
-        }
-        next
-    }
-}
-
-/// Instructions that touch neither the motors, the I/O nor time: a batch of
-/// them runs without moving the world.
-fn is_pure(ins: Instruction) -> bool {
-    matches!(
-        ins.opcode,
-        opcode::CALC
-            | opcode::COMP
-            | opcode::JC
-            | opcode::JA
-            | opcode::CSUB
-            | opcode::RSUB
-            | opcode::CALCX
-            | opcode::CLE
-            | opcode::CALCVV
-            | opcode::CALCVA
-            | opcode::CALCAV
-            | opcode::CALCVX
-            | opcode::CALCXV
-            | opcode::CALCV
-            | opcode::DJNZ
-            | opcode::SIV
-            | opcode::GIV
-            | opcode::AIV
-            | opcode::CALL
-            | opcode::RST
-    ) || (matches!(ins.opcode, opcode::SGP | opcode::GGP) && ins.motor == 2)
 }

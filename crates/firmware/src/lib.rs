@@ -16,6 +16,7 @@ pub mod motion;
 pub mod profile;
 pub mod program;
 pub mod reference_search;
+mod time;
 pub mod world;
 pub mod world_file;
 
