@@ -17,8 +17,10 @@
 //!   stop, the motor loses steps: the position counter goes on, the
 //!   carriage does not.
 
-use crate::module::{Module, ap, error_flag, gp};
+use crate::module::Module;
+use crate::parameter_numbers::{ap, gp};
 use crate::program::Source;
+use crate::state::registers::error_flag;
 
 /// Full steps per second at which the motor has no torque left.
 pub const CORNER_FULLSTEPS: f64 = 2000.0;
@@ -33,16 +35,7 @@ pub const PRESCALER_UNIT: f64 = 10730.0;
 /// No step for 2^20 clocks of 16 MHz: the standstill flag.
 pub const STANDSTILL_NS: u64 = 65_536_000;
 
-/// Per-axis driver state.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Driver {
-    /// Last stallGuard2 reading, 0…1023.
-    pub load_value: i32,
-    /// coolStep's current scale (0…31), while coolStep regulates.
-    pub cool_scale: Option<f64>,
-    /// Measurements towards the next coolStep decrement.
-    pub down_count: f64,
-}
+pub use crate::state::axis::Driver;
 
 impl Module {
     /// The driver is switched off (no torque).

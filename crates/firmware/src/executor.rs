@@ -4,11 +4,14 @@
 //! shared with the program interpreter, which passes `Origin::Program` so
 //! that reads load the accumulator and branch commands are allowed.
 
-use crate::module::{Compare, Module, Origin, Outcome, Special, ap, error_flag, gp};
+use crate::module::Module;
 use crate::motion::RampMode;
+use crate::outcome::{Origin, Outcome, Special};
+use crate::parameter_numbers::{ap, gp};
 use crate::profile::{Parameter, PortDirection};
 use crate::reference_search::{ReferenceSearch, Switch};
-use tmclsim_protocol::{CalcOp, Command, ErrorFlag, Instruction, MoveMode, RfsAction, Status, opcode};
+use crate::state::registers::Compare;
+use tmclsim_protocol::{CalcOp, Command, Instruction, MoveMode, RfsAction, Status, opcode};
 
 type Exec = Result<i32, Status>;
 
@@ -46,8 +49,8 @@ impl Module {
                 if key != MAGIC_KEY {
                     return Outcome::error(Status::InvalidValue, key);
                 }
-                self.eeprom.clear();
-                self.eeprom_generation += 1;
+                self.persistence.eeprom.clear();
+                self.persistence.mark_written();
                 self.reset();
                 return Outcome { status: Status::Ok, value: key, special: Special::Silent };
             }
@@ -98,14 +101,14 @@ impl Module {
                     return Err(Status::EepromLocked);
                 }
                 let v = self.axes[m].params[param as usize];
-                self.eeprom.set_axis(motor, param, v);
-                self.eeprom_generation += 1;
+                self.persistence.eeprom.set_axis(motor, param, v);
+                self.persistence.mark_written();
                 Ok(echo)
             }
             Rsap { param, motor } => {
                 let m = self.motor(motor)?;
                 let spec = self.axis_spec(param, |a| a.eeprom)?;
-                let v = self.eeprom.axis(motor, param).unwrap_or(spec.default_word());
+                let v = self.persistence.eeprom.axis(motor, param).unwrap_or(spec.default_word());
                 self.write_axis_parameter(m, param, v);
                 Ok(echo)
             }
@@ -121,13 +124,13 @@ impl Module {
                     return Err(Status::EepromLocked);
                 }
                 let v = self.globals[bank as usize][param as usize];
-                self.eeprom.set_global(bank, param, v);
-                self.eeprom_generation += 1;
+                self.persistence.eeprom.set_global(bank, param, v);
+                self.persistence.mark_written();
                 Ok(echo)
             }
             Rsgp { param, bank } => {
                 let spec = self.global_spec(param, bank, |a| a.eeprom)?;
-                let v = self.eeprom.global(bank, param).unwrap_or(spec.default_word());
+                let v = self.persistence.eeprom.global(bank, param).unwrap_or(spec.default_word());
                 self.globals[bank as usize][param as usize] = v;
                 Ok(echo)
             }
@@ -234,23 +237,16 @@ impl Module {
                 Err(_) => Ok(echo),
             },
             Cle { flag } => {
-                self.registers.errors &= !match flag {
-                    ErrorFlag::All => 0xFF,
-                    ErrorFlag::Timeout => error_flag::TIMEOUT,
-                    ErrorFlag::Alarm => error_flag::ALARM,
-                    ErrorFlag::Deviation => error_flag::DEVIATION,
-                    ErrorFlag::Position => error_flag::POSITION,
-                    ErrorFlag::Shutdown => error_flag::SHUTDOWN,
-                };
+                self.registers.clear_errors(flag);
                 Ok(echo)
             }
             Ei { interrupt } | Di { interrupt } => {
                 let enable = matches!(cmd, Ei { .. });
                 if interrupt == 255 {
-                    self.interrupts_global = enable;
+                    self.interrupts.global = enable;
                 } else {
                     self.profile.interrupt(interrupt).ok_or(Status::WrongType)?;
-                    self.interrupts_enabled[interrupt as usize] = enable;
+                    self.interrupts.enabled[interrupt as usize] = enable;
                 }
                 Ok(echo)
             }
@@ -261,7 +257,7 @@ impl Module {
                 if address < 0 || address >= self.profile.module.program_memory as i32 {
                     return Err(Status::InvalidValue);
                 }
-                self.interrupt_vectors[interrupt as usize] = Some(address as u16);
+                self.interrupts.vectors[interrupt as usize] = Some(address as u16);
                 Ok(echo)
             }
             FirmwareVersion { binary: true } => Ok(self.profile.version_word()),
@@ -270,7 +266,7 @@ impl Module {
                 if mask <= 0 || mask as u32 & !valid != 0 {
                     return Err(Status::InvalidValue);
                 }
-                self.event_arm = Some((every_move, mask as u32));
+                self.interrupts.event_arm = Some((every_move, mask as u32));
                 Ok(mask)
             }
             Reset { key } => {
@@ -308,7 +304,7 @@ impl Module {
                 self.enter_ascii_mode();
                 Ok(echo)
             }
-            Sac { bus, count, value } => self.spi_transfer(bus, count, value),
+            Sac { bus, count, value } => self.io.spi_transfer(bus, count, value),
             FirmwareVersion { binary: false } | FactoryDefaults { .. } => unreachable!("handled in execute"),
             Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti => {
                 Err(Status::NotAvailable)
@@ -328,8 +324,7 @@ impl Module {
     }
 
     pub(crate) fn load_accumulator(&mut self, v: i32) {
-        self.registers.accumulator = v;
-        self.registers.compare = Compare::of(v, 0);
+        self.registers.load(v);
     }
 
     /// 32-bit two's complement arithmetic (decisions.md rule 19).
@@ -421,12 +416,9 @@ impl Module {
         }
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
-        axis.rfs = None;
-        axis.ramp_override = None;
-        axis.closed_loop.torque_mode = false;
+        axis.end_overrides();
         axis.params[ap::TARGET_SPEED as usize] = velocity * sign;
-        axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
-        axis.motion.mode = RampMode::Velocity;
+        axis.set_ramp_mode(RampMode::Velocity);
         axis.notify_on_arrival = false;
         Ok(())
     }
@@ -434,12 +426,9 @@ impl Module {
     /// MST: velocity mode with target speed 0.
     pub(crate) fn motor_stop(&mut self, m: usize) {
         let axis = &mut self.axes[m];
-        axis.rfs = None;
-        axis.ramp_override = None;
-        axis.closed_loop.torque_mode = false;
+        axis.end_overrides();
         axis.params[ap::TARGET_SPEED as usize] = 0;
-        axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
-        axis.motion.mode = RampMode::Velocity;
+        axis.set_ramp_mode(RampMode::Velocity);
         axis.notify_on_arrival = false;
     }
 
@@ -458,22 +447,14 @@ impl Module {
         }
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
-        axis.rfs = None;
-        axis.ramp_override = None;
-        axis.closed_loop.torque_mode = false;
+        axis.end_overrides();
         // MVP selects position mode; soft mode, once chosen, stays.
         if axis.motion.mode != RampMode::Soft {
-            axis.motion.mode = RampMode::Position;
-            axis.params[ap::RAMP_MODE as usize] = RampMode::Position as i32;
+            axis.set_ramp_mode(RampMode::Position);
         }
         self.set_target(m, target);
-        if let Some((every, mask)) = self.event_arm
-            && mask & (1 << m) != 0
-        {
+        if self.interrupts.claim_arrival_event(m) {
             self.axes[m].notify_on_arrival = true;
-            if !every {
-                self.event_arm = None;
-            }
             if self.axes[m].motion.x == self.axes[m].motion.target && self.axes[m].motion.v == 0.0 {
                 // Already there: the event follows at once.
                 self.axes[m].notify_on_arrival = false;
@@ -542,20 +523,6 @@ impl Module {
         Ok(())
     }
 
-    /// SAC (TMCM-351): an SPI transfer of `count` bytes on chip select
-    /// `bus`. The simulated device on each bus is a shift register: it
-    /// answers with what the previous transfer sent.
-    fn spi_transfer(&mut self, bus: u8, count: u8, value: i32) -> Exec {
-        let slot = self.spi.get_mut(bus as usize).ok_or(Status::WrongType)?;
-        if !(1..=4).contains(&count) {
-            return Err(Status::InvalidValue);
-        }
-        let mask = if count == 4 { u32::MAX } else { (1u32 << (8 * count)) - 1 };
-        let answer = *slot & mask;
-        *slot = value as u32 & mask;
-        Ok(answer as i32)
-    }
-
     /// GP 73 on modules that have it: the configuration EEPROM is locked.
     pub(crate) fn eeprom_locked(&self) -> bool {
         self.profile.global_parameter(0, gp::EEPROM_LOCK).is_some() && self.globals[0][gp::EEPROM_LOCK as usize] == 1
@@ -597,8 +564,7 @@ impl Module {
         self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
         axis.notify_on_arrival = false;
-        axis.motion.mode = RampMode::Velocity;
-        axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
+        axis.set_ramp_mode(RampMode::Velocity);
         axis.rfs = Some(rfs);
         self.reference_search_step(m, true, false);
         Ok(())
@@ -628,8 +594,7 @@ impl Module {
             if let Some((reference, distance)) = rfs.finish {
                 // Move to the reference point at the switch speed.
                 let axis = &mut self.axes[m];
-                axis.motion.mode = RampMode::Position;
-                axis.params[ap::RAMP_MODE as usize] = RampMode::Position as i32;
+                axis.set_ramp_mode(RampMode::Position);
                 axis.motion.target = reference.round();
                 if axis.motion.x != axis.motion.target || axis.motion.v != 0.0 {
                     self.axes[m].rfs = Some(rfs);
@@ -709,8 +674,9 @@ impl Module {
             }
             ap::RAMP_MODE => {
                 let axis = &mut self.axes[m];
+                axis.set_ramp_mode(RampMode::from_code(value));
+                // AP 138 keeps the word as written.
                 axis.params[param as usize] = value;
-                axis.motion.mode = RampMode::from_code(value);
             }
             ap::ENCODER_POSITION if self.has_closed_loop() => {
                 let now = self.closed_loop_encoder(m) as f64 - self.axes[m].closed_loop.encoder_offset;
@@ -724,11 +690,9 @@ impl Module {
                 // Torque mode: the driver sets this current (mA).
                 let axis = &mut self.axes[m];
                 axis.params[param as usize] = value;
+                axis.end_overrides();
                 axis.closed_loop.torque_mode = true;
-                axis.rfs = None;
-                axis.ramp_override = None;
-                axis.motion.mode = RampMode::Velocity;
-                axis.params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
+                axis.set_ramp_mode(RampMode::Velocity);
             }
             crate::closed_loop::cl::MODE if self.has_closed_loop() => {
                 self.axes[m].params[param as usize] = value;
@@ -821,19 +785,16 @@ impl Module {
                 _ => return Err(Status::InvalidValue),
             };
             self.globals[0][param as usize] = locked;
-            self.eeprom.set_global(0, param, locked);
-            self.eeprom_generation += 1;
+            self.persistence.eeprom.set_global(0, param, locked);
+            self.persistence.mark_written();
             return Ok(());
         }
         if auto && self.eeprom_locked() {
             return Err(Status::EepromLocked);
         }
         match (bank, param) {
-            (0, gp::TICK_TIMER) => {
-                self.tick_base_ns = self.now_ns;
-                self.tick_offset_ms = value as i64;
-            }
-            (0, gp::RANDOM) => self.rng = value as u32 | 1,
+            (0, gp::TICK_TIMER) => self.globals.set_tick_timer(self.now_ns, value as i64),
+            (0, gp::RANDOM) => self.globals.seed_random(value),
             (0, gp::CODE_PROTECTION) => {
                 let old = self.globals[0][param as usize];
                 if matches!(old, 1 | 3) && matches!(value, 0 | 2) {
@@ -842,8 +803,8 @@ impl Module {
                         *w = Instruction::default();
                     }
                     self.program.reset();
-                    self.eeprom.program.clear();
-                    self.eeprom_generation += 1;
+                    self.persistence.eeprom.program.clear();
+                    self.persistence.mark_written();
                 }
                 self.globals[0][param as usize] = value;
             }
@@ -857,8 +818,8 @@ impl Module {
             _ => self.globals[bank as usize][param as usize] = value,
         }
         if auto {
-            self.eeprom.set_global(bank, param, value);
-            self.eeprom_generation += 1;
+            self.persistence.eeprom.set_global(bank, param, value);
+            self.persistence.mark_written();
         }
         Ok(())
     }
@@ -866,22 +827,11 @@ impl Module {
     pub fn get_global_parameter(&mut self, param: u8, bank: u8) -> Result<i32, Status> {
         self.global_spec(param, bank, |a| a.read)?;
         Ok(match (bank, param) {
-            (0, gp::TICK_TIMER) => {
-                let ms = (self.now_ns - self.tick_base_ns) / 1_000_000;
-                (self.tick_offset_ms + ms as i64) as i32 & i32::MAX
-            }
+            (0, gp::TICK_TIMER) => self.globals.tick_timer(self.now_ns),
             (0, gp::APPLICATION_STATUS) => self.program.mode as i32,
             (0, gp::DOWNLOAD_MODE) => self.program.download.is_some() as i32,
             (0, gp::PROGRAM_COUNTER) => self.program.pc as i32,
-            (0, gp::RANDOM) => {
-                // xorshift32, 31 bits.
-                let mut x = self.rng;
-                x ^= x << 13;
-                x ^= x >> 17;
-                x ^= x << 5;
-                self.rng = x;
-                (x >> 1) as i32
-            }
+            (0, gp::RANDOM) => self.globals.random(),
             _ => self.globals[bank as usize][param as usize],
         })
     }
@@ -897,7 +847,7 @@ impl Module {
             if !(0..=1).contains(&value) {
                 return Err(Status::InvalidValue);
             }
-            self.pullups = value == 1;
+            self.io.pullups = value == 1;
             return Ok(());
         }
         if !has(PortDirection::Output) {
@@ -909,7 +859,7 @@ impl Module {
                 return Err(Status::InvalidValue);
             }
             let mask = self.output_mask(bank);
-            self.outputs = (self.outputs & !mask) | (v as u32 & mask);
+            self.io.set_outputs(mask, v as u32);
             return Ok(());
         }
         if self.profile.port(PortDirection::Output, bank, port).is_none() {
@@ -918,11 +868,7 @@ impl Module {
         if !(0..=1).contains(&value) {
             return Err(Status::InvalidValue);
         }
-        if value == 1 {
-            self.outputs |= 1 << port;
-        } else {
-            self.outputs &= !(1 << port);
-        }
+        self.io.set_output(port, value == 1);
         Ok(())
     }
 
@@ -942,14 +888,14 @@ impl Module {
         };
         if port == 255 {
             return Ok(if first.direction == PortDirection::Output {
-                (self.outputs & self.output_mask(bank)) as i32
+                (self.io.outputs & self.output_mask(bank)) as i32
             } else {
                 in_bank.filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | (self.world.digital(p.number) as i32) << p.number)
             });
         }
         let p = in_bank.find(|p| p.number == port).ok_or(Status::WrongType)?;
         Ok(match p.direction {
-            PortDirection::Output => (self.outputs >> port & 1) as i32,
+            PortDirection::Output => (self.io.outputs >> port & 1) as i32,
             _ if p.max == 1 => self.world.digital(port) as i32,
             // The supply voltage channel is the one with a 0.1 V unit.
             _ if p.unit.as_deref().is_some_and(|u| u.contains('V')) => self.world.supply_decivolts as i32,
@@ -959,11 +905,11 @@ impl Module {
 
     /// The states of the digital outputs, bit n = OUTn.
     pub fn outputs(&self) -> u32 {
-        self.outputs
+        self.io.outputs
     }
 
     pub fn pullups(&self) -> bool {
-        self.pullups
+        self.io.pullups
     }
 
     // ----- coordinates --------------------------------------------------
@@ -981,18 +927,18 @@ impl Module {
             for m in 0..self.axes.len() {
                 for c in range.clone() {
                     let v = self.axes[m].coordinates[c as usize];
-                    self.eeprom.set_coordinate(m as u8, c, v);
+                    self.persistence.eeprom.set_coordinate(m as u8, c, v);
                 }
             }
-            self.eeprom_generation += 1;
+            self.persistence.mark_written();
             return Ok(());
         }
         let m = self.motor(motor)?;
         let v = value.unwrap_or(0);
         self.axes[m].coordinates[n as usize] = v;
         if n > 0 && self.globals[0][gp::COORDINATE_STORAGE as usize] == 1 {
-            self.eeprom.set_coordinate(motor, n, v);
-            self.eeprom_generation += 1;
+            self.persistence.eeprom.set_coordinate(motor, n, v);
+            self.persistence.mark_written();
         }
         Ok(())
     }
@@ -1005,7 +951,7 @@ impl Module {
         let range = if n == 0 { 1..=self.profile.module.coordinates } else { n..=n };
         for m in 0..self.axes.len() {
             for c in range.clone() {
-                self.axes[m].coordinates[c as usize] = self.eeprom.coordinate(m as u8, c).unwrap_or(0);
+                self.axes[m].coordinates[c as usize] = self.persistence.eeprom.coordinate(m as u8, c).unwrap_or(0);
             }
         }
         Ok(())

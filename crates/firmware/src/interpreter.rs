@@ -2,10 +2,12 @@
 //! time, with WAIT, subroutines and interrupts; and the control commands
 //! (128–135) that load, start, step and inspect programs.
 
-use crate::module::{Compare, Module, Origin, Outcome, Special, error_flag, gp};
+use crate::module::Module;
+use crate::outcome::{Origin, Outcome, Special};
+use crate::parameter_numbers::gp;
 use crate::program::{Context, RunMode, STACK_DEPTH, Source, TraceRecord, Wait};
 use tmclsim_protocol::frame::memory_reply;
-use tmclsim_protocol::{Command, Condition, Instruction, Status, WaitCondition, opcode};
+use tmclsim_protocol::{Command, Instruction, Status, WaitCondition, opcode};
 
 /// Ten milliseconds: one WAIT tick.
 const TICK_NS: u64 = 10_000_000;
@@ -65,7 +67,7 @@ impl Module {
             Command::ExitDownload => {
                 if self.program.download.take().is_some() {
                     // The downloaded words are in the EEPROM image; save it.
-                    self.eeprom_generation += 1;
+                    self.persistence.mark_written();
                 }
                 Ok(ok(0))
             }
@@ -102,9 +104,9 @@ impl Module {
             return Outcome::error(Status::InvalidValue, ins.value);
         };
         *slot = ins;
-        self.eeprom.program.insert(address, ins.to_bytes());
+        self.persistence.eeprom.program.insert(address, ins.to_bytes());
         // Each word is in the EEPROM when it is acknowledged, as on the module.
-        self.eeprom_generation += 1;
+        self.persistence.mark_written();
         self.program.download = Some(address + 1);
         self.program.download_pointer = address + 1;
         Outcome { status: Status::Loaded, value: ins.value, special: Special::None }
@@ -120,8 +122,8 @@ impl Module {
         for (a, w) in self.program.memory.iter_mut().enumerate() {
             *w = words.get(a).copied().unwrap_or_default();
         }
-        self.eeprom.program = words.iter().enumerate().map(|(a, w)| (a as u16, w.to_bytes())).collect();
-        self.eeprom_generation += 1;
+        self.persistence.eeprom.program = words.iter().enumerate().map(|(a, w)| (a as u16, w.to_bytes())).collect();
+        self.persistence.mark_written();
         self.program.download_pointer = words.len() as u16;
         Ok(())
     }
@@ -238,14 +240,14 @@ impl Module {
             Command::Ja { address } => self.program.pc = target(address)?,
             Command::Jc { condition, address } => {
                 let a = target(address)?;
-                if self.condition(condition) {
+                if self.registers.holds(condition) {
                     self.program.pc = a;
                 }
             }
             Command::Csub { address } => self.call(target(address)?),
             Command::Call { condition, address } => {
                 let a = target(address)?;
-                if self.condition(condition) {
+                if self.registers.holds(condition) {
                     self.call(a);
                 }
             }
@@ -307,44 +309,26 @@ impl Module {
         }
     }
 
-    pub(crate) fn condition(&self, c: Condition) -> bool {
-        let cmp = self.registers.compare;
-        let e = self.registers.errors;
-        match c {
-            Condition::Zero | Condition::Equal => cmp == Compare::Equal,
-            Condition::NotZero | Condition::NotEqual => cmp != Compare::Equal,
-            Condition::Greater => cmp == Compare::Greater,
-            Condition::GreaterEqual => cmp != Compare::Less,
-            Condition::Lower => cmp == Compare::Less,
-            Condition::LowerEqual => cmp != Compare::Greater,
-            Condition::Timeout => e & error_flag::TIMEOUT != 0,
-            Condition::Alarm => e & error_flag::ALARM != 0,
-            Condition::Deviation => e & error_flag::DEVIATION != 0,
-            Condition::PositionError => e & error_flag::POSITION != 0,
-        }
-    }
-
     /// Enters the handler of the most urgent pending interrupt, if the
     /// program may take one now (decisions.md rule 22).
     /// An enabled interrupt with a vector is pending and may be taken.
     pub(crate) fn interrupt_ready(&self) -> bool {
-        self.interrupts_global
+        self.interrupts.global
             && self.program.handler.is_none()
             && self.program.pending != [0; 4]
-            && self.program.first_pending(|n| self.interrupts_enabled[n as usize] && self.interrupt_vectors[n as usize].is_some()).is_some()
+            && self.program.first_pending(|n| self.interrupts.serviceable(n)).is_some()
     }
 
     pub(crate) fn take_interrupt(&mut self) {
-        if !self.interrupts_global || self.program.handler.is_some() || self.program.pending == [0; 4] {
+        if !self.interrupts.global || self.program.handler.is_some() || self.program.pending == [0; 4] {
             return;
         }
-        let vectors = &self.interrupt_vectors;
-        let enabled = &self.interrupts_enabled;
-        let Some(n) = self.program.first_pending(|n| enabled[n as usize] && vectors[n as usize].is_some()) else {
+        let interrupts = &self.interrupts;
+        let Some(n) = self.program.first_pending(|n| interrupts.serviceable(n)) else {
             return;
         };
         self.program.clear_pending(n);
-        let vector = self.interrupt_vectors[n as usize].expect("checked");
+        let vector = self.interrupts.vectors[n as usize].expect("checked");
         self.program.handler = Some(Context { registers: self.registers, pc: self.program.pc, wait: self.program.wait.take() });
         self.program.pc = vector;
         self.program.next_ns = self.program.next_ns.max(self.now_ns);
@@ -356,7 +340,7 @@ impl Module {
             return;
         }
         if let Some(n) = self.profile.interrupt_for(source)
-            && self.interrupts_enabled[n as usize]
+            && self.interrupts.enabled[n as usize]
         {
             self.program.set_pending(n);
         }

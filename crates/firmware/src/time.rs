@@ -2,8 +2,10 @@
 //! program's batches and WAITs, timers, input and switch edges, the
 //! heartbeat, the motors moving and the driver watching them.
 
-use crate::module::{Module, ap, error_flag, gp};
+use crate::module::Module;
+use crate::parameter_numbers::{ap, gp};
 use crate::program::{RunMode, Source};
+use crate::state::registers::error_flag;
 use tmclsim_protocol::{Instruction, WaitCondition, opcode};
 
 impl Module {
@@ -72,7 +74,7 @@ impl Module {
         if let Some(deadline) = self.heartbeat_deadline()
             && self.now_ns >= deadline
         {
-            self.heartbeat_tripped = true;
+            self.link.heartbeat_tripped = true;
             for motor in 0..self.axes.len() {
                 self.motor_stop(motor);
             }
@@ -84,7 +86,7 @@ impl Module {
     /// their bank 3 trigger setting selects.
     fn look_at_inputs(&mut self) {
         let inputs = self.world.digital_inputs;
-        let changed = inputs ^ self.last_inputs;
+        let changed = inputs ^ self.io.last_inputs;
         if changed != 0 {
             for n in 0..8u8 {
                 if changed & (1 << n) != 0 {
@@ -92,18 +94,18 @@ impl Module {
                     self.trigger(Source::InputChange(n), rising);
                 }
             }
-            self.last_inputs = inputs;
+            self.io.last_inputs = inputs;
         }
         for m in 0..self.axes.len() {
             let (l, r, _) = self.switches(m);
-            let (pl, pr) = self.last_switches.get(m).copied().unwrap_or((l, r));
+            let (pl, pr) = self.io.last_switches.get(m).copied().unwrap_or((l, r));
             if l != pl {
                 self.trigger(Source::StopLeft(m as u8), l);
             }
             if r != pr {
                 self.trigger(Source::StopRight(m as u8), r);
             }
-            if let Some(s) = self.last_switches.get_mut(m) {
+            if let Some(s) = self.io.last_switches.get_mut(m) {
                 *s = (l, r);
             }
         }
@@ -128,7 +130,7 @@ impl Module {
 
     pub(crate) fn heartbeat_deadline(&self) -> Option<u64> {
         let hb = self.globals[0][gp::HEARTBEAT as usize];
-        (hb > 0 && !self.heartbeat_tripped).then(|| self.last_frame_ns + hb as u64 * 1_000_000)
+        (hb > 0 && !self.link.heartbeat_tripped).then(|| self.link.last_frame_ns + hb as u64 * 1_000_000)
     }
 
     /// The next virtual time at which something observable happens on its
@@ -313,10 +315,10 @@ impl Module {
     /// Interrupts that depend on motion are enabled: the world must then be
     /// looked at often (every millisecond) even while the program waits.
     pub(crate) fn motion_interrupts_armed(&self) -> bool {
-        self.interrupts_global
+        self.interrupts.global
             && self.program.is_running()
             && self.profile.interrupts.iter().any(|i| {
-                self.interrupts_enabled[i.number as usize]
+                self.interrupts.enabled[i.number as usize]
                     && matches!(
                         Source::from_symbol(&i.symbol),
                         Some(
@@ -332,7 +334,7 @@ impl Module {
         for t in 0..3u8 {
             let Some(n) = self.profile.interrupt_for(Source::Timer(t)) else { continue };
             let period_ms = self.globals[3][n as usize] as u32 as u64;
-            if !self.program.is_running() || period_ms == 0 || !self.interrupts_enabled[n as usize] {
+            if !self.program.is_running() || period_ms == 0 || !self.interrupts.enabled[n as usize] {
                 self.program.timers[t as usize] = None;
                 continue;
             }
