@@ -220,4 +220,34 @@ impl Module {
         self.motor_stop(m);
         self.axes[m].motion.v = 0.0;
     }
+
+    /// The current setting in effect (0…255): run, boost, standby or off.
+    pub fn motor_current(&self, m: usize) -> u32 {
+        let axis = &self.axes[m];
+        let p = &axis.params;
+        let run = p[ap::MAX_CURRENT as usize].clamp(0, 255) as u32;
+        if axis.motion.v != 0.0 {
+            let slow = p[ap::SMART_ENERGY_SLOW_RUN_CURRENT as usize].clamp(0, 255) as u32;
+            if p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0
+                && slow > 0
+                && self.actual_speed(m).abs() < p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize]
+            {
+                return slow;
+            }
+            let boost = p[ap::BOOST_CURRENT as usize].clamp(0, 255) as u32;
+            return if axis.motion.a != 0.0 && boost > 0 { boost } else { run };
+        }
+        let standby = p[ap::STANDBY_CURRENT as usize].clamp(0, 255) as u32;
+        if axis.motion.stopped_by_switch && p[ap::END_SWITCH_POWER_DOWN as usize] == 1 {
+            return standby;
+        }
+        let Some(since) = axis.standstill_since else { return run };
+        let still_ms = (self.now_ns.saturating_sub(since)) / 1_000_000;
+        let freewheel = p[ap::FREEWHEELING as usize].max(0) as u64 * 10;
+        if freewheel > 0 && still_ms >= freewheel {
+            return 0;
+        }
+        let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * 10;
+        if still_ms >= delay { standby } else { run }
+    }
 }

@@ -1,139 +1,19 @@
-//! The TMCL program interpreter: one instruction at a time, in virtual
-//! time, with WAIT, subroutines and interrupts; and the control commands
-//! (128–135) that load, start, step and inspect programs.
+//! The TMCL program interpreter: one instruction at a time, with jumps,
+//! WAIT, subroutines and interrupts; and the debugger's controls
+//! (breakpoints, single steps, the trace). The control commands 128–135
+//! are in `commands/program_control.rs`, the interpreter's clock in
+//! `time.rs`.
 
 use crate::module::Module;
-use crate::outcome::{Origin, Outcome, Special};
-use crate::parameter_numbers::gp;
+use crate::outcome::Origin;
 use crate::program::{Context, RunMode, STACK_DEPTH, Source, TraceRecord, Wait};
-use tmclsim_protocol::frame::memory_reply;
 use tmclsim_protocol::{Command, Instruction, Status, WaitCondition, opcode};
 
 /// Ten milliseconds: one WAIT tick.
 const TICK_NS: u64 = 10_000_000;
 
 impl Module {
-    // ----- control commands ---------------------------------------------
-
-    /// 128–135: program control over any link.
-    pub(crate) fn control(&mut self, cmd: Command) -> Result<Outcome, Status> {
-        let memory = self.program.memory.len() as i32;
-        let ok = Outcome::ok;
-        match cmd {
-            Command::StopApplication => {
-                if self.program.mode != RunMode::Reset {
-                    self.program.mode = RunMode::Stop;
-                }
-                Ok(ok(0))
-            }
-            Command::RunApplication { from } => {
-                if let Some(address) = from {
-                    if !(0..memory).contains(&address) {
-                        return Err(Status::InvalidValue);
-                    }
-                    self.program.pc = address as u16;
-                    self.program.stack.clear();
-                    self.program.wait = None;
-                    self.program.handler = None;
-                }
-                self.start_program();
-                Ok(ok(from.unwrap_or(0)))
-            }
-            Command::StepApplication => {
-                self.program.mode = RunMode::Step;
-                self.program.hit_breakpoint = None;
-                self.program.next_ns = self.now_ns;
-                self.step_program();
-                Ok(ok(0))
-            }
-            Command::ResetApplication => {
-                self.program.reset();
-                self.program.mode = RunMode::Reset;
-                self.registers = Default::default();
-                Ok(ok(0))
-            }
-            Command::EnterDownload { address } => {
-                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 2 | 3) || self.eeprom_locked() {
-                    return Err(Status::EepromLocked);
-                }
-                if !(0..memory).contains(&address) {
-                    return Err(Status::InvalidValue);
-                }
-                self.program.mode = RunMode::Stop;
-                self.program.download = Some(address as u16);
-                self.program.download_pointer = address as u16;
-                Ok(ok(address))
-            }
-            Command::ExitDownload => {
-                if self.program.download.take().is_some() {
-                    // The downloaded words are in the EEPROM image; save it.
-                    self.persistence.mark_written();
-                }
-                Ok(ok(0))
-            }
-            Command::ReadMemory { address } => {
-                if !(0..memory).contains(&address) {
-                    return Err(Status::InvalidValue);
-                }
-                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 1 | 3) {
-                    return Err(Status::EepromLocked);
-                }
-                let stored = self.program.memory[address as usize];
-                Ok(Outcome { status: Status::Ok, value: address, special: Special::Frame(memory_reply(self.host_address(), stored)) })
-            }
-            Command::ApplicationStatus { kind } => {
-                let p = &self.program;
-                let word = |address: u16| ((p.mode as i32) << 24) | ((p.wait.is_some() as i32) << 16) | address as i32;
-                Ok(ok(match kind {
-                    0 => word(p.download_pointer),
-                    1 => word(p.pc),
-                    2 => self.registers.accumulator,
-                    _ => self.registers.x,
-                }))
-            }
-            _ => Err(Status::InvalidCommand),
-        }
-    }
-
-    /// Stores a word in download mode (status 101), decisions.md rule 15.
-    pub(crate) fn download_word(&mut self, ins: Instruction) -> Outcome {
-        let Some(address) = self.program.download else {
-            return Outcome::error(Status::NotAvailable, ins.value);
-        };
-        let Some(slot) = self.program.memory.get_mut(address as usize) else {
-            return Outcome::error(Status::InvalidValue, ins.value);
-        };
-        *slot = ins;
-        self.persistence.eeprom.program.insert(address, ins.to_bytes());
-        // Each word is in the EEPROM when it is acknowledged, as on the module.
-        self.persistence.mark_written();
-        self.program.download = Some(address + 1);
-        self.program.download_pointer = address + 1;
-        Outcome { status: Status::Loaded, value: ins.value, special: Special::None }
-    }
-
-    /// Loads a program into memory from address 0 (as a download would)
-    /// and stores it in the EEPROM.
-    pub fn load_program(&mut self, words: &[Instruction]) -> Result<(), Status> {
-        if words.len() > self.program.memory.len() {
-            return Err(Status::InvalidValue);
-        }
-        self.program.mode = RunMode::Stop;
-        for (a, w) in self.program.memory.iter_mut().enumerate() {
-            *w = words.get(a).copied().unwrap_or_default();
-        }
-        self.persistence.eeprom.program = words.iter().enumerate().map(|(a, w)| (a as u16, w.to_bytes())).collect();
-        self.persistence.mark_written();
-        self.program.download_pointer = words.len() as u16;
-        Ok(())
-    }
-
-    /// Pauses the program (step mode), as a debugger does.
-    pub fn pause_program(&mut self) {
-        if self.program.mode == RunMode::Run {
-            self.program.mode = RunMode::Step;
-        }
-    }
+    // ----- the debugger -------------------------------------------------
 
     /// Runs until one more instruction has executed (a WAIT in progress
     /// first ends), then pauses; time stops at most `slice_ns` after it.
@@ -149,13 +29,6 @@ impl Module {
         self.program.single_step = false;
         self.pause_program();
         self.program.executed != before
-    }
-
-    /// Starts (or continues) the program as 129 does.
-    pub fn start_program(&mut self) {
-        // A program paused at a breakpoint resumes with that instruction.
-        self.program.mode = RunMode::Run;
-        self.program.next_ns = self.program.next_ns.max(self.now_ns);
     }
 
     pub fn program(&self) -> &crate::program::Program {

@@ -7,10 +7,13 @@
 pub mod ascii;
 pub mod can;
 pub mod closed_loop;
+mod commands;
 pub mod driver;
 pub mod eeprom;
 pub mod executor;
+mod frames;
 mod interpreter;
+mod mechanics;
 pub mod module;
 pub mod motion;
 mod outcome;
@@ -19,6 +22,8 @@ pub mod profile;
 pub mod program;
 pub mod reference_search;
 mod state;
+#[cfg(test)]
+mod test_support;
 mod time;
 pub mod world;
 pub mod world_file;

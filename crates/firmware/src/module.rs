@@ -1,8 +1,11 @@
-//! A virtual TMCL module: profile, state, EEPROM, motion and world, driven
-//! by `handle_frame` (or `execute`) and `advance`.
+//! A virtual TMCL module: the `Module` struct, a composition of its state
+//! (`state/`), its constructors and accessors, and power-up and reset. What
+//! it does lives in the `impl Module` files: the links (`frames.rs`,
+//! `can.rs`, `ascii.rs`), the commands (`executor.rs`, `commands/`), the
+//! program (`interpreter.rs`), the axes (`mechanics.rs`, `driver.rs`,
+//! `closed_loop.rs`) and virtual time (`time.rs`).
 
 use crate::eeprom::Eeprom;
-use crate::motion;
 use crate::profile::Profile;
 use crate::program::{Program, RunMode};
 use crate::state::globals::Globals;
@@ -12,8 +15,6 @@ use crate::state::link::Link;
 use crate::state::persistence::Persistence;
 use crate::world::World;
 use std::sync::Arc;
-use tmclsim_protocol::frame::version_string_reply;
-use tmclsim_protocol::{FRAME_LEN, Reply, Request, Status, opcode};
 
 pub use crate::outcome::{Origin, Outcome, Special};
 pub use crate::parameter_numbers::{ap, gp};
@@ -159,11 +160,6 @@ impl Module {
         self.persistence.store_global(0, gp::SERIAL_ADDRESS, address as i32);
     }
 
-    /// Does a frame with this address byte reach this module?
-    pub fn answers_to(&self, address: u8) -> bool {
-        address == self.address() || (self.secondary_address() != 0 && address == self.secondary_address())
-    }
-
     /// Power cycle: RAM from factory defaults, then what the EEPROM holds.
     pub fn power_on(&mut self) {
         let profile = self.profile.clone();
@@ -250,144 +246,9 @@ impl Module {
         }
     }
 
-    /// Handles one 9-byte frame from a serial-type link: address filter,
-    /// checksum, execution, reply (decisions.md rules 2–4, 11).
-    pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
-        let (request, checksum_ok) = match Request::decode(frame) {
-            Ok(r) => (r, true),
-            Err(r) => (r, false),
-        };
-        if !self.answers_to(request.address) {
-            return None;
-        }
-        self.link.last_address = request.address;
-        self.link.restart_heartbeat(self.now_ns);
-        let host = self.host_address();
-        if !checksum_ok {
-            if self.replies_suppressed(0) {
-                return None;
-            }
-            return Some(Reply::new(host, request.address, Status::WrongChecksum, 0, 0).encode());
-        }
-        let ins = request.instruction;
-        let outcome =
-            if self.program.download.is_some() && !opcode::is_control(ins.opcode) { self.download_word(ins) } else { self.execute(ins) };
-        let reply = match outcome.special {
-            Special::Silent => return None,
-            Special::Frame(f) => f,
-            Special::None => Reply::new(host, request.address, outcome.status, ins.opcode, outcome.value).encode(),
-        };
-        if ins.opcode == opcode::RESET && outcome.status == Status::Ok {
-            // The reply goes out, then the module restarts.
-            self.reset();
-            return Some(reply);
-        }
-        if self.replies_suppressed(ins.opcode) {
-            return None;
-        }
-        Some(reply)
-    }
-
-    /// GP 255: replies in direct mode are suppressed except for GAP, GGP
-    /// and GIO.
-    fn replies_suppressed(&self, op: u8) -> bool {
-        self.globals[0][gp::SUPPRESS_REPLY as usize] == 1 && !matches!(op, opcode::GAP | opcode::GGP | opcode::GIO)
-    }
-
     /// Software reset (255 with 1234): a power cycle.
     pub fn reset(&mut self) {
         self.resets += 1;
         self.power_on();
-    }
-
-    /// Unsolicited frames (138 events) produced since the last call.
-    pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
-        std::mem::take(&mut self.interrupts.events)
-    }
-
-    pub fn has_events(&self) -> bool {
-        !self.interrupts.events.is_empty()
-    }
-
-    pub(crate) fn push_event(&mut self, mask: u32) {
-        let reply = Reply::new(self.host_address(), self.link.last_address, Status::Event, opcode::TARGET_REACHED_EVENT, mask as i32);
-        self.interrupts.events.push(reply.encode());
-    }
-
-    pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
-        version_string_reply(self.host_address(), &self.profile.version_text())
-    }
-
-    pub(crate) fn shaft_sign(&self) -> f64 {
-        if self.globals[0][gp::REVERSE_SHAFT as usize] == 1 { -1.0 } else { 1.0 }
-    }
-
-    /// Mechanical position of an axis for a motor position.
-    pub(crate) fn mech(&self, motor: usize, x: f64) -> f64 {
-        x * self.shaft_sign() + self.axes[motor].mech_offset
-    }
-
-    /// Where the carriage of an axis is, in the world's coordinates.
-    pub fn mechanical_position(&self, motor: usize) -> f64 {
-        self.mech(motor, self.axes[motor].motion.x)
-    }
-
-    /// Logical switch states (after GP 79 polarity): (left, right, home).
-    pub fn switches(&self, motor: usize) -> (bool, bool, bool) {
-        self.switches_at(motor, self.axes[motor].motion.x)
-    }
-
-    pub(crate) fn switches_at(&self, motor: usize, x: f64) -> (bool, bool, bool) {
-        let w = &self.world.axes[motor];
-        let m = self.mech(motor, x);
-        let invert = self.globals[0][gp::END_SWITCH_POLARITY as usize] == 1;
-        (w.left_pressed(m) ^ invert, w.right_pressed(m) ^ invert, w.home_pressed(m))
-    }
-
-    pub(crate) fn stops_at(&self, motor: usize, x: f64) -> motion::Stops {
-        if self.axes[motor].rfs.is_some() {
-            // AP 12/13 do not influence the reference search.
-            return motion::Stops::default();
-        }
-        let (left, right, _) = self.switches_at(motor, x);
-        let p = &self.axes[motor].params;
-        motion::Stops {
-            block_positive: right && p[ap::RIGHT_SWITCH_DISABLE as usize] == 0,
-            block_negative: left && p[ap::LEFT_SWITCH_DISABLE as usize] == 0,
-            soft: p[ap::SOFT_STOP as usize] == 1,
-        }
-    }
-
-    /// Ramp settings of an axis in µsteps and seconds.
-    pub(crate) fn ramp(&self, motor: usize) -> motion::Ramp {
-        if let Some(r) = self.axes[motor].ramp_override {
-            return r;
-        }
-        let p = &self.axes[motor].params;
-        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
-        let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
-        let mut vmax = p[ap::MAX_SPEED as usize].clamp(0, 2047) as f64;
-        let mut target_velocity = p[ap::TARGET_SPEED as usize] as f64;
-        if self.axes[motor].closed_loop.torque_mode {
-            target_velocity = self.torque_mode_velocity(motor);
-        }
-        if let Some(rfs) = &self.axes[motor].rfs {
-            let slow = p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047) as f64;
-            match rfs.current() {
-                Some(seek) => {
-                    let fast = p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047) as f64;
-                    target_velocity = seek.dir * if seek.fast { fast } else { slow };
-                }
-                None => vmax = slow.max(1.0),
-            }
-        }
-        motion::Ramp {
-            vmax: motion::velocity_pps(vmax, pd),
-            vmin: motion::velocity_pps(p[ap::MIN_SPEED as usize].clamp(0, 2047) as f64, pd),
-            accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
-            accel_velocity: motion::accel_pps2(a.max(1) as f64, rd, pd),
-            target_velocity: motion::velocity_pps(target_velocity, pd),
-        }
     }
 }
