@@ -58,6 +58,7 @@ impl Module {
         self.globals[0][gp::SUPPRESS_REPLY as usize] == 1 && !matches!(op, opcode::GAP | opcode::GGP | opcode::GIO)
     }
 
+    /// 136 type 0: the version text as a frame.
     pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
         version_string_reply(self.host_address(), &self.profile.version_text())
     }

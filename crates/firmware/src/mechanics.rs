@@ -8,6 +8,7 @@ use crate::motion;
 use crate::parameter_numbers::{ap, gp};
 
 impl Module {
+    /// AP 1: the position counter.
     pub fn actual_position(&self, m: usize) -> i32 {
         self.wrap_position(self.axes[m].motion.position())
     }
