@@ -1,21 +1,26 @@
-//! `Bus`: several modules on one link, as on an RS485 bus.
+//! `Bus`: several modules on one link, as on an RS485 bus — a firmware
+//! `Bus` shared with the modules' objects (and a server, when served).
 
 use crate::errors::value_error;
 use crate::module::{Module, seconds_to_ns, served_error};
 use crate::types::{Reply, ReplyKind, command_from};
 use pyo3::prelude::*;
 use std::borrow::Cow;
+use std::sync::Arc;
+use tmclsim_firmware::Bus as FwBus;
 use tmclsim_protocol::{FRAME_LEN, Request};
+use tmclsim_server::SharedBus;
 
 /// Several modules on one link: every frame reaches every module, the
 /// addressed one answers.
 ///
 /// ``Bus([Module(address=1), Module(address=2)])``. The modules stay
-/// usable on their own; the bus brings them to one virtual time and moves
-/// them together with ``advance``. ``tmclsim.serve(bus)`` serves the whole
+/// usable on their own; they now live on the bus, at one virtual time, and
+/// move together with ``advance``. ``tmclsim.serve(bus)`` serves the whole
 /// bus on one TCP port and pty.
 #[pyclass(module = "tmclsim", name = "Bus")]
 pub struct Bus {
+    pub shared: Arc<SharedBus>,
     pub modules: Vec<Py<Module>>,
 }
 
@@ -27,25 +32,34 @@ impl Bus {
             return Err(value_error("a bus needs at least one module"));
         }
         let mut addresses = Vec::new();
-        let mut latest = 0;
         for m in &modules {
             let mut m = m.bind(py).try_borrow_mut()?;
             if m.is_served() {
                 return Err(served_error());
+            }
+            if m.shared.len() != 1 {
+                return Err(value_error("the module is on a bus already"));
             }
             let address = m.address_now()?;
             if addresses.contains(&address) {
                 return Err(value_error(format!("two modules have address {address}: give each its own (Module(address=…))")));
             }
             addresses.push(address);
-            latest = latest.max(m.now_ns()?);
         }
+        // Each module leaves its bus of one for the new bus, with its
+        // EEPROM file; the firmware bus brings them to one time.
+        let mut fw = Vec::new();
+        let mut eeproms = Vec::new();
         for m in &modules {
-            let mut m = m.bind(py).try_borrow_mut()?;
-            let module = m.local_module()?;
-            module.advance_to(latest);
+            let m = m.bind(py).try_borrow_mut()?;
+            fw.extend(m.shared.take_modules());
+            eeproms.push(m.eeprom_path.clone());
         }
-        Ok(Bus { modules })
+        let shared = Arc::new(SharedBus::new(FwBus::new(fw), eeproms));
+        for (i, m) in modules.iter().enumerate() {
+            m.bind(py).try_borrow_mut()?.move_to(shared.clone(), i);
+        }
+        Ok(Bus { shared, modules })
     }
 
     /// The modules, in the order given.
@@ -59,12 +73,10 @@ impl Bus {
     ///
     /// The module that answers to ``address`` now (GP 66).
     fn module(&self, py: Python<'_>, address: u8) -> PyResult<Py<Module>> {
-        for m in &self.modules {
-            if m.bind(py).try_borrow_mut()?.address_now()? == address {
-                return Ok(m.clone_ref(py));
-            }
+        match self.shared.with_bus(|b| b.index_of(address)) {
+            Some(i) => Ok(self.modules[i].clone_ref(py)),
+            None => Err(value_error(format!("no module on the bus answers to address {address}"))),
         }
-        Err(value_error(format!("no module on the bus answers to address {address}")))
     }
 
     /// send_frame(frame: bytes) -> bytes | None
@@ -72,15 +84,10 @@ impl Bus {
     ///
     /// Puts nine bytes on the bus: every module sees them, the addressed
     /// one answers (None: nobody answered).
-    fn send_frame(&self, py: Python<'_>, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
+    fn send_frame(&self, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
         let frame: &[u8; FRAME_LEN] =
             frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
-        let mut answer = None;
-        for m in &self.modules {
-            let reply = m.bind(py).try_borrow_mut()?.handle_frame(frame)?;
-            answer = answer.or(reply);
-        }
-        Ok(answer)
+        Ok(self.shared.with_bus(|b| b.handle_frame(frame)).replies.into_iter().next())
     }
 
     /// send(address, command, type=None, motor=None, value=None) -> Reply | None
@@ -91,7 +98,6 @@ impl Bus {
     #[pyo3(signature = (address, command, r#type=None, motor=None, value=None))]
     fn send(
         &self,
-        py: Python<'_>,
         address: u8,
         command: &Bound<'_, PyAny>,
         r#type: Option<u8>,
@@ -100,7 +106,7 @@ impl Bus {
     ) -> PyResult<Option<Reply>> {
         let ins = command_from(command, r#type, motor, value)?;
         let frame = Request::new(address, ins).encode();
-        let reply = self.send_frame(py, Cow::Borrowed(&frame))?;
+        let reply = self.send_frame(Cow::Borrowed(&frame))?;
         Ok(reply.map(|raw| Reply::new(raw, ReplyKind::of(ins, address, &raw))))
     }
 
@@ -110,21 +116,13 @@ impl Bus {
     /// Moves every module on by the same virtual time.
     fn advance(&self, py: Python<'_>, seconds: f64) -> PyResult<()> {
         let ns = seconds_to_ns(seconds)?;
-        for m in &self.modules {
-            let mut m = m.bind(py).try_borrow_mut()?;
-            if m.is_served() {
-                // A served bus moves together: once is enough.
-                return m.advance_ns(py, ns);
-            }
-            m.advance_ns(py, ns)?;
-        }
-        Ok(())
+        self.modules[0].bind(py).try_borrow_mut()?.advance_ns(py, ns)
     }
 
-    /// Virtual time in seconds (of the first module).
+    /// Virtual time in seconds.
     #[getter]
-    fn time(&self, py: Python<'_>) -> PyResult<f64> {
-        Ok(self.modules[0].bind(py).try_borrow_mut()?.now_ns()? as f64 * 1e-9)
+    fn time(&self) -> f64 {
+        self.shared.now_ns() as f64 * 1e-9
     }
 
     fn __len__(&self) -> usize {
@@ -146,12 +144,8 @@ impl Bus {
         Ok(list.try_iter()?.into_any().unbind())
     }
 
-    fn __repr__(&self, py: Python<'_>) -> String {
-        let addresses: Vec<String> = self
-            .modules
-            .iter()
-            .map(|m| m.bind(py).try_borrow_mut().ok().and_then(|mut m| m.address_now().ok()).map_or("?".into(), |a| a.to_string()))
-            .collect();
+    fn __repr__(&self) -> String {
+        let addresses: Vec<String> = self.shared.with_bus(|b| b.modules().iter().map(|m| m.address().to_string()).collect());
         format!("<tmclsim.Bus addresses {}>", addresses.join(", "))
     }
 }

@@ -1,10 +1,10 @@
 //! `Module`: one virtual TMCL module.
 //!
-//! In process, the module is owned here and changes only when Python
-//! calls (virtual time stands still between `advance` calls). While it is
-//! served (`Server`), the module lives in the server and this object
-//! reaches it through the server's lock; when the server stops, the
-//! module comes back.
+//! The module lives on a bus (`tmclsim_server::SharedBus`, a bus of one
+//! unless it was put on a `Bus`), as every front end's module does: the
+//! bus's clock is stepped in process (virtual time stands still between
+//! `advance` calls) and follows the wall clock while a `Server` serves it
+//! in real time; the bus writes the EEPROM file.
 
 use crate::asm::{Program, program_from};
 use crate::errors::{os_error, tmcl_error, value_error};
@@ -16,25 +16,15 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyInt, PyList, PyString};
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
+use tmclsim_firmware::Bus;
 use tmclsim_firmware::eeprom::save_atomic;
-use tmclsim_firmware::profile::{Access, Parameter};
+use tmclsim_firmware::profile::Parameter;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
 use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Request, Status, opcode};
-use tmclsim_server::SharedModule;
-
-/// Where the module is. (A served module needs no room: boxing the local
-/// one would only add an indirection to every call.)
-#[allow(clippy::large_enum_variant)]
-pub enum Backend {
-    /// Owned by this object. `events` holds 138 events taken out of the
-    /// module while it was lent for a world command.
-    Local { module: FwModule, events: Vec<[u8; FRAME_LEN]> },
-    /// In a server: module `index` of its link.
-    Served { shared: Arc<SharedModule>, index: usize },
-}
+use tmclsim_server::SharedBus;
 
 /// A virtual TMCL module (a TMCM-1141 by default).
 ///
@@ -54,62 +44,33 @@ pub enum Backend {
 /// costs milliseconds.
 #[pyclass(subclass, module = "tmclsim", name = "Module")]
 pub struct Module {
-    pub backend: Backend,
+    /// The bus the module is on, and its place there.
+    pub shared: Arc<SharedBus>,
+    pub index: usize,
+    /// A server serves the bus.
+    pub served: bool,
     pub profile: Arc<Profile>,
     names: Names,
     pub eeprom_path: Option<PathBuf>,
-    saved_generation: u64,
     /// Labels of the last program loaded (for breakpoints and `run`).
     symbols: BTreeMap<String, u32>,
 }
 
 impl Module {
-    /// Runs `f` on the module wherever it is; saves the EEPROM file of an
-    /// in-process module when `f` wrote the EEPROM.
+    /// Runs `f` on the module, brought up to the bus's now; the bus then
+    /// carries out what changed (EEPROM file, events).
     pub fn with<R>(&mut self, f: impl FnOnce(&mut FwModule) -> R) -> PyResult<R> {
-        match &mut self.backend {
-            Backend::Local { module, .. } => {
-                let r = f(module);
-                if module.eeprom_generation() != self.saved_generation {
-                    self.saved_generation = module.eeprom_generation();
-                    if let Some(path) = &self.eeprom_path {
-                        save_atomic(path, module.eeprom())
-                            .map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", path.display())))?;
-                    }
-                }
-                Ok(r)
-            }
-            Backend::Served { shared, index } => Ok(shared.with_module(*index, f)),
-        }
-    }
-
-    /// Takes the module out for a server, which holds it as module `index`
-    /// of its link until `give_back`.
-    pub fn lend(&mut self, shared: Arc<SharedModule>, index: usize) -> PyResult<FwModule> {
-        match std::mem::replace(&mut self.backend, Backend::Served { shared, index }) {
-            Backend::Local { module, .. } => Ok(module),
-            served => {
-                self.backend = served;
-                Err(served_error())
-            }
-        }
-    }
-
-    /// The module is back from a server.
-    pub fn give_back(&mut self, module: FwModule) {
-        self.saved_generation = module.eeprom_generation();
-        self.backend = Backend::Local { module, events: Vec::new() };
+        Ok(self.shared.with_module(self.index, f))
     }
 
     pub fn is_served(&self) -> bool {
-        matches!(self.backend, Backend::Served { .. })
+        self.served
     }
 
-    pub fn local_module(&mut self) -> PyResult<&mut FwModule> {
-        match &mut self.backend {
-            Backend::Local { module, .. } => Ok(module),
-            Backend::Served { .. } => Err(served_error()),
-        }
+    /// Moves the module onto another bus (a `Bus` was made of it).
+    pub fn move_to(&mut self, shared: Arc<SharedBus>, index: usize) {
+        self.shared = shared;
+        self.index = index;
     }
 
     /// Sends one instruction to the module's own address.
@@ -135,19 +96,14 @@ impl Module {
 
     /// Moves virtual time on (in process, or a served link in stepped time).
     pub fn advance_ns(&mut self, py: Python<'_>, ns: u64) -> PyResult<()> {
-        match &mut self.backend {
-            Backend::Local { module, .. } => py.detach(|| module.advance(ns)),
-            Backend::Served { shared, .. } => {
-                if !shared.is_stepped() {
-                    return Err(PyRuntimeError::new_err(
-                        "the module is served in real time: set server.stepped = True to move virtual time by hand",
-                    ));
-                }
-                let shared = shared.clone();
-                py.detach(|| shared.advance(ns));
-            }
+        if !self.shared.is_stepped() {
+            return Err(PyRuntimeError::new_err(
+                "the module is served in real time: set server.stepped = True to move virtual time by hand",
+            ));
         }
-        self.with(|_| ())
+        let shared = self.shared.clone();
+        py.detach(|| shared.advance(ns));
+        Ok(())
     }
 
     fn axis_number(&self, param: &Bound<'_, PyAny>) -> PyResult<u8> {
@@ -173,10 +129,8 @@ impl Module {
         text.push_str(&format!(": {} (status {})", status.describe(), status.code()));
         let detail = match (status, spec) {
             (Status::WrongType, None) => Some("the module has no such parameter".to_string()),
-            (Status::WrongType, Some(p)) if write && !p.access.write => Some(format!("it is read-only (access {})", access_text(p.access))),
-            (Status::WrongType, Some(p)) if !write && !p.access.read => {
-                Some(format!("it cannot be read (access {})", access_text(p.access)))
-            }
+            (Status::WrongType, Some(p)) if write && !p.access.write => Some(format!("it is read-only (access {})", p.access)),
+            (Status::WrongType, Some(p)) if !write && !p.access.read => Some(format!("it cannot be read (access {})", p.access)),
             (Status::InvalidValue, Some(p)) if write && motor_or_bank.is_none() => {
                 Some(format!("the value must be in {}…{}", p.min, p.max))
             }
@@ -228,16 +182,6 @@ fn byte(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<u8> {
     obj.extract::<u8>().map_err(|_| value_error(format!("a {what} is 0…255, not {obj}")))
 }
 
-fn access_text(a: Access) -> String {
-    let mut s = String::new();
-    for (on, c) in [(a.read, 'R'), (a.write, 'W'), (a.eeprom, 'E'), (a.auto, 'A')] {
-        if on {
-            s.push(c);
-        }
-    }
-    s
-}
-
 pub fn seconds_to_ns(seconds: f64) -> PyResult<u64> {
     if !(seconds >= 0.0 && seconds.is_finite()) {
         return Err(value_error(format!("time moves forward only: {seconds} s")));
@@ -252,13 +196,7 @@ fn world_from(world: Option<&Bound<'_, PyAny>>, axes: usize) -> PyResult<World> 
         return Ok(World::stage(axes));
     }
     if let Ok(text) = world.cast::<PyString>() {
-        let text = text.to_cow()?;
-        return match text.as_ref() {
-            "stage" => Ok(World::stage(axes)),
-            "free" => Ok(World::free(axes)),
-            toml if toml.contains('\n') => World::from_toml(toml, axes).map_err(|e| value_error(format!("world: {e}"))),
-            path => World::load_file(Path::new(path), axes).map_err(|e| value_error(format!("world: {e}"))),
-        };
+        return World::named(&text.to_cow()?, axes).map_err(|e| value_error(format!("world: {e}")));
     }
     let path: PathBuf = world.extract().map_err(|_| value_error("world is \"stage\", \"free\", a path or TOML text"))?;
     World::load_file(&path, axes).map_err(|e| value_error(format!("world: {e}")))
@@ -272,7 +210,7 @@ fn parameter_dict<'py>(py: Python<'py>, p: &Parameter, bank: Option<u8>) -> PyRe
     }
     d.set_item("name", &p.name)?;
     d.set_item("snake_name", snake_case(&p.name))?;
-    d.set_item("access", access_text(p.access))?;
+    d.set_item("access", p.access.to_string())?;
     d.set_item("min", p.min)?;
     d.set_item("max", p.max)?;
     d.set_item("default", p.default)?;
@@ -307,16 +245,9 @@ impl Module {
     #[pyo3(signature = (profile="tmcm-1141", address=None, eeprom=None, world=None))]
     fn py_new(profile: &str, address: Option<u8>, eeprom: Option<PathBuf>, world: Option<&Bound<'_, PyAny>>) -> PyResult<Module> {
         let profile = Profile::built_in(profile).map_err(value_error)?;
-        let name = profile.module.name.clone();
         let image = match &eeprom {
-            Some(path) => match Eeprom::load(path).map_err(value_error)? {
-                Some(image) if image.module != name => {
-                    return Err(value_error(format!("{} holds the EEPROM of a {}, not of a {name}", path.display(), image.module)));
-                }
-                Some(image) => image,
-                None => Eeprom::new(&name),
-            },
-            None => Eeprom::new(&name),
+            Some(path) => tmclsim_firmware::eeprom::load_for(path, &profile.module.name).map_err(value_error)?.0,
+            None => Eeprom::new(&profile.module.name),
         };
         let world = world_from(world, profile.module.axes as usize)?;
         let mut module = FwModule::with_world(profile.clone(), image, world);
@@ -330,14 +261,8 @@ impl Module {
         {
             save_atomic(path, module.eeprom()).map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", path.display())))?;
         }
-        Ok(Module {
-            saved_generation: module.eeprom_generation(),
-            names: Names::new(&profile),
-            backend: Backend::Local { module, events: Vec::new() },
-            profile,
-            eeprom_path: eeprom,
-            symbols: BTreeMap::new(),
-        })
+        let shared = Arc::new(SharedBus::new(Bus::single(module), vec![eeprom.clone()]));
+        Ok(Module { shared, index: 0, served: false, names: Names::new(&profile), profile, eeprom_path: eeprom, symbols: BTreeMap::new() })
     }
 
     /// The module's name, e.g. ``"TMCM-1141"``.
@@ -413,11 +338,9 @@ impl Module {
     /// produced since the last call. A served module sends them on its link
     /// instead.
     fn take_events(&mut self) -> PyResult<Vec<Reply>> {
-        let mut frames = Vec::new();
-        if let Backend::Local { module, events } = &mut self.backend {
-            frames.append(events);
-            frames.extend(module.take_events());
-        }
+        // Carry out what is due first; events no link received wait on the bus.
+        self.with(|_| ())?;
+        let frames = self.shared.take_unclaimed_events(self.index);
         Ok(frames.into_iter().map(|f| Reply::new(f, ReplyKind::Normal)).collect())
     }
 
@@ -711,11 +634,18 @@ impl Module {
     #[pyo3(signature = (timeout=10.0))]
     fn step(&mut self, py: Python<'_>, timeout: f64) -> PyResult<bool> {
         let limit = seconds_to_ns(timeout)?;
-        let module = self.local_module()?;
-        let end = module.now_ns().saturating_add(limit);
-        let done = py.detach(|| module.step_instruction(end, 10_000_000));
-        self.with(|_| ())?;
-        Ok(done)
+        if !self.shared.is_stepped() {
+            return Err(PyRuntimeError::new_err(
+                "the module is served in real time: step needs stepped time (stop the server or set server.stepped = True)",
+            ));
+        }
+        let (shared, index) = (self.shared.clone(), self.index);
+        Ok(py.detach(|| {
+            shared.with_module(index, |m| {
+                let end = m.now_ns().saturating_add(limit);
+                m.step_instruction(end, 10_000_000)
+            })
+        }))
     }
 
     /// Breakpoints: addresses (or labels of the program loaded last)
@@ -828,14 +758,7 @@ impl Module {
     /// ``ValueError`` with its error. ``link …`` commands need a served
     /// module.
     fn world(&mut self, line: &str) -> PyResult<String> {
-        let answer = match &mut self.backend {
-            Backend::Local { module, events } => {
-                events.extend(module.take_events());
-                world::on_module(module, line)
-            }
-            Backend::Served { shared, index } => world::on_served(shared, *index, line),
-        };
-        answer.map_err(value_error)
+        world::run(&self.shared, self.index, line, self.served).map_err(value_error)
     }
 
     fn __repr__(&mut self) -> String {
@@ -871,20 +794,21 @@ impl Module {
 /// between: the core's share of a call through the binding.
 #[pyfunction]
 pub fn _time_core(module: &Bound<'_, Module>, operation: &str, calls: u32) -> PyResult<f64> {
-    let mut this = module.try_borrow_mut()?;
-    let m = this.local_module()?;
-    let frame = Request::new(m.address(), Ins::new(opcode::GAP, 4, 0, 0)).encode();
-    let started = std::time::Instant::now();
-    let mut sink = 0i64;
-    for n in 0..calls {
-        sink += match operation {
-            "send_frame" => std::hint::black_box(m.handle_frame(std::hint::black_box(&frame))).map_or(0, |r| r[7] as i64),
-            "get_axis_parameter" => m.get_axis_parameter(std::hint::black_box(4), 0).unwrap_or(0) as i64,
-            "set_axis_parameter" => m.set_axis_parameter(4, 0, std::hint::black_box(1000 + (n % 2) as i32)).map_or(0, |_| 1),
-            "get_global_parameter" => m.get_global_parameter(std::hint::black_box(66), 0).unwrap_or(0) as i64,
-            other => return Err(value_error(format!("unknown operation '{other}'"))),
-        };
-    }
-    std::hint::black_box(sink);
-    Ok(started.elapsed().as_secs_f64() / calls.max(1) as f64)
+    let this = module.try_borrow_mut()?;
+    this.shared.with_module(this.index, |m| {
+        let frame = Request::new(m.address(), Ins::new(opcode::GAP, 4, 0, 0)).encode();
+        let started = std::time::Instant::now();
+        let mut sink = 0i64;
+        for n in 0..calls {
+            sink += match operation {
+                "send_frame" => std::hint::black_box(m.handle_frame(std::hint::black_box(&frame))).map_or(0, |r| r[7] as i64),
+                "get_axis_parameter" => m.get_axis_parameter(std::hint::black_box(4), 0).unwrap_or(0) as i64,
+                "set_axis_parameter" => m.set_axis_parameter(4, 0, std::hint::black_box(1000 + (n % 2) as i32)).map_or(0, |_| 1),
+                "get_global_parameter" => m.get_global_parameter(std::hint::black_box(66), 0).unwrap_or(0) as i64,
+                other => return Err(value_error(format!("unknown operation '{other}'"))),
+            };
+        }
+        std::hint::black_box(sink);
+        Ok(started.elapsed().as_secs_f64() / calls.max(1) as f64)
+    })
 }

@@ -1,8 +1,9 @@
 //! `Server`: modules served on TCP and a pty in a background thread.
 //!
-//! The modules move into the server for as long as it runs; the `Module`
-//! objects reach them through the server's lock meanwhile, and get them
-//! back when the server stops (also when it is garbage collected).
+//! The server serves the very bus the `Module` objects (or the `Bus`)
+//! hold: nothing moves. While it runs in real time the bus's clock follows
+//! the wall clock; when it stops (also when garbage collected) the clock is
+//! stepped again.
 
 use crate::bus::Bus;
 use crate::errors::{os_error, value_error};
@@ -16,8 +17,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
-use tmclsim_firmware::Module as FwModule;
-use tmclsim_server::{Endpoints, LinkFaults, ServerConfig, ServerHandle, SharedModule};
+use tmclsim_server::{Endpoints, LinkFaults, ServerConfig, ServerHandle, SharedBus};
 
 /// An endpoint argument: `True` (the default place), `False`/`None` (off),
 /// or an address / path.
@@ -89,26 +89,25 @@ fn pty_path(endpoint: Endpoint, module_name: &str) -> Option<PathBuf> {
 #[pyclass(subclass, module = "tmclsim", name = "Server")]
 pub struct Server {
     handle: Option<ServerHandle>,
-    shared: Arc<SharedModule>,
+    shared: Arc<SharedBus>,
     modules: Vec<Py<Module>>,
     endpoints: Endpoints,
 }
 
 impl Server {
-    fn live(&self) -> PyResult<&Arc<SharedModule>> {
+    fn live(&self) -> PyResult<&Arc<SharedBus>> {
         if self.handle.is_some() { Ok(&self.shared) } else { Err(PyRuntimeError::new_err("the server is stopped")) }
     }
 
-    /// Stops serving and gives the modules back to their `Module` objects.
+    /// Stops serving; the modules are in process again, in stepped time.
     fn shutdown(&mut self, py: Python<'_>) {
         let Some(handle) = self.handle.take() else { return };
         handle.stop();
-        for (i, m) in self.modules.iter().enumerate() {
-            let Ok(mut m) = m.bind(py).try_borrow_mut() else { continue };
-            // A copy: what stays behind must keep the EEPROM image, or the
-            // server would write a stand-in's image to the EEPROM file.
-            let module = self.shared.with_module(i, |slot| slot.clone());
-            m.give_back(module);
+        self.shared.set_stepped(true);
+        for m in &self.modules {
+            if let Ok(mut m) = m.bind(py).try_borrow_mut() {
+                m.served = false;
+            }
         }
     }
 }
@@ -134,10 +133,15 @@ impl Server {
         stepped: bool,
         wire_timing: bool,
     ) -> PyResult<Server> {
-        let modules: Vec<Py<Module>> = if let Ok(m) = target.cast::<Module>() {
-            vec![m.clone().unbind()]
+        let (shared, modules): (Arc<SharedBus>, Vec<Py<Module>>) = if let Ok(m) = target.cast::<Module>() {
+            let shared = m.borrow().shared.clone();
+            if shared.len() != 1 {
+                return Err(value_error("the module is on a bus: serve the Bus"));
+            }
+            (shared, vec![m.clone().unbind()])
         } else if let Ok(bus) = target.cast::<Bus>() {
-            bus.borrow().modules.iter().map(|m| m.clone_ref(py)).collect()
+            let bus = bus.borrow();
+            (bus.shared.clone(), bus.modules.iter().map(|m| m.clone_ref(py)).collect())
         } else {
             return Err(PyTypeError::new_err(format!("serve takes a Module or a Bus, not {}", target.get_type().name()?)));
         };
@@ -149,10 +153,6 @@ impl Server {
             }
             refs.push(r);
         }
-        let mut latest = 0;
-        for r in refs.iter_mut() {
-            latest = latest.max(r.now_ns()?);
-        }
         if matches!(tcp, Endpoint::Off) && matches!(pty, Endpoint::Off) {
             return Err(value_error("serve needs tcp, pty or both"));
         }
@@ -163,21 +163,12 @@ impl Server {
             wire_timing,
             ..ServerConfig::default()
         };
-        // The server starts with stand-ins, stops its clock, and then takes
-        // the real modules: they change hands at the virtual time they
-        // have, and stay with their objects if the server cannot start.
-        let stand_ins = refs.iter().map(|r| (FwModule::new(r.profile.clone()), r.eeprom_path.clone())).collect();
-        let handle = tmclsim_server::start_bus_with_eeproms(stand_ins, config).map_err(|e| os_error(format!("cannot serve: {e}")))?;
-        let shared = handle.module().clone();
-        shared.set_stepped(true);
-        for (i, r) in refs.iter_mut().enumerate() {
-            let mut module = r.lend(shared.clone(), i)?;
-            module.advance_to(latest);
-            shared.with_module(i, move |slot| *slot = module);
+        shared.with_bus(|b| *b = std::mem::replace(b, tmclsim_firmware::Bus::new(Vec::new())).with_wire_timing(wire_timing));
+        let handle = tmclsim_server::start_shared(shared.clone(), config).map_err(|e| os_error(format!("cannot serve: {e}")))?;
+        for r in refs.iter_mut() {
+            r.served = true;
         }
-        if !stepped {
-            shared.set_stepped(false);
-        }
+        shared.set_stepped(stepped);
         let endpoints = handle.endpoints().clone();
         Ok(Server { handle: Some(handle), shared, modules, endpoints })
     }
@@ -271,7 +262,7 @@ impl Server {
     /// Virtual time of the served modules, in seconds.
     #[getter]
     fn time(&self) -> PyResult<f64> {
-        Ok(self.live()?.with_module(0, |m| m.now_ns()) as f64 * 1e-9)
+        Ok(self.live()?.now_ns() as f64 * 1e-9)
     }
 
     /// world(line: str, module: int = 0) -> str
@@ -287,7 +278,7 @@ impl Server {
         if module >= self.modules.len() {
             return Err(value_error(format!("module {module}: the server has {}", self.modules.len())));
         }
-        world::on_served(shared, module, line).map_err(value_error)
+        world::run(shared, module, line, true).map_err(value_error)
     }
 
     /// link_faults(drop=None, corrupt=None, delay_ms=None, mute=None, clear=False) -> dict

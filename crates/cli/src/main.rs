@@ -201,11 +201,7 @@ fn profile(name: &str) -> Result<ExitCode, String> {
 
 /// The world named on the command line: `stage`, `free` or a file.
 pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::World, String> {
-    match name {
-        "stage" => Ok(tmclsim_firmware::World::stage(axes)),
-        "free" => Ok(tmclsim_firmware::World::free(axes)),
-        path => tmclsim_firmware::World::load_file(std::path::Path::new(path), axes),
-    }
+    tmclsim_firmware::World::named(name, axes)
 }
 
 fn world(args: WorldArgs) -> Result<ExitCode, String> {

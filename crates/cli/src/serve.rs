@@ -41,18 +41,12 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
         other => other,
     };
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
-    let fresh = Eeprom::new(&profile.module.name);
     let (image, eeprom_note) = match &args.eeprom {
-        Some(path) => match Eeprom::load(path)? {
-            Some(image) => {
-                if image.module != profile.module.name {
-                    return Err(format!("{} holds the EEPROM of a {}, not of a {}", path.display(), image.module, profile.module.name));
-                }
-                (image, format!("restored from {}", path.display()))
-            }
-            None => (fresh, format!("factory defaults; changes are kept in {} (new)", path.display())),
+        Some(path) => match tmclsim_firmware::eeprom::load_for(path, &profile.module.name)? {
+            (image, true) => (image, format!("restored from {}", path.display())),
+            (image, false) => (image, format!("factory defaults; changes are kept in {} (new)", path.display())),
         },
-        None => (fresh, "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
+        None => (Eeprom::new(&profile.module.name), "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
     };
     let module = Module::with_world(profile.clone(), image, world);
     let mut module = module;

@@ -96,6 +96,19 @@ impl Eeprom {
     }
 }
 
+/// The EEPROM a module of `module_name` powers up with from `path`: the
+/// stored image (`true`), or an empty one when the file does not exist
+/// yet (`false`). A file of another module is refused.
+pub fn load_for(path: &Path, module_name: &str) -> Result<(Eeprom, bool), String> {
+    match Eeprom::load(path)? {
+        Some(image) if image.module != module_name => {
+            Err(format!("{} holds the EEPROM of a {}, not of a {module_name}", path.display(), image.module))
+        }
+        Some(image) => Ok((image, true)),
+        None => Ok((Eeprom::new(module_name), false)),
+    }
+}
+
 /// Writes the image to `path` atomically.
 pub fn save_atomic(path: &Path, image: &Eeprom) -> std::io::Result<()> {
     let dir = match path.parent() {

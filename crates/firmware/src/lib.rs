@@ -5,7 +5,9 @@
 //! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
 
 pub mod ascii;
+pub mod bus;
 pub mod can;
+pub mod clock;
 pub mod closed_loop;
 mod commands;
 pub mod driver;
@@ -21,13 +23,17 @@ mod parameter_numbers;
 pub mod profile;
 pub mod program;
 pub mod reference_search;
+pub mod snapshot;
 mod state;
 #[cfg(test)]
 mod test_support;
 mod time;
 pub mod world;
+pub mod world_command;
 pub mod world_file;
 
+pub use bus::Bus;
+pub use clock::Clock;
 pub use eeprom::Eeprom;
 pub use module::{Module, Outcome, Special};
 pub use profile::Profile;

@@ -71,6 +71,18 @@ struct AxisFile {
 }
 
 impl World {
+    /// The world a front end names: `stage` (the built-in linear stage),
+    /// `free` (no switches, no end stops), TOML text (anything with a line
+    /// break) or the path of a TOML file.
+    pub fn named(spec: &str, axes: usize) -> Result<World, String> {
+        match spec {
+            "stage" => Ok(World::stage(axes)),
+            "free" => Ok(World::free(axes)),
+            text if text.contains('\n') => World::from_toml(text, axes),
+            path => World::load_file(std::path::Path::new(path), axes),
+        }
+    }
+
     /// Reads a world description for a module with `axes` axes.
     pub fn from_toml(text: &str, axes: usize) -> Result<World, String> {
         let f: WorldFile = toml::from_str(text).map_err(|e| e.to_string())?;

@@ -1,27 +1,29 @@
-//! The clock task: wakes when the module has something due on its own.
+//! The clock task: wakes exactly when the bus has something due on its own
+//! ([`Bus::next_deadline`](tmclsim_firmware::Bus::next_deadline)), never on
+//! a polling period.
 
-use crate::shared::SharedModule;
+use crate::shared::SharedBus;
 use std::sync::Arc;
 use tokio::sync::watch;
 use tokio::time::Instant;
 
-pub(crate) async fn run(module: Arc<SharedModule>, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(bus: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
     loop {
-        let due = module.schedule();
+        let due = bus.tick();
+        let at = due.and_then(|ns| bus.instant_of(ns));
         let sleep = async {
-            match due.and_then(|ns| module.instant_of(ns)) {
+            match at {
                 Some(at) => tokio::time::sleep_until(Instant::from_std(at)).await,
                 None => std::future::pending::<()>().await,
             }
         };
         tokio::select! {
             _ = sleep => {
-                if let Some(at) = due.and_then(|ns| module.instant_of(ns)) {
-                    module.record_wakeup(std::time::Instant::now().saturating_duration_since(at).as_nanos() as u64);
+                if let Some(at) = at {
+                    bus.record_wakeup(std::time::Instant::now().saturating_duration_since(at).as_nanos() as u64);
                 }
-                module.tick()
             }
-            _ = module.changed() => {}
+            _ = bus.changed() => {}
             _ = stop.changed() => return,
         }
     }

@@ -18,7 +18,7 @@ mod slcan;
 mod tcp;
 
 pub use faults::LinkFaults;
-pub use shared::SharedModule;
+pub use shared::{SharedBus, Stats};
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -91,7 +91,7 @@ impl Endpoints {
 #[derive(Clone)]
 pub struct LinkHandle {
     pub endpoints: Endpoints,
-    pub module: Arc<SharedModule>,
+    pub module: Arc<SharedBus>,
 }
 
 /// A server running on its own thread; dropping it stops it.
@@ -108,7 +108,7 @@ impl ServerHandle {
     }
 
     /// The served module(s) of the (first) link.
-    pub fn module(&self) -> &Arc<SharedModule> {
+    pub fn module(&self) -> &Arc<SharedBus> {
         &self.links[0].module
     }
 
@@ -119,7 +119,7 @@ impl ServerHandle {
 
     /// Frames handled and real-time deadlines missed, over all links.
     pub fn stats(&self) -> shared::Stats {
-        self.links.iter().fold(shared::Stats::default(), |acc, l| acc.add(l.module.stats()))
+        self.links.iter().fold(shared::Stats::default(), |acc, l| acc.merged(l.module.stats()))
     }
 
     /// Stops serving, closes the links and removes the pty symlinks.
@@ -213,9 +213,17 @@ pub fn start_fleet(links: Vec<LinkSpec>) -> std::io::Result<ServerHandle> {
     if links.is_empty() || links.iter().any(|l| l.modules.is_empty()) {
         return Err(std::io::Error::other("every link needs at least one module"));
     }
-    let specs: Vec<(Arc<SharedModule>, ServerConfig)> =
-        links.into_iter().map(|l| (Arc::new(SharedModule::bus(l.modules, l.config.wire_timing)), l.config)).collect();
-    let shared: Vec<Arc<SharedModule>> = specs.iter().map(|(m, _)| m.clone()).collect();
+    serve_buses(links.into_iter().map(|l| (Arc::new(SharedBus::wall(l.modules, l.config.wire_timing)), l.config)).collect())
+}
+
+/// Serves a bus that already exists (e.g. one the Python package holds):
+/// its clock stays what it is (stepped or wall).
+pub fn start_shared(bus: Arc<SharedBus>, config: ServerConfig) -> std::io::Result<ServerHandle> {
+    serve_buses(vec![(bus, config)])
+}
+
+fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<ServerHandle> {
+    let shared: Vec<Arc<SharedBus>> = specs.iter().map(|(m, _)| m.clone()).collect();
     let (stop_tx, stop_rx) = watch::channel(false);
     let (ready_tx, ready_rx) = std::sync::mpsc::channel::<std::io::Result<Vec<Endpoints>>>();
     let thread = std::thread::Builder::new().name("tmclsim-server".into()).spawn(move || {

@@ -1,7 +1,7 @@
 //! One byte-stream link (a TCP connection or the pty): framing, the
 //! module's answer, replies and events written back in order.
 
-use crate::shared::SharedModule;
+use crate::shared::SharedBus;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -20,12 +20,7 @@ pub(crate) fn next_link_id() -> u64 {
 /// Serves one stream until it closes or fails. Replies are written by this
 /// task as soon as they exist; unsolicited events (138) reach it through a
 /// channel, so one task writes and frames never interleave.
-pub(crate) async fn serve<R, W>(
-    mut reader: R,
-    mut writer: W,
-    module: Arc<SharedModule>,
-    inter_byte_timeout: Duration,
-) -> std::io::Result<()>
+pub(crate) async fn serve<R, W>(mut reader: R, mut writer: W, module: Arc<SharedBus>, inter_byte_timeout: Duration) -> std::io::Result<()>
 where
     R: AsyncRead + Unpin,
     W: AsyncWrite + Unpin,

@@ -6,7 +6,7 @@
 //! echo, no line editing) as a USB/RS485 serial port behaves.
 
 use crate::ServerConfig;
-use crate::shared::SharedModule;
+use crate::shared::SharedBus;
 use std::io;
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd, RawFd};
 use std::path::{Path, PathBuf};
@@ -131,7 +131,7 @@ impl AsyncWrite for Master {
     }
 }
 
-pub(crate) async fn run(pty: Pty, module: Arc<SharedModule>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
     let (master, _slave) = match pty.into_stream() {
         Ok(v) => v,
         Err(e) => {

@@ -1,40 +1,34 @@
-//! The modules of one link (a single module, or several on an RS485-style
-//! multi-drop bus), shared by the link's connections and paced by the wall
-//! clock or stepped by hand.
+//! A [`Bus`] shared by the connections of a link, its clock task, its
+//! control socket and any in-process user (the Python package): the bus
+//! behind a lock, plus what only a server has — EEPROM files, the link
+//! that receives events, link faults and counters.
 
 use crate::faults::LinkFaults;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
-use tmclsim_firmware::Module;
+use tmclsim_firmware::can::CanFrame;
 use tmclsim_firmware::eeprom::save_atomic;
+use tmclsim_firmware::world_command::WorldCommand;
+use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::FRAME_LEN;
 use tokio::sync::{Notify, mpsc};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
 type EventSink = mpsc::UnboundedSender<[u8; FRAME_LEN]>;
 
-/// One module on the link, with its EEPROM file.
-struct Node {
-    module: Module,
-    eeprom: Option<PathBuf>,
-    saved_generation: u64,
-}
+/// Events kept for an in-process reader while no link has spoken.
+const UNCLAIMED_EVENTS: usize = 1024;
 
 struct State {
-    nodes: Vec<Node>,
+    bus: Bus,
+    /// EEPROM file of each module.
+    eeproms: Vec<Option<PathBuf>>,
     sink: Option<(u64, EventSink)>,
+    /// Events no link has claimed yet, by module index.
+    unclaimed: Vec<(usize, [u8; FRAME_LEN])>,
     /// What the clock task sleeps until (`None`: nothing).
     scheduled: Option<u64>,
-}
-
-/// How virtual time passes.
-#[derive(Clone, Copy, Debug)]
-enum Clock {
-    /// Paced by the wall clock: virtual time `origin_ns` at `origin`.
-    Wall { origin: Instant, origin_ns: u64 },
-    /// Only `SharedModule::advance` moves time (stepped virtual time).
-    Stepped,
 }
 
 /// Counters of a served link.
@@ -46,99 +40,72 @@ pub struct Stats {
     pub missed_deadlines: u64,
     /// The latest wake-up, in nanoseconds after its due time.
     pub max_lateness_ns: u64,
+    /// Times the clock task woke for something due.
+    pub wakeups: u64,
 }
 
 impl Stats {
-    pub fn add(self, o: Stats) -> Stats {
+    pub fn merged(self, o: Stats) -> Stats {
         Stats {
             frames: self.frames + o.frames,
             missed_deadlines: self.missed_deadlines + o.missed_deadlines,
             max_lateness_ns: self.max_lateness_ns.max(o.max_lateness_ns),
+            wakeups: self.wakeups + o.wakeups,
         }
     }
 }
 
-/// The served module(s) behind a lock, with the clock and EEPROM files.
-pub struct SharedModule {
+/// The bus of a link, shared.
+pub struct SharedBus {
     stats: Mutex<Stats>,
     state: Mutex<State>,
-    clock: Mutex<Clock>,
     changed: Notify,
     faults: Mutex<LinkFaults>,
-    /// Deliver bytes at the modules' baud rate (GP 65).
-    wire_timing: bool,
     /// Some module of the link is in ASCII mode.
     ascii: std::sync::atomic::AtomicBool,
 }
 
-/// GP 65 codes → bits per second (TMCM-1141 table 18).
-pub fn baud_rate(code: i32) -> u32 {
-    match code {
-        1 => 14_400,
-        2 => 19_200,
-        3 => 28_800,
-        4 => 38_400,
-        5 => 57_600,
-        6 => 76_800,
-        7 => 115_200,
-        8 => 230_400,
-        _ => 9_600,
-    }
-}
-
-impl SharedModule {
-    pub fn new(module: Module, eeprom: Option<PathBuf>) -> SharedModule {
-        SharedModule::bus(vec![(module, eeprom)], false)
-    }
-
-    /// Several modules on one link; each with its own EEPROM file.
-    pub fn bus(modules: Vec<(Module, Option<PathBuf>)>, wire_timing: bool) -> SharedModule {
-        let origin_ns = modules.iter().map(|(m, _)| m.now_ns()).max().unwrap_or(0);
-        let nodes = modules
-            .into_iter()
-            .map(|(mut module, eeprom)| {
-                module.advance_to(origin_ns);
-                let saved_generation = module.eeprom_generation();
-                Node { module, eeprom, saved_generation }
-            })
-            .collect();
-        let shared = SharedModule {
+impl SharedBus {
+    /// A bus with each module's EEPROM file (`eeproms` shorter than the
+    /// bus: no file for the rest).
+    pub fn new(bus: Bus, mut eeproms: Vec<Option<PathBuf>>) -> SharedBus {
+        eeproms.resize(bus.len(), None);
+        let shared = SharedBus {
             stats: Mutex::new(Stats::default()),
-            state: Mutex::new(State { nodes, sink: None, scheduled: None }),
-            clock: Mutex::new(Clock::Wall { origin: Instant::now(), origin_ns }),
+            state: Mutex::new(State { bus, eeproms, sink: None, unclaimed: Vec::new(), scheduled: None }),
             changed: Notify::new(),
             faults: Mutex::new(LinkFaults::default()),
-            wire_timing,
             ascii: std::sync::atomic::AtomicBool::new(false),
         };
         shared.update_ascii(&shared.lock());
         shared
     }
 
+    /// One module and its EEPROM file, in wall-clock time.
+    pub fn single(module: Module, eeprom: Option<PathBuf>) -> SharedBus {
+        SharedBus::wall(vec![(module, eeprom)], false)
+    }
+
+    /// Modules with their EEPROM files on one link, in wall-clock time.
+    pub fn wall(modules: Vec<(Module, Option<PathBuf>)>, wire_timing: bool) -> SharedBus {
+        let (modules, eeproms): (Vec<Module>, Vec<Option<PathBuf>>) = modules.into_iter().unzip();
+        let mut bus = Bus::new(modules).with_wire_timing(wire_timing);
+        bus.set_stepped(false);
+        SharedBus::new(bus, eeproms)
+    }
+
     /// Some module of the link reads text (ASCII mode): bytes go to
-    /// [`SharedModule::ascii_byte`] instead of the frame assembler.
+    /// [`SharedBus::ascii_byte`] instead of the frame assembler.
     pub fn ascii_active(&self) -> bool {
         self.ascii.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     fn update_ascii(&self, s: &State) {
-        let any = s.nodes.iter().any(|n| n.module.ascii_mode());
-        self.ascii.store(any, std::sync::atomic::Ordering::Relaxed);
+        self.ascii.store(s.bus.ascii_active(), std::sync::atomic::Ordering::Relaxed);
     }
 
-    /// One byte of text for the modules in ASCII mode; echoes and replies
-    /// are appended to `out`.
-    pub(crate) fn ascii_byte(&self, byte: u8, out: &mut Vec<u8>) {
-        let mut s = self.lock();
-        let now = self.now_ns();
-        for n in &mut s.nodes {
-            n.module.advance_to(now);
-            if n.module.ascii_mode() {
-                n.module.ascii_byte(byte, out);
-            }
-        }
-        Self::after_change(&mut s);
-        self.update_ascii(&s);
+    fn lock(&self) -> std::sync::MutexGuard<'_, State> {
+        self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     pub fn stats(&self) -> Stats {
@@ -148,6 +115,7 @@ impl SharedModule {
     /// The clock woke `late_ns` after a due time.
     pub(crate) fn record_wakeup(&self, late_ns: u64) {
         let mut s = self.stats.lock().unwrap_or_else(|p| p.into_inner());
+        s.wakeups += 1;
         if late_ns > 1_000_000 {
             s.missed_deadlines += 1;
         }
@@ -156,15 +124,11 @@ impl SharedModule {
 
     /// How many modules the link has.
     pub fn len(&self) -> usize {
-        self.lock().nodes.len()
+        self.lock().bus.len()
     }
 
     pub fn is_empty(&self) -> bool {
         self.len() == 0
-    }
-
-    fn lock(&self) -> std::sync::MutexGuard<'_, State> {
-        self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// The link faults in force.
@@ -184,196 +148,169 @@ impl SharedModule {
         (f.apply(frame), delay)
     }
 
-    /// Virtual time now: by the wall clock, or (stepped) 0, which moves
-    /// nothing.
+    /// Virtual time now, by the bus's clock.
     pub fn now_ns(&self) -> u64 {
-        match *self.clock.lock().unwrap_or_else(|p| p.into_inner()) {
-            Clock::Wall { origin, origin_ns } => origin_ns + origin.elapsed().as_nanos() as u64,
-            Clock::Stepped => 0,
-        }
+        self.lock().bus.now_ns()
     }
 
     /// The wall-clock instant of a virtual time (`None` in stepped time).
     pub fn instant_of(&self, ns: u64) -> Option<Instant> {
-        match *self.clock.lock().unwrap_or_else(|p| p.into_inner()) {
-            Clock::Wall { origin, origin_ns } => Some(origin + Duration::from_nanos(ns.saturating_sub(origin_ns))),
-            Clock::Stepped => None,
-        }
+        self.lock().bus.clock().instant_of(ns)
     }
 
     /// Stepped virtual time (`true`): time stands still between calls of
-    /// [`SharedModule::advance`]. `false` goes back to the wall clock from
+    /// [`SharedBus::advance`]. `false` goes back to the wall clock from
     /// where the modules are.
     pub fn set_stepped(&self, stepped: bool) {
-        if stepped {
-            // Bring the modules up to the wall clock before time stops.
-            self.tick();
-            *self.clock.lock().unwrap_or_else(|p| p.into_inner()) = Clock::Stepped;
-        } else {
-            let s = self.lock();
-            let now = s.nodes.iter().map(|n| n.module.now_ns()).max().unwrap_or(0);
-            let mut clock = self.clock.lock().unwrap_or_else(|p| p.into_inner());
-            if matches!(*clock, Clock::Stepped) {
-                *clock = Clock::Wall { origin: Instant::now(), origin_ns: now };
-            }
-        }
+        self.with_bus(|bus| bus.set_stepped(stepped));
         self.changed.notify_one();
     }
 
     pub fn is_stepped(&self) -> bool {
-        matches!(*self.clock.lock().unwrap_or_else(|p| p.into_inner()), Clock::Stepped)
+        self.lock().bus.clock().is_stepped()
     }
 
-    /// Stepped virtual time: moves every module on by `dt_ns` (events go
-    /// out on their links as they become due).
+    /// Moves every module on by `dt_ns` (events go out on their links as
+    /// they become due).
     pub fn advance(&self, dt_ns: u64) {
-        let mut s = self.lock();
-        for n in &mut s.nodes {
-            n.module.advance(dt_ns);
-        }
-        Self::after_change(&mut s);
+        self.with_bus(|bus| bus.advance(dt_ns));
+        self.changed.notify_one();
     }
 
-    /// Runs `f` on the first module, brought up to the current time.
+    /// Runs `f` on the bus, brought up to the clock's now; then carries out
+    /// what changed (EEPROM files, events) and wakes the clock task.
+    pub fn with_bus<R>(&self, f: impl FnOnce(&mut Bus) -> R) -> R {
+        let mut s = self.lock();
+        s.bus.catch_up();
+        let r = f(&mut s.bus);
+        Self::after_change(&mut s);
+        self.update_ascii(&s);
+        drop(s);
+        self.changed.notify_one();
+        r
+    }
+
+    /// Runs `f` on module `index` (in bus order), brought up to now.
+    pub fn with_module<R>(&self, index: usize, f: impl FnOnce(&mut Module) -> R) -> R {
+        self.with_bus(|bus| f(bus.module_mut(index)))
+    }
+
+    /// Runs `f` on the first module.
     pub fn with<R>(&self, f: impl FnOnce(&mut Module) -> R) -> R {
         self.with_module(0, f)
     }
 
-    /// Runs `f` on module `index` (in the order given to the server).
-    pub fn with_module<R>(&self, index: usize, f: impl FnOnce(&mut Module) -> R) -> R {
-        let mut s = self.lock();
-        let now = self.now_ns();
-        for n in &mut s.nodes {
-            n.module.advance_to(now);
-        }
-        let r = f(&mut s.nodes[index].module);
-        Self::after_change(&mut s);
-        r
+    /// Applies a world command to the module at `address` (`None`: the
+    /// first one).
+    pub fn apply_world(&self, address: Option<u8>, command: &WorldCommand) -> Result<String, String> {
+        self.with_bus(|bus| bus.apply_world(address, command))
     }
 
-    /// Handles one frame from link `link`, whose events go to `sink`: every
-    /// module sees it, the addressed one answers. Returns the replies and
-    /// how long to wait before sending them (GP 75 of the module that
-    /// answered, and with wire timing the time the bytes take on the wire).
+    /// Takes the modules out (the bus is left empty), e.g. to put them on
+    /// another bus.
+    pub fn take_modules(&self) -> Vec<Module> {
+        let mut s = self.lock();
+        s.bus.catch_up();
+        Self::after_change(&mut s);
+        s.eeproms.clear();
+        std::mem::replace(&mut s.bus, Bus::new(Vec::new())).into_modules()
+    }
+
+    /// Events of module `index` that no link received (an in-process user
+    /// reads them here).
+    pub fn take_unclaimed_events(&self, index: usize) -> Vec<[u8; FRAME_LEN]> {
+        let mut s = self.lock();
+        let (mine, rest) = std::mem::take(&mut s.unclaimed).into_iter().partition(|(i, _)| *i == index);
+        s.unclaimed = rest;
+        mine.into_iter().map(|(_, e)| e).collect()
+    }
+
+    /// Handles one frame from link `link`, whose events go to `sink`.
+    /// Returns the replies and how long to wait before sending them.
     pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
         self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
-        let now = self.now_ns();
-        let mut replies = Vec::new();
-        let mut delay = Duration::ZERO;
-        for n in &mut s.nodes {
-            // Only the addressed module does anything with a frame; the
-            // others catch up with time when they are next looked at.
-            if !n.module.answers_to(frame[0]) {
-                continue;
-            }
-            n.module.advance_to(now);
-            if let Some(r) = n.module.handle_frame(frame) {
-                replies.push(r);
-                delay = delay.max(Duration::from_nanos(n.module.reply_delay_ns()));
-                if self.wire_timing {
-                    // Request and reply, 10 bits a byte.
-                    let baud = baud_rate(n.module.baud_rate_code()) as u64;
-                    delay += Duration::from_nanos(2 * 9 * 10 * 1_000_000_000 / baud);
-                }
-            }
-        }
+        let answer = s.bus.handle_frame(frame);
+        self.after_request(s, link, sink, !answer.replies.is_empty());
+        (answer.replies, Duration::from_nanos(answer.delay_ns))
+    }
+
+    /// Handles a CAN frame: every module sees it, those it is for answer.
+    pub(crate) fn handle_can(&self, link: u64, sink: &EventSink, frame: &CanFrame) -> Vec<CanFrame> {
+        self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
+        let mut s = self.lock();
+        let replies = s.bus.handle_can(frame);
+        self.after_request(s, link, sink, true);
+        replies
+    }
+
+    /// One byte of text for the modules in ASCII mode; echoes and replies
+    /// are appended to `out`.
+    pub(crate) fn ascii_byte(&self, byte: u8, out: &mut Vec<u8>) {
+        let mut s = self.lock();
+        s.bus.ascii_byte(byte, out);
+        Self::after_change(&mut s);
         self.update_ascii(&s);
-        let has_events = s.nodes.iter().any(|n| n.module.has_events());
-        if (!replies.is_empty() || has_events) && s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
+    }
+
+    /// After a request from `link`: that link receives events from now on
+    /// (if it got an answer or events are waiting), effects are carried
+    /// out, and the clock task is woken if something is due sooner than it
+    /// sleeps for.
+    fn after_request(&self, mut s: std::sync::MutexGuard<'_, State>, link: u64, sink: &EventSink, answered: bool) {
+        self.update_ascii(&s);
+        let has_events = s.bus.modules().iter().any(Module::has_events);
+        if (answered || has_events) && s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
             s.sink = Some((link, sink.clone()));
         }
         Self::after_change(&mut s);
-        // Wake the clock task only when something is due sooner than what
-        // it sleeps for.
-        let due = s.nodes.iter().filter_map(|n| n.module.next_event_ns()).min();
+        let due = s.bus.next_deadline();
         let wake = due.is_some_and(|d| s.scheduled.is_none_or(|sch| d < sch));
         drop(s);
         if wake {
             self.changed.notify_one();
         }
-        (replies, delay)
-    }
-
-    /// Handles a CAN frame: every module sees it, those it is for answer.
-    pub(crate) fn handle_can(
-        &self,
-        link: u64,
-        sink: &EventSink,
-        frame: &tmclsim_firmware::can::CanFrame,
-    ) -> Vec<tmclsim_firmware::can::CanFrame> {
-        let mut s = self.lock();
-        let now = self.now_ns();
-        let mut replies = Vec::new();
-        for n in &mut s.nodes {
-            n.module.advance_to(now);
-            if let Some(r) = n.module.handle_can(frame) {
-                replies.push(r);
-            }
-        }
-        if s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
-            s.sink = Some((link, sink.clone()));
-        }
-        Self::after_change(&mut s);
-        self.update_ascii(&s);
-        drop(s);
-        self.changed.notify_one();
-        replies
     }
 
     /// A 138 event (9-byte form) as the CAN frame of the module it is from.
-    pub(crate) fn event_as_can(&self, event: &[u8; FRAME_LEN]) -> Option<tmclsim_firmware::can::CanFrame> {
+    pub(crate) fn event_as_can(&self, event: &[u8; FRAME_LEN]) -> Option<CanFrame> {
         let s = self.lock();
-        s.nodes.iter().find(|n| n.module.answers_to(event[1])).map(|n| n.module.event_as_can(event))
+        s.bus.index_of(event[1]).map(|i| s.bus.event_as_can(i, event))
     }
 
-    /// The clock task's next wake-up: what is due, remembered so that
-    /// frames know whether to wake it earlier.
-    pub(crate) fn schedule(&self) -> Option<u64> {
+    /// The clock task: brings the bus to now, carries out what became due
+    /// and returns the next deadline, remembered so that requests know
+    /// whether to wake the task earlier.
+    pub(crate) fn tick(&self) -> Option<u64> {
         let mut s = self.lock();
-        let now = self.now_ns();
-        for n in &mut s.nodes {
-            n.module.advance_to(now);
-        }
+        s.bus.catch_up();
         Self::after_change(&mut s);
-        let due = s.nodes.iter().filter_map(|n| n.module.next_event_ns()).min();
+        let due = s.bus.next_deadline();
         s.scheduled = due;
         due
     }
 
-    /// Advances to now and dispatches what became due.
-    pub(crate) fn tick(&self) {
-        let mut s = self.lock();
-        let now = self.now_ns();
-        for n in &mut s.nodes {
-            n.module.advance_to(now);
-        }
-        Self::after_change(&mut s);
-    }
-
-    /// Resolves when a frame changed the modules' plans.
+    /// Resolves when something changed the bus's plans.
     pub(crate) async fn changed(&self) {
         self.changed.notified().await
     }
 
     fn after_change(s: &mut State) {
-        let State { nodes, sink, .. } = s;
-        for n in nodes.iter_mut() {
-            if n.module.has_events() {
-                let events = n.module.take_events();
-                if let Some((_, sink)) = sink {
-                    for e in events {
-                        let _ = sink.send(e);
-                    }
+        let effects = s.bus.take_effects();
+        for (index, event) in effects.events {
+            match &s.sink {
+                Some((_, sink)) => {
+                    let _ = sink.send(event);
                 }
+                None if s.unclaimed.len() < UNCLAIMED_EVENTS => s.unclaimed.push((index, event)),
+                None => {}
             }
-            if n.module.eeprom_generation() != n.saved_generation {
-                if let Some(path) = &n.eeprom
-                    && let Err(e) = save_atomic(path, n.module.eeprom())
-                {
-                    eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
-                }
-                n.saved_generation = n.module.eeprom_generation();
+        }
+        for index in effects.eeprom_written {
+            if let Some(path) = &s.eeproms[index]
+                && let Err(e) = save_atomic(path, s.bus.module(index).eeprom())
+            {
+                eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
             }
         }
     }

@@ -3,7 +3,7 @@
 //! `slcan_tmcl` connection open it like a CANable or a Lawicel CANUSB.
 
 use crate::pty::Pty;
-use crate::shared::SharedModule;
+use crate::shared::SharedBus;
 use std::sync::Arc;
 use tmclsim_firmware::can::CanFrame;
 use tmclsim_protocol::slcan::{self, SlcanCommand};
@@ -13,7 +13,7 @@ use tokio::sync::{mpsc, watch};
 /// Longest command line kept (an extended frame with 8 bytes is 26).
 const MAX_LINE: usize = 64;
 
-pub(crate) async fn run(pty: Pty, module: Arc<SharedModule>, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
     let (master, _slave) = match pty.into_stream() {
         Ok(v) => v,
         Err(e) => {
@@ -67,7 +67,7 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedModule>, mut stop: watch::Re
 
 /// One line from the host; the adapter's answer and any received frames
 /// are appended to `out`.
-fn command(text: &str, open: &mut bool, module: &SharedModule, link: u64, events: &mpsc::UnboundedSender<[u8; 9]>, out: &mut String) {
+fn command(text: &str, open: &mut bool, module: &SharedBus, link: u64, events: &mpsc::UnboundedSender<[u8; 9]>, out: &mut String) {
     const OK: &str = "\r";
     const ERROR: &str = "\x07";
     match slcan::parse(text) {

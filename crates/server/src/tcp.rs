@@ -1,13 +1,13 @@
 //! TCP: every connection is a link of its own to the same module.
 
 use crate::ServerConfig;
-use crate::shared::SharedModule;
+use crate::shared::SharedBus;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use tokio::net::TcpListener;
 use tokio::sync::watch;
 
-pub(crate) async fn run(listener: TcpListener, module: Arc<SharedModule>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
     let open = Arc::new(AtomicUsize::new(0));
     let mut connections = tokio::task::JoinSet::new();
     loop {

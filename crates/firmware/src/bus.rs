@@ -1,0 +1,352 @@
+//! The one thing every front end drives: modules on a link (a single
+//! module is a bus of one) with their [`Clock`].
+//!
+//! Requests go in (9-byte frames, CAN frames, ASCII bytes), replies come
+//! out; time moves with [`Bus::advance_to`], and [`Bus::next_deadline`]
+//! says exactly when something happens next on its own. What a front end
+//! must carry out (EEPROM images to persist, 138 events to send) it takes
+//! with [`Bus::take_effects`]; observers look at [`Bus::snapshot`].
+
+use crate::can::CanFrame;
+use crate::clock::Clock;
+use crate::module::Module;
+use crate::snapshot::ModuleSnapshot;
+use crate::world_command::WorldCommand;
+use tmclsim_protocol::FRAME_LEN;
+
+/// The replies to one frame and when they may go out.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Answer {
+    pub replies: Vec<[u8; FRAME_LEN]>,
+    /// Delay before the replies: GP 75 of the module that answered and,
+    /// with wire timing, the time request and reply take on the wire.
+    pub delay_ns: u64,
+}
+
+/// What a front end must carry out after the bus changed.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Effects {
+    /// Modules (by index) whose EEPROM was written: persist
+    /// `bus.module(i).eeprom()`.
+    pub eeprom_written: Vec<usize>,
+    /// Unsolicited frames (138 events), by module index, in order.
+    pub events: Vec<(usize, [u8; FRAME_LEN])>,
+}
+
+impl Effects {
+    pub fn is_empty(&self) -> bool {
+        self.eeprom_written.is_empty() && self.events.is_empty()
+    }
+}
+
+/// Modules on one link and their clock.
+#[derive(Clone, Debug)]
+pub struct Bus {
+    modules: Vec<Module>,
+    clock: Clock,
+    /// The latest virtual time the bus was brought to. Modules a frame is
+    /// not for may lag behind; they catch up when next looked at.
+    now_ns: u64,
+    /// EEPROM generation of each module when its effects were last taken.
+    saved: Vec<u64>,
+    /// Deliver bytes at the modules' baud rate (GP 65), as a real RS485
+    /// bus does.
+    wire_timing: bool,
+}
+
+impl Bus {
+    /// Modules on one link, brought to one virtual time (the latest of
+    /// theirs), with a stepped clock.
+    pub fn new(mut modules: Vec<Module>) -> Bus {
+        let now_ns = modules.iter().map(Module::now_ns).max().unwrap_or(0);
+        for m in &mut modules {
+            m.advance_to(now_ns);
+        }
+        let saved = modules.iter().map(Module::eeprom_generation).collect();
+        Bus { modules, clock: Clock::Stepped, now_ns, saved, wire_timing: false }
+    }
+
+    /// A bus of one.
+    pub fn single(module: Module) -> Bus {
+        Bus::new(vec![module])
+    }
+
+    pub fn with_wire_timing(mut self, on: bool) -> Bus {
+        self.wire_timing = on;
+        self
+    }
+
+    pub fn clock(&self) -> Clock {
+        self.clock
+    }
+
+    /// Stepped (`true`): time stands still between calls of
+    /// [`Bus::advance`]. `false`: time follows the wall clock from where
+    /// the bus is.
+    pub fn set_stepped(&mut self, stepped: bool) {
+        if stepped {
+            self.catch_up();
+            self.clock = Clock::Stepped;
+        } else if self.clock.is_stepped() {
+            self.clock = Clock::wall_from(self.now_ns);
+        }
+    }
+
+    /// Virtual time now, by the clock.
+    pub fn now_ns(&self) -> u64 {
+        self.clock.now_ns(self.now_ns)
+    }
+
+    /// Brings every module to the clock's now.
+    pub fn catch_up(&mut self) {
+        let now = self.now_ns();
+        self.advance_to(now);
+    }
+
+    /// Moves every module to virtual time `t_ns` (no-op for the past).
+    pub fn advance_to(&mut self, t_ns: u64) {
+        for m in &mut self.modules {
+            m.advance_to(t_ns);
+        }
+        self.now_ns = self.now_ns.max(t_ns);
+    }
+
+    /// Moves the bus on by `dt_ns`. With a wall clock, the clock is moved
+    /// on with it.
+    pub fn advance(&mut self, dt_ns: u64) {
+        let t = self.now_ns().saturating_add(dt_ns);
+        self.advance_to(t);
+        if !self.clock.is_stepped() {
+            self.clock = Clock::wall_from(self.now_ns);
+        }
+    }
+
+    /// The next virtual time at which something happens on its own on any
+    /// module (`None`: nothing until a request comes).
+    pub fn next_deadline(&self) -> Option<u64> {
+        self.modules.iter().filter_map(Module::next_event_ns).min()
+    }
+
+    /// One 9-byte frame on the link: every module sees it, the addressed
+    /// one answers.
+    pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Answer {
+        let now = self.now_ns();
+        self.now_ns = now;
+        let mut answer = Answer::default();
+        for m in &mut self.modules {
+            // Only the addressed module does anything with a frame; the
+            // others catch up when they are next looked at.
+            if !m.answers_to(frame[0]) {
+                continue;
+            }
+            m.advance_to(now);
+            if let Some(r) = m.handle_frame(frame) {
+                answer.replies.push(r);
+                answer.delay_ns = answer.delay_ns.max(m.reply_delay_ns());
+                if self.wire_timing {
+                    // Request and reply, 10 bits a byte.
+                    answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / baud_rate(m) as u64;
+                }
+            }
+        }
+        answer
+    }
+
+    /// One CAN frame on the bus: every module sees it, those it is for
+    /// answer.
+    pub fn handle_can(&mut self, frame: &CanFrame) -> Vec<CanFrame> {
+        self.catch_up();
+        self.modules.iter_mut().filter_map(|m| m.handle_can(frame)).collect()
+    }
+
+    /// Some module reads text (ASCII mode).
+    pub fn ascii_active(&self) -> bool {
+        self.modules.iter().any(Module::ascii_mode)
+    }
+
+    /// One byte of text for the modules in ASCII mode; echoes and replies
+    /// are appended to `out`.
+    pub fn ascii_byte(&mut self, byte: u8, out: &mut Vec<u8>) {
+        self.catch_up();
+        for m in &mut self.modules {
+            if m.ascii_mode() {
+                m.ascii_byte(byte, out);
+            }
+        }
+    }
+
+    /// A 138 event of module `index` as its CAN frame.
+    pub fn event_as_can(&self, index: usize, event: &[u8; FRAME_LEN]) -> CanFrame {
+        self.modules[index].event_as_can(event)
+    }
+
+    /// What the front end must carry out since the last call.
+    pub fn take_effects(&mut self) -> Effects {
+        let mut effects = Effects::default();
+        for (i, m) in self.modules.iter_mut().enumerate() {
+            if m.has_events() {
+                effects.events.extend(m.take_events().into_iter().map(|e| (i, e)));
+            }
+            if m.eeprom_generation() != self.saved[i] {
+                self.saved[i] = m.eeprom_generation();
+                effects.eeprom_written.push(i);
+            }
+        }
+        effects
+    }
+
+    pub fn len(&self) -> usize {
+        self.modules.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.modules.is_empty()
+    }
+
+    pub fn modules(&self) -> &[Module] {
+        &self.modules
+    }
+
+    pub fn module(&self, index: usize) -> &Module {
+        &self.modules[index]
+    }
+
+    /// Module `index`, for changes a front end makes outside the protocol
+    /// (programs, parameters by name, the world).
+    pub fn module_mut(&mut self, index: usize) -> &mut Module {
+        &mut self.modules[index]
+    }
+
+    /// The index of the module that answers to `address` now.
+    pub fn index_of(&self, address: u8) -> Option<usize> {
+        self.modules.iter().position(|m| m.answers_to(address))
+    }
+
+    /// Replaces module `index` (a module swapped in keeps the bus's time).
+    pub fn replace(&mut self, index: usize, mut module: Module) -> Module {
+        module.advance_to(self.now_ns);
+        self.saved[index] = module.eeprom_generation();
+        std::mem::replace(&mut self.modules[index], module)
+    }
+
+    /// Takes the modules out of the bus.
+    pub fn into_modules(self) -> Vec<Module> {
+        self.modules
+    }
+
+    /// Applies a world command to the module at `address` (`None`: the
+    /// first module), at the clock's now.
+    pub fn apply_world(&mut self, address: Option<u8>, command: &WorldCommand) -> Result<String, String> {
+        let index = match address {
+            None => 0,
+            Some(a) => self.index_of(a).ok_or_else(|| format!("no module on the bus answers to address {a}"))?,
+        };
+        self.catch_up();
+        command.apply(&mut self.modules[index])
+    }
+
+    /// A picture of every module, in bus order.
+    pub fn snapshot(&self) -> Vec<ModuleSnapshot> {
+        self.modules.iter().map(ModuleSnapshot::of).collect()
+    }
+}
+
+/// Bits per second of a module's link (GP 65).
+fn baud_rate(m: &Module) -> u32 {
+    match m.baud_rate_code() {
+        1 => 14_400,
+        2 => 19_200,
+        3 => 28_800,
+        4 => 38_400,
+        5 => 57_600,
+        6 => 76_800,
+        7 => 115_200,
+        8 => 230_400,
+        _ => 9_600,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tmclsim_protocol::{Instruction, Reply, Request, Status};
+
+    fn module(address: u8) -> Module {
+        let mut m = Module::built_in("tmcm-1141").unwrap();
+        m.set_address(address);
+        m
+    }
+
+    fn frame(address: u8, op: u8, kind: u8, value: i32) -> [u8; FRAME_LEN] {
+        Request::new(address, Instruction::new(op, kind, 0, value)).encode()
+    }
+
+    #[test]
+    fn only_the_addressed_module_answers() {
+        let mut bus = Bus::new(vec![module(1), module(2)]);
+        let a = bus.handle_frame(&frame(2, 6, 1, 0));
+        assert_eq!(a.replies.len(), 1);
+        let r = Reply::decode(&a.replies[0]).unwrap();
+        assert_eq!((r.module, r.status), (2, Status::Ok.code()));
+        assert!(bus.handle_frame(&frame(3, 6, 1, 0)).replies.is_empty());
+        assert_eq!(bus.index_of(2), Some(1));
+    }
+
+    #[test]
+    fn modules_are_brought_to_one_time() {
+        let mut late = module(2);
+        late.advance(5_000_000);
+        let bus = Bus::new(vec![module(1), late]);
+        assert!(bus.modules().iter().all(|m| m.now_ns() == 5_000_000));
+        assert_eq!(bus.now_ns(), 5_000_000);
+    }
+
+    #[test]
+    fn a_stepped_bus_moves_only_when_advanced() {
+        let mut bus = Bus::single(module(1));
+        assert!(bus.clock().is_stepped());
+        bus.handle_frame(&frame(1, 1, 0, 1000)); // ROR 0, 1000
+        let before = bus.snapshot()[0].axes[0].speed;
+        bus.catch_up();
+        assert_eq!(bus.now_ns(), 0);
+        bus.advance(100_000_000);
+        assert_eq!(bus.now_ns(), 100_000_000);
+        let after = bus.snapshot()[0].axes[0].clone();
+        assert!(after.speed > before && after.position > 0, "{after:?}");
+    }
+
+    #[test]
+    fn eeprom_writes_and_events_are_effects() {
+        let mut bus = Bus::new(vec![module(1), module(2)]);
+        assert!(bus.take_effects().is_empty());
+        bus.handle_frame(&frame(2, 7, 4, 0)); // STAP 4, 0 on module 2
+        assert_eq!(bus.take_effects().eeprom_written, vec![1]);
+        assert!(bus.take_effects().is_empty(), "taken once");
+        // 138 on the next MVP of motor 0, then the move.
+        bus.handle_frame(&frame(1, 138, 0, 1));
+        bus.handle_frame(&frame(1, 4, 0, 1000));
+        let due = bus.next_deadline().expect("the event is due");
+        bus.advance_to(due);
+        let effects = bus.take_effects();
+        assert_eq!(effects.events.len(), 1);
+        assert_eq!(effects.events[0].0, 0);
+        assert_eq!(effects.events[0].1[2], 128);
+    }
+
+    #[test]
+    fn world_commands_reach_the_module_by_address() {
+        let mut bus = Bus::new(vec![module(1), module(2)]);
+        bus.apply_world(Some(2), &WorldCommand::Input { number: 0, high: true }).unwrap();
+        assert!(!bus.module(0).world().digital(0));
+        assert!(bus.module(1).world().digital(0));
+        assert_eq!(bus.snapshot()[1].io.inputs & 1, 1);
+        assert_eq!(bus.apply_world(Some(9), &WorldCommand::Show { axis: None }).unwrap_err(), "no module on the bus answers to address 9");
+    }
+
+    #[test]
+    fn wire_timing_adds_the_bytes_time() {
+        let mut bus = Bus::single(module(1)).with_wire_timing(true);
+        // 9600 baud (GP 65 = 0): 180 bits.
+        assert_eq!(bus.handle_frame(&frame(1, 6, 1, 0)).delay_ns, 18_750_000);
+    }
+}

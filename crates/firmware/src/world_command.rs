@@ -1,0 +1,340 @@
+//! Typed commands that change (or show) the world around a module, and
+//! their text form: the control protocol of docs/world.md. Every front end
+//! (control socket, `tmclsim world`, Python) parses a line into a
+//! [`WorldCommand`] and applies it through [`Bus::apply_world`]
+//! (crate::bus::Bus::apply_world).
+
+use crate::module::Module;
+use crate::world::Load;
+
+pub const HELP: &str = "commands: [@ADDRESS] input N 0|1 | analog N VALUE | supply VOLTS | temperature CELSIUS | \
+switch AXIS left|right|home press|release|auto | place AXIS left|right POSITION [WIDTH] | place AXIS home FROM TO | \
+travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \
+link drop N | link corrupt N | link delay MS | link mute on|off | link clear | show [AXIS] | help";
+
+/// One of the three switches of an axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SwitchKind {
+    Left,
+    Right,
+    Home,
+}
+
+/// One of the driver's coil faults.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CoilFault {
+    ShortA,
+    ShortB,
+    OpenA,
+    OpenB,
+}
+
+/// A change of the world (or a look at it).
+#[derive(Clone, Debug, PartialEq)]
+pub enum WorldCommand {
+    /// Drives a digital input high or low.
+    Input {
+        number: u8,
+        high: bool,
+    },
+    /// Sets an ADC reading (0…4095).
+    Analog {
+        number: u8,
+        value: u16,
+    },
+    /// Supply voltage in volts.
+    Supply {
+        volts: f64,
+    },
+    Temperature {
+        celsius: f64,
+    },
+    /// Forces a switch pressed (`Some(true)`), released, or back to what
+    /// the carriage position says (`None`).
+    Switch {
+        axis: usize,
+        which: SwitchKind,
+        pressed: Option<bool>,
+    },
+    /// Places a stop switch at a position (with an optional width).
+    PlaceStop {
+        axis: usize,
+        which: SwitchKind,
+        position: f64,
+        width: Option<f64>,
+    },
+    /// Places the home switch between two positions.
+    PlaceHome {
+        axis: usize,
+        from: f64,
+        to: f64,
+    },
+    /// Mechanical end stops of the axis.
+    Travel {
+        axis: usize,
+        from: f64,
+        to: f64,
+    },
+    /// A load torque (% of rated) everywhere or between two positions; 0
+    /// removes the loads.
+    Load {
+        axis: usize,
+        torque: f64,
+        from: Option<f64>,
+        to: Option<f64>,
+    },
+    Fault {
+        axis: usize,
+        which: CoilFault,
+        on: bool,
+    },
+    /// Positions and switches of one axis or all.
+    Show {
+        axis: Option<usize>,
+    },
+}
+
+/// A parsed control line: which module it is for (`@ADDRESS`, `None`: the
+/// first one) and what to do.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Addressed {
+    pub address: Option<u8>,
+    pub command: WorldCommand,
+}
+
+fn num<T: std::str::FromStr>(w: Option<&str>, what: &str) -> Result<T, String> {
+    let w = w.ok_or_else(|| format!("{what} is missing"))?;
+    w.parse().map_err(|_| format!("'{w}' is not a valid {what}"))
+}
+
+fn optional(w: Option<&str>) -> Result<Option<f64>, String> {
+    w.map(|x| x.parse().map_err(|_| format!("'{x}' is not a number"))).transpose()
+}
+
+pub fn on_off(w: Option<&str>) -> Result<bool, String> {
+    match w {
+        Some("on") | Some("1") => Ok(true),
+        Some("off") | Some("0") => Ok(false),
+        other => Err(format!("expected on or off, found {}", other.unwrap_or("nothing"))),
+    }
+}
+
+fn switch_kind(w: Option<&str>) -> Result<SwitchKind, String> {
+    match w {
+        Some("left") => Ok(SwitchKind::Left),
+        Some("right") => Ok(SwitchKind::Right),
+        Some("home") => Ok(SwitchKind::Home),
+        other => Err(format!("expected left, right or home, found {}", other.unwrap_or("nothing"))),
+    }
+}
+
+impl WorldCommand {
+    /// Parses the words of a control line (without `@ADDRESS`; `link` and
+    /// `help` belong to the link, not the world).
+    pub fn parse(words: &[&str]) -> Result<WorldCommand, String> {
+        let mut w = words.iter().copied();
+        let cmd = w.next().ok_or("empty command")?;
+        Ok(match cmd {
+            "input" => {
+                let number = num(w.next(), "input number")?;
+                let level: u8 = num(w.next(), "level")?;
+                WorldCommand::Input { number, high: level != 0 }
+            }
+            "analog" => {
+                let number = num(w.next(), "input number")?;
+                let value: u16 = num(w.next(), "value")?;
+                if value > 4095 {
+                    return Err(format!("{value} is above 4095"));
+                }
+                WorldCommand::Analog { number, value }
+            }
+            "supply" => WorldCommand::Supply { volts: num(w.next(), "voltage")? },
+            "temperature" => WorldCommand::Temperature { celsius: num(w.next(), "temperature")? },
+            "switch" => {
+                let axis = num(w.next(), "axis")?;
+                let which = switch_kind(w.next())?;
+                let pressed = match w.next() {
+                    Some("press") => Some(true),
+                    Some("release") => Some(false),
+                    Some("auto") => None,
+                    other => return Err(format!("expected press, release or auto, found {}", other.unwrap_or("nothing"))),
+                };
+                WorldCommand::Switch { axis, which, pressed }
+            }
+            "place" => {
+                let axis = num(w.next(), "axis")?;
+                let which = switch_kind(w.next())?;
+                let position = num(w.next(), "position")?;
+                let rest = optional(w.next())?;
+                match which {
+                    SwitchKind::Home => WorldCommand::PlaceHome { axis, from: position, to: rest.ok_or("place home takes FROM and TO")? },
+                    _ => WorldCommand::PlaceStop { axis, which, position, width: rest },
+                }
+            }
+            "travel" => {
+                WorldCommand::Travel { axis: num(w.next(), "axis")?, from: num(w.next(), "position")?, to: num(w.next(), "position")? }
+            }
+            "load" => {
+                let axis = num(w.next(), "axis")?;
+                let torque = num(w.next(), "torque in %")?;
+                WorldCommand::Load { axis, torque, from: optional(w.next())?, to: optional(w.next())? }
+            }
+            "fault" => {
+                let axis = num(w.next(), "axis")?;
+                let which = match w.next() {
+                    Some("short-a") => CoilFault::ShortA,
+                    Some("short-b") => CoilFault::ShortB,
+                    Some("open-a") => CoilFault::OpenA,
+                    Some("open-b") => CoilFault::OpenB,
+                    other => return Err(format!("expected short-a, short-b, open-a or open-b, found {}", other.unwrap_or("nothing"))),
+                };
+                WorldCommand::Fault { axis, which, on: on_off(w.next())? }
+            }
+            "show" => WorldCommand::Show { axis: w.next().map(|a| num(Some(a), "axis")).transpose()? },
+            other => return Err(format!("unknown command '{other}' ({HELP})")),
+        })
+    }
+
+    /// The axis the command names, if any.
+    pub fn axis(&self) -> Option<usize> {
+        match *self {
+            WorldCommand::Switch { axis, .. }
+            | WorldCommand::PlaceStop { axis, .. }
+            | WorldCommand::PlaceHome { axis, .. }
+            | WorldCommand::Travel { axis, .. }
+            | WorldCommand::Load { axis, .. }
+            | WorldCommand::Fault { axis, .. } => Some(axis),
+            WorldCommand::Show { axis } => axis,
+            _ => None,
+        }
+    }
+
+    /// Applies the command to a module; `Ok` carries what to print after
+    /// `ok` (only `show` prints something).
+    pub fn apply(&self, m: &mut Module) -> Result<String, String> {
+        let axes = m.profile().module.axes as usize;
+        if let Some(a) = self.axis()
+            && a >= axes
+        {
+            return Err(format!("axis {a} does not exist (the module has {axes})"));
+        }
+        let world = m.world_mut();
+        match *self {
+            WorldCommand::Input { number, high } => world.set_digital(number, high),
+            WorldCommand::Analog { number, value } => world.set_analog(number, value),
+            WorldCommand::Supply { volts } => world.supply_decivolts = (volts * 10.0).round().clamp(0.0, 1000.0) as u16,
+            WorldCommand::Temperature { celsius } => world.temperature = celsius,
+            WorldCommand::Switch { axis, which, pressed } => {
+                let wa = &mut world.axes[axis];
+                match which {
+                    SwitchKind::Left => wa.forced_left = pressed,
+                    SwitchKind::Right => wa.forced_right = pressed,
+                    SwitchKind::Home => wa.forced_home = pressed,
+                }
+            }
+            WorldCommand::PlaceStop { axis, which, position, width } => {
+                let wa = &mut world.axes[axis];
+                match which {
+                    SwitchKind::Left => (wa.left_switch, wa.left_width) = (Some(position), width),
+                    _ => (wa.right_switch, wa.right_width) = (Some(position), width),
+                }
+            }
+            WorldCommand::PlaceHome { axis, from, to } => world.axes[axis].home_switch = Some((from, to)),
+            WorldCommand::Travel { axis, from, to } => world.axes[axis].travel = Some((from, to)),
+            WorldCommand::Load { axis, torque, from, to } => {
+                let loads = &mut world.axes[axis].loads;
+                loads.clear();
+                if torque > 0.0 {
+                    loads.push(Load { torque, from, to, ..Load::default() });
+                }
+            }
+            WorldCommand::Fault { axis, which, on } => {
+                let f = &mut world.axes[axis].faults;
+                match which {
+                    CoilFault::ShortA => f.short_a = on,
+                    CoilFault::ShortB => f.short_b = on,
+                    CoilFault::OpenA => f.open_a = on,
+                    CoilFault::OpenB => f.open_b = on,
+                }
+            }
+            WorldCommand::Show { axis } => {
+                let list: Vec<usize> = axis.map_or_else(|| (0..axes).collect(), |a| vec![a]);
+                let mut out = format!("time {:.3} s", m.now_ns() as f64 * 1e-9);
+                for a in list {
+                    let (l, r, h) = m.switches(a);
+                    out.push_str(&format!(
+                        "; axis {a}: position {} carriage {:.1} speed {} left {} right {} home {}",
+                        m.actual_position(a),
+                        m.mechanical_position(a),
+                        m.actual_speed(a),
+                        l as u8,
+                        r as u8,
+                        h as u8
+                    ));
+                }
+                return Ok(out);
+            }
+        }
+        Ok(String::new())
+    }
+}
+
+impl Addressed {
+    /// Parses `[@ADDRESS] COMMAND …`.
+    pub fn parse(line: &str) -> Result<Addressed, String> {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let (address, rest) = match words.first().and_then(|w| w.strip_prefix('@')) {
+            Some(a) => (Some(a.parse().map_err(|_| format!("'@{a}' is not a module address (0…255)"))?), &words[1..]),
+            None => (None, &words[..]),
+        };
+        Ok(Addressed { address, command: WorldCommand::parse(rest)? })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_parse_into_typed_commands() {
+        assert_eq!(
+            Addressed::parse("input 2 1").unwrap(),
+            Addressed { address: None, command: WorldCommand::Input { number: 2, high: true } }
+        );
+        assert_eq!(
+            Addressed::parse("@3 load 1 50 10 20").unwrap(),
+            Addressed { address: Some(3), command: WorldCommand::Load { axis: 1, torque: 50.0, from: Some(10.0), to: Some(20.0) } }
+        );
+        assert_eq!(
+            WorldCommand::parse(&["place", "0", "home", "5", "9"]).unwrap(),
+            WorldCommand::PlaceHome { axis: 0, from: 5.0, to: 9.0 }
+        );
+        assert_eq!(WorldCommand::parse(&["show"]).unwrap(), WorldCommand::Show { axis: None });
+    }
+
+    #[test]
+    fn bad_lines_say_what_is_wrong() {
+        assert_eq!(WorldCommand::parse(&["analog", "0", "5000"]).unwrap_err(), "5000 is above 4095");
+        assert_eq!(WorldCommand::parse(&["switch", "0", "middle", "press"]).unwrap_err(), "expected left, right or home, found middle");
+        assert_eq!(WorldCommand::parse(&["place", "0", "home", "5"]).unwrap_err(), "place home takes FROM and TO");
+        assert_eq!(Addressed::parse("@x input 0 1").unwrap_err(), "'@x' is not a module address (0…255)");
+        assert!(WorldCommand::parse(&["fly"]).unwrap_err().starts_with("unknown command 'fly'"));
+    }
+
+    #[test]
+    fn commands_change_the_world_and_check_the_axis() {
+        let mut m = Module::built_in("tmcm-1141").unwrap();
+        WorldCommand::Input { number: 1, high: true }.apply(&mut m).unwrap();
+        assert!(m.world().digital(1));
+        WorldCommand::Supply { volts: 12.3 }.apply(&mut m).unwrap();
+        assert_eq!(m.world().supply_decivolts, 123);
+        assert_eq!(
+            WorldCommand::Travel { axis: 1, from: 0.0, to: 1.0 }.apply(&mut m).unwrap_err(),
+            "axis 1 does not exist (the module has 1)"
+        );
+        WorldCommand::Switch { axis: 0, which: SwitchKind::Left, pressed: Some(true) }.apply(&mut m).unwrap();
+        assert_eq!(m.switches(0), (true, false, false));
+        let shown = WorldCommand::Show { axis: None }.apply(&mut m).unwrap();
+        assert!(shown.contains("axis 0: position 0") && shown.contains("left 1"), "{shown}");
+    }
+}
