@@ -1,13 +1,14 @@
 //! The manual's example programs, assembled and run on the virtual
 //! TMCM-1141: they do what the manual says they do.
 
+mod common;
+
+use common::{MS, send};
 use std::path::Path;
 use tmclsim_asm::assemble_file;
 use tmclsim_firmware::{Module, Profile};
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
-
-const MS: u64 = 1_000_000;
 
 fn load(name: &str) -> (Module, tmclsim_asm::Program) {
     let profile = Profile::built_in("tmcm-1141").unwrap();
@@ -16,13 +17,6 @@ fn load(name: &str) -> (Module, tmclsim_asm::Program) {
     let mut m = Module::new(profile);
     m.load_program(&program.instructions).unwrap();
     (m, program)
-}
-
-fn send(m: &mut Module, line: &str) -> i32 {
-    let f = Request::new(1, parse_line(line).unwrap()).encode();
-    let r = Reply::decode(&m.handle_frame(&f).unwrap()).unwrap();
-    assert_eq!(r.status, 100, "{line}");
-    r.value
 }
 
 #[test]

@@ -6,23 +6,16 @@
 
 mod common;
 
-use std::io::{Read, Write};
+use common::ask;
+
 use std::net::TcpStream;
 use std::process::{Child, Stdio};
 use std::time::Duration;
 use tmclsim_firmware::Eeprom;
-use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Instruction, Reply, Request};
+use tmclsim_protocol::Instruction;
 
 fn spawn(eeprom: &std::path::Path) -> (Child, String) {
     common::serve(&["--eeprom", eeprom.to_str().unwrap()], Stdio::null())
-}
-
-fn ask(s: &mut TcpStream, line: &str) -> Option<Reply> {
-    s.write_all(&Request::new(1, parse_line(line).unwrap()).encode()).ok()?;
-    let mut buf = [0u8; 9];
-    s.read_exact(&mut buf).ok()?;
-    Reply::decode(&buf)
 }
 
 /// One EEPROM cell under test: what was last acknowledged and what was

@@ -9,8 +9,7 @@ use std::net::TcpStream;
 use std::process::{Child, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
-use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
+use tmclsim_protocol::Reply;
 
 struct Server {
     child: Child,
@@ -40,7 +39,7 @@ impl Server {
         let mut s = TcpStream::connect(&self.addr).unwrap();
         s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
         for (line, expect) in [("SAP 4, 0, 1234", 1234), ("GAP 4, 0", 1234), ("GGP 66, 0", 1)] {
-            s.write_all(&Request::new(1, parse_line(line).unwrap()).encode()).unwrap();
+            s.write_all(&common::frame(line)).unwrap();
             let mut b = [0u8; 9];
             s.read_exact(&mut b).unwrap();
             let r = Reply::decode(&b).unwrap();
@@ -178,7 +177,7 @@ fn half_open_and_half_closed_connections() {
     // gets the reply.
     let mut s = TcpStream::connect(&server.addr).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-    s.write_all(&Request::new(1, parse_line("GAP 4, 0").unwrap()).encode()).unwrap();
+    s.write_all(&common::frame("GAP 4, 0")).unwrap();
     s.shutdown(std::net::Shutdown::Write).unwrap();
     let mut b = [0u8; 9];
     s.read_exact(&mut b).unwrap();

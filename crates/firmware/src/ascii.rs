@@ -10,21 +10,15 @@
 //! none (10). Only the commands the module permits in ASCII mode run;
 //! `RUN` and `STOP` start and stop the TMCL program.
 
-use crate::module::{Module, gp};
+use crate::module::Module;
+use crate::parameter_numbers::gp;
 use tmclsim_protocol::{Instruction, Status, mnemonic};
 
-/// Longest line kept; the rest of a longer line is dropped.
-const MAX_LINE: usize = 128;
+pub use crate::state::link::AsciiLine;
 
 const CR: u8 = b'\r';
 const BACKSPACE: u8 = 0x08;
 const DELETE: u8 = 0x7F;
-
-/// The line being typed.
-#[derive(Clone, Debug, Default)]
-pub struct AsciiLine {
-    buf: Vec<u8>,
-}
 
 /// The character that stands for an address (`A` = 1).
 pub fn address_char(address: u8) -> u8 {
@@ -34,12 +28,12 @@ pub fn address_char(address: u8) -> u8 {
 impl Module {
     /// The module reads text (ASCII mode) rather than 9-byte frames.
     pub fn ascii_mode(&self) -> bool {
-        self.ascii
+        self.link.ascii
     }
 
     pub(crate) fn enter_ascii_mode(&mut self) {
-        self.ascii = true;
-        self.ascii_line.buf.clear();
+        self.link.ascii = true;
+        self.link.ascii_line.clear();
     }
 
     fn echo_mode(&self) -> i32 {
@@ -56,7 +50,7 @@ impl Module {
         };
         match byte {
             CR => {
-                let line = std::mem::take(&mut self.ascii_line.buf);
+                let line = self.link.ascii_line.take();
                 if !addressed(self, &line) {
                     return;
                 }
@@ -68,8 +62,7 @@ impl Module {
                     }
                     _ => {}
                 }
-                self.last_frame_ns = self.now_ns;
-                self.heartbeat_tripped = false;
+                self.link.restart_heartbeat(self.now_ns);
                 let text = String::from_utf8_lossy(&line[1..]).into_owned();
                 let (status, value) = self.ascii_command(text.trim());
                 if let Some((status, value)) = status.zip(value) {
@@ -79,19 +72,17 @@ impl Module {
             }
             b'\n' | 0 => {}
             BACKSPACE | DELETE => {
-                if self.ascii_line.buf.len() > 1 && self.echo_mode() == 0 && addressed(self, &self.ascii_line.buf) {
+                let line = &self.link.ascii_line;
+                if line.len() > 1 && self.echo_mode() == 0 && addressed(self, line.bytes()) {
                     out.push(BACKSPACE);
                 }
-                if self.ascii_line.buf.len() > 1 || !addressed(self, &self.ascii_line.buf) {
-                    self.ascii_line.buf.pop();
+                if line.len() > 1 || !addressed(self, line.bytes()) {
+                    self.link.ascii_line.pop();
                 }
             }
             _ => {
-                if self.ascii_line.buf.len() < MAX_LINE {
-                    self.ascii_line.buf.push(byte);
-                    if self.echo_mode() == 0 && addressed(self, &self.ascii_line.buf) {
-                        out.push(byte);
-                    }
+                if self.link.ascii_line.push(byte) && self.echo_mode() == 0 && addressed(self, self.link.ascii_line.bytes()) {
+                    out.push(byte);
                 }
             }
         }
@@ -103,7 +94,7 @@ impl Module {
         match text.to_ascii_uppercase().as_str() {
             "" => return (None, None),
             "BIN" => {
-                self.ascii = false;
+                self.link.ascii = false;
                 return (Some(Status::Ok), Some(0));
             }
             "RUN" => {

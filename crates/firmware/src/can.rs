@@ -10,7 +10,9 @@
 //! GP 70 reply ID) use them; the others use their serial address (GP 66,
 //! GP 87) and the host address (GP 76).
 
-use crate::module::{Module, Special, gp};
+use crate::module::Module;
+use crate::outcome::Special;
+use crate::parameter_numbers::gp;
 use tmclsim_protocol::{Instruction, Status, opcode};
 
 /// A CAN frame: 11-bit identifier and up to 8 data bytes.
@@ -64,8 +66,7 @@ impl Module {
         if frame.len < 7 {
             return None;
         }
-        self.last_frame_ns = self.now_ns;
-        self.heartbeat_tripped = false;
+        self.link.restart_heartbeat(self.now_ns);
         let d = frame.data;
         let ins = Instruction::new(d[0], d[1], d[2], i32::from_be_bytes([d[3], d[4], d[5], d[6]]));
         let outcome =

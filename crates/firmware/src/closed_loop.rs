@@ -20,9 +20,11 @@
 //! - Torque mode (SAP 14, mA): the driver sets that current; the motor runs
 //!   at the speed where its torque equals the load.
 
-use crate::module::{Module, ap, error_flag};
+use crate::module::Module;
 use crate::motion::{self, RampMode};
+use crate::parameter_numbers::ap;
 use crate::program::Source;
+use crate::state::registers::error_flag;
 
 /// Current scale reserve above what the load needs (%).
 pub const RESERVE_PERCENT: f64 = 20.0;
@@ -53,26 +55,7 @@ pub mod cl {
     pub const POSITION_ERROR: u8 = 237;
 }
 
-/// Per-axis closed-loop state.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ClosedLoop {
-    /// Mechanical offset at which rotor and virtual position agree.
-    pub sync_offset: f64,
-    /// Current scale in effect, %.
-    pub scale: f64,
-    /// Torque mode is selected (SAP 14).
-    pub torque_mode: bool,
-    /// Encoder count at power-up (incremental encoders count from there).
-    pub encoder_zero: f64,
-    /// Last count the encoder delivered (frozen while its signal is lost).
-    pub encoder_last: f64,
-    /// Added by SAP 209.
-    pub encoder_offset: f64,
-    /// A deviation was reported and has not gone away yet.
-    pub deviation_reported: bool,
-    /// The rotor's velocity in µsteps/s over the last step.
-    pub rotor_velocity: f64,
-}
+pub use crate::state::axis::ClosedLoop;
 
 impl Module {
     /// The module can run in closed loop (features `closed_loop`).

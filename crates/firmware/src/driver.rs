@@ -17,9 +17,11 @@
 //!   stop, the motor loses steps: the position counter goes on, the
 //!   carriage does not.
 
-use crate::module::{Module, ap, error_flag};
-use crate::profile::StallDetection;
+use crate::module::Module;
+use crate::parameter_numbers::ap;
 use crate::program::Source;
+use crate::state::registers::error_flag;
+use tmclsim_profile::StallDetection;
 
 /// Full steps per second at which the motor has no torque left.
 pub const CORNER_FULLSTEPS: f64 = 2000.0;
@@ -34,16 +36,7 @@ pub const PRESCALER_UNIT: f64 = 10730.0;
 /// No step for 2^20 clocks of 16 MHz: the standstill flag.
 pub const STANDSTILL_NS: u64 = 65_536_000;
 
-/// Per-axis driver state.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Driver {
-    /// Last stallGuard2 reading, 0…1023.
-    pub load_value: i32,
-    /// coolStep's current scale (0…31), while coolStep regulates.
-    pub cool_scale: Option<f64>,
-    /// Measurements towards the next coolStep decrement.
-    pub down_count: f64,
-}
+pub use crate::state::axis::Driver;
 
 impl Module {
     /// The driver is switched off (no torque).
@@ -73,31 +66,6 @@ impl Module {
         let counts = self.mechanical_position(m) / microsteps_per_rev * counts_per_rev;
         let factor = self.axes[m].params[ap::ENCODER_PRESCALER as usize] as f64 / PRESCALER_UNIT;
         ((counts * factor).round() as i64 + self.axes[m].encoder_offset) as i32
-    }
-
-    /// Some moving axis has something the driver must look at often: a
-    /// load, stall detection, coolStep, an encoder deviation limit, or a
-    /// driver that is off.
-    pub(crate) fn driver_watches(&self) -> bool {
-        (0..self.axes.len()).any(|m| {
-            let axis = &self.axes[m];
-            let p = &axis.params;
-            let f = &self.profile.features;
-            let will_move = axis.motion.v != 0.0
-                || match axis.motion.mode {
-                    crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
-                    _ => axis.motion.x != axis.motion.target,
-                };
-            let closed_loop = self.has_closed_loop() && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6);
-            closed_loop
-                || will_move
-                    && (!self.world.axes[m].loads.is_empty()
-                        || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
-                        || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
-                        || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
-                        || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
-                        || self.driver_off(m))
-        })
     }
 
     /// AP 208.
@@ -247,5 +215,35 @@ impl Module {
     fn stop_now(&mut self, m: usize) {
         self.motor_stop(m);
         self.axes[m].motion.v = 0.0;
+    }
+
+    /// The current setting in effect (0…255): run, boost, standby or off.
+    pub fn motor_current(&self, m: usize) -> u32 {
+        let axis = &self.axes[m];
+        let p = &axis.params;
+        let run = p[ap::MAX_CURRENT as usize].clamp(0, 255) as u32;
+        if axis.motion.v != 0.0 {
+            let slow = p[ap::SMART_ENERGY_SLOW_RUN_CURRENT as usize].clamp(0, 255) as u32;
+            if p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0
+                && slow > 0
+                && self.actual_speed(m).abs() < p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize]
+            {
+                return slow;
+            }
+            let boost = p[ap::BOOST_CURRENT as usize].clamp(0, 255) as u32;
+            return if axis.motion.a != 0.0 && boost > 0 { boost } else { run };
+        }
+        let standby = p[ap::STANDBY_CURRENT as usize].clamp(0, 255) as u32;
+        if axis.motion.stopped_by_switch && p[ap::END_SWITCH_POWER_DOWN as usize] == 1 {
+            return standby;
+        }
+        let Some(since) = axis.standstill_since else { return run };
+        let still_ms = (self.now_ns.saturating_sub(since)) / 1_000_000;
+        let freewheel = p[ap::FREEWHEELING as usize].max(0) as u64 * 10;
+        if freewheel > 0 && still_ms >= freewheel {
+            return 0;
+        }
+        let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * 10;
+        if still_ms >= delay { standby } else { run }
     }
 }

@@ -1,137 +1,19 @@
-//! The TMCL program interpreter: one instruction at a time, in virtual
-//! time, with WAIT, subroutines and interrupts; and the control commands
-//! (128–135) that load, start, step and inspect programs.
+//! The TMCL program interpreter: one instruction at a time, with jumps,
+//! WAIT, subroutines and interrupts; and the debugger's controls
+//! (breakpoints, single steps, the trace). The control commands 128–135
+//! are in `commands/program_control.rs`, the interpreter's clock in
+//! `time.rs`.
 
-use crate::module::{Compare, Module, Origin, Outcome, Special, error_flag, gp};
+use crate::module::Module;
+use crate::outcome::Origin;
 use crate::program::{Context, RunMode, STACK_DEPTH, Source, TraceRecord, Wait};
-use tmclsim_protocol::frame::memory_reply;
-use tmclsim_protocol::{Command, Condition, Instruction, Status, WaitCondition, opcode};
+use tmclsim_protocol::{Command, Instruction, Status, WaitCondition, opcode};
 
 /// Ten milliseconds: one WAIT tick.
 const TICK_NS: u64 = 10_000_000;
 
 impl Module {
-    // ----- control commands ---------------------------------------------
-
-    /// 128–135: program control over any link.
-    pub(crate) fn control(&mut self, cmd: Command) -> Result<Outcome, Status> {
-        let memory = self.program.memory.len() as i32;
-        let ok = Outcome::ok;
-        match cmd {
-            Command::StopApplication => {
-                if self.program.mode != RunMode::Reset {
-                    self.program.mode = RunMode::Stop;
-                }
-                Ok(ok(0))
-            }
-            Command::RunApplication { from } => {
-                if let Some(address) = from {
-                    if !(0..memory).contains(&address) {
-                        return Err(Status::InvalidValue);
-                    }
-                    self.program.pc = address as u16;
-                    self.program.stack.clear();
-                    self.program.wait = None;
-                    self.program.handler = None;
-                }
-                self.start_program();
-                Ok(ok(from.unwrap_or(0)))
-            }
-            Command::StepApplication => {
-                self.program.mode = RunMode::Step;
-                self.program.hit_breakpoint = None;
-                self.program.next_ns = self.now_ns;
-                self.step_program();
-                Ok(ok(0))
-            }
-            Command::ResetApplication => {
-                self.program.reset();
-                self.program.mode = RunMode::Reset;
-                self.registers = Default::default();
-                Ok(ok(0))
-            }
-            Command::EnterDownload { address } => {
-                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 2 | 3) || self.eeprom_locked() {
-                    return Err(Status::EepromLocked);
-                }
-                if !(0..memory).contains(&address) {
-                    return Err(Status::InvalidValue);
-                }
-                self.program.mode = RunMode::Stop;
-                self.program.download = Some(address as u16);
-                self.program.download_pointer = address as u16;
-                Ok(ok(address))
-            }
-            Command::ExitDownload => {
-                if self.program.download.take().is_some() {
-                    // The downloaded words are in the EEPROM image; save it.
-                    self.eeprom_generation += 1;
-                }
-                Ok(ok(0))
-            }
-            Command::ReadMemory { address } => {
-                if !(0..memory).contains(&address) {
-                    return Err(Status::InvalidValue);
-                }
-                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 1 | 3) {
-                    return Err(Status::EepromLocked);
-                }
-                let stored = self.program.memory[address as usize];
-                Ok(Outcome { status: Status::Ok, value: address, special: Special::Frame(memory_reply(self.host_address(), stored)) })
-            }
-            Command::ApplicationStatus { kind } => {
-                let p = &self.program;
-                let word = |address: u16| ((p.mode as i32) << 24) | ((p.wait.is_some() as i32) << 16) | address as i32;
-                Ok(ok(match kind {
-                    0 => word(p.download_pointer),
-                    1 => word(p.pc),
-                    2 => self.registers.accumulator,
-                    _ => self.registers.x,
-                }))
-            }
-            _ => Err(Status::InvalidCommand),
-        }
-    }
-
-    /// Stores a word in download mode (status 101), decisions.md rule 15.
-    pub(crate) fn download_word(&mut self, ins: Instruction) -> Outcome {
-        let Some(address) = self.program.download else {
-            return Outcome::error(Status::NotAvailable, ins.value);
-        };
-        let Some(slot) = self.program.memory.get_mut(address as usize) else {
-            return Outcome::error(Status::InvalidValue, ins.value);
-        };
-        *slot = ins;
-        self.eeprom.program.insert(address, ins.to_bytes());
-        // Each word is in the EEPROM when it is acknowledged, as on the module.
-        self.eeprom_generation += 1;
-        self.program.download = Some(address + 1);
-        self.program.download_pointer = address + 1;
-        Outcome { status: Status::Loaded, value: ins.value, special: Special::None }
-    }
-
-    /// Loads a program into memory from address 0 (as a download would)
-    /// and stores it in the EEPROM.
-    pub fn load_program(&mut self, words: &[Instruction]) -> Result<(), Status> {
-        if words.len() > self.program.memory.len() {
-            return Err(Status::InvalidValue);
-        }
-        self.program.mode = RunMode::Stop;
-        for (a, w) in self.program.memory.iter_mut().enumerate() {
-            *w = words.get(a).copied().unwrap_or_default();
-        }
-        self.eeprom.program = words.iter().enumerate().map(|(a, w)| (a as u16, w.to_bytes())).collect();
-        self.eeprom_generation += 1;
-        self.program.download_pointer = words.len() as u16;
-        Ok(())
-    }
-
-    /// Pauses the program (step mode), as a debugger does.
-    pub fn pause_program(&mut self) {
-        if self.program.mode == RunMode::Run {
-            self.program.mode = RunMode::Step;
-        }
-    }
+    // ----- the debugger -------------------------------------------------
 
     /// Runs until one more instruction has executed (a WAIT in progress
     /// first ends), then pauses; time stops at most `slice_ns` after it.
@@ -147,13 +29,6 @@ impl Module {
         self.program.single_step = false;
         self.pause_program();
         self.program.executed != before
-    }
-
-    /// Starts (or continues) the program as 129 does.
-    pub fn start_program(&mut self) {
-        // A program paused at a breakpoint resumes with that instruction.
-        self.program.mode = RunMode::Run;
-        self.program.next_ns = self.program.next_ns.max(self.now_ns);
     }
 
     pub fn program(&self) -> &crate::program::Program {
@@ -195,38 +70,8 @@ impl Module {
         self.execute_next();
     }
 
-    /// Runs instructions due at `now` (and pure ones after them, up to
-    /// `limit`) without moving the world; returns when the world must catch
-    /// up, the program stops or waits.
-    pub(crate) fn run_batch(&mut self, limit: u64) {
-        loop {
-            self.take_interrupt();
-            let pc = self.program.pc;
-            if !self.program.breakpoints.is_empty() && self.program.breakpoints.contains(&pc) && self.program.hit_breakpoint != Some(pc) {
-                self.program.hit_breakpoint = Some(pc);
-                self.program.mode = RunMode::Step;
-                return;
-            }
-            self.program.hit_breakpoint = None;
-            let Some(ins) = self.program.memory.get(pc as usize).copied() else {
-                self.program.mode = RunMode::Stop;
-                return;
-            };
-            // With the trace on, every instruction sees the world of its
-            // own moment (positions in the trace are exact).
-            let pure = is_pure(ins) && self.program.trace.is_none();
-            if !pure && self.program.next_ns > self.now_ns {
-                return;
-            }
-            self.execute_next();
-            if !self.program.is_running() || self.program.wait.is_some() || !pure || self.program.next_ns > limit {
-                return;
-            }
-        }
-    }
-
     /// Executes the word at the program counter at time `program.next_ns`.
-    fn execute_next(&mut self) {
+    pub(crate) fn execute_next(&mut self) {
         let pc = self.program.pc;
         let Some(ins) = self.program.memory.get(pc as usize).copied() else {
             self.program.mode = RunMode::Stop;
@@ -268,14 +113,14 @@ impl Module {
             Command::Ja { address } => self.program.pc = target(address)?,
             Command::Jc { condition, address } => {
                 let a = target(address)?;
-                if self.condition(condition) {
+                if self.registers.holds(condition) {
                     self.program.pc = a;
                 }
             }
             Command::Csub { address } => self.call(target(address)?),
             Command::Call { condition, address } => {
                 let a = target(address)?;
-                if self.condition(condition) {
+                if self.registers.holds(condition) {
                     self.call(a);
                 }
             }
@@ -337,97 +182,26 @@ impl Module {
         }
     }
 
-    pub(crate) fn condition(&self, c: Condition) -> bool {
-        let cmp = self.registers.compare;
-        let e = self.registers.errors;
-        match c {
-            Condition::Zero | Condition::Equal => cmp == Compare::Equal,
-            Condition::NotZero | Condition::NotEqual => cmp != Compare::Equal,
-            Condition::Greater => cmp == Compare::Greater,
-            Condition::GreaterEqual => cmp != Compare::Less,
-            Condition::Lower => cmp == Compare::Less,
-            Condition::LowerEqual => cmp != Compare::Greater,
-            Condition::Timeout => e & error_flag::TIMEOUT != 0,
-            Condition::Alarm => e & error_flag::ALARM != 0,
-            Condition::Deviation => e & error_flag::DEVIATION != 0,
-            Condition::PositionError => e & error_flag::POSITION != 0,
-        }
-    }
-
-    /// Ends a WAIT whose condition holds or whose time is up.
-    pub(crate) fn check_wait(&mut self) {
-        let Some(w) = self.program.wait else { return };
-        let m = w.motor as usize;
-        let met = match w.condition {
-            WaitCondition::Ticks => w.until_ns.is_none_or(|u| self.now_ns >= u),
-            WaitCondition::Position => self.actual_position(m) == self.axes[m].target_word && self.axes[m].motion.v == 0.0,
-            WaitCondition::ReferenceSwitch => self.switches(m).2,
-            WaitCondition::LimitSwitch => {
-                let (l, r, _) = self.switches(m);
-                l || r
-            }
-            WaitCondition::ReferenceSearch => !self.reference_search_active(m),
-        };
-        if met {
-            self.program.wait = None;
-        } else if w.condition != WaitCondition::Ticks && w.until_ns.is_some_and(|u| self.now_ns >= u) {
-            self.registers.errors |= error_flag::TIMEOUT;
-            self.program.wait = None;
-        }
-        if self.program.wait.is_none() {
-            self.program.next_ns = self.program.next_ns.max(self.now_ns);
-        }
-    }
-
-    /// When the world must be looked at again for the WAIT in progress.
-    pub(crate) fn wait_horizon(&self) -> Option<u64> {
-        let w = self.program.wait?;
-        let mut t = w.until_ns;
-        let m = w.motor as usize;
-        let poll = self.now_ns + 1_000_000;
-        let candidate = match w.condition {
-            WaitCondition::Ticks => None,
-            WaitCondition::Position => {
-                // The ramp is known in closed form: wake up when it ends.
-                let ramp = self.ramp(m);
-                let mut stops = |x: f64| self.stops_at(m, x);
-                match self.axes[m].motion.time_to_rest(&ramp, &mut stops) {
-                    // At rest off the target (a switch stopped it): nothing
-                    // changes by itself; only the timeout ends the wait.
-                    Some(s) if s <= 0.0 => None,
-                    Some(s) => Some(self.now_ns + (s * 1e9).ceil() as u64),
-                    None => Some(poll),
-                }
-            }
-            _ => Some(poll),
-        };
-        if let Some(c) = candidate {
-            t = Some(t.map_or(c, |u| u.min(c)));
-        }
-        t
-    }
-
     /// Enters the handler of the most urgent pending interrupt, if the
     /// program may take one now (decisions.md rule 22).
     /// An enabled interrupt with a vector is pending and may be taken.
     pub(crate) fn interrupt_ready(&self) -> bool {
-        self.interrupts_global
+        self.interrupts.global
             && self.program.handler.is_none()
             && self.program.pending != [0; 4]
-            && self.program.first_pending(|n| self.interrupts_enabled[n as usize] && self.interrupt_vectors[n as usize].is_some()).is_some()
+            && self.program.first_pending(|n| self.interrupts.serviceable(n)).is_some()
     }
 
     pub(crate) fn take_interrupt(&mut self) {
-        if !self.interrupts_global || self.program.handler.is_some() || self.program.pending == [0; 4] {
+        if !self.interrupts.global || self.program.handler.is_some() || self.program.pending == [0; 4] {
             return;
         }
-        let vectors = &self.interrupt_vectors;
-        let enabled = &self.interrupts_enabled;
-        let Some(n) = self.program.first_pending(|n| enabled[n as usize] && vectors[n as usize].is_some()) else {
+        let interrupts = &self.interrupts;
+        let Some(n) = self.program.first_pending(|n| interrupts.serviceable(n)) else {
             return;
         };
         self.program.clear_pending(n);
-        let vector = self.interrupt_vectors[n as usize].expect("checked");
+        let vector = self.interrupts.vectors[n as usize].expect("checked");
         self.program.handler = Some(Context { registers: self.registers, pc: self.program.pc, wait: self.program.wait.take() });
         self.program.pc = vector;
         self.program.next_ns = self.program.next_ns.max(self.now_ns);
@@ -439,76 +213,9 @@ impl Module {
             return;
         }
         if let Some(n) = self.profile.interrupt_for(source)
-            && self.interrupts_enabled[n as usize]
+            && self.interrupts.enabled[n as usize]
         {
             self.program.set_pending(n);
         }
     }
-
-    /// Interrupts that depend on motion are enabled: the world must then be
-    /// looked at often (every millisecond) even while the program waits.
-    pub(crate) fn motion_interrupts_armed(&self) -> bool {
-        self.interrupts_global
-            && self.program.is_running()
-            && self.profile.interrupts.iter().any(|i| {
-                self.interrupts_enabled[i.number as usize]
-                    && matches!(
-                        Source::from_symbol(&i.symbol),
-                        Some(
-                            Source::TargetReached(_) | Source::StopLeft(_) | Source::StopRight(_) | Source::Stall(_) | Source::Deviation(_)
-                        )
-                    )
-            })
-    }
-
-    /// Timer interrupts: fire those due, return the next firing time.
-    pub(crate) fn run_timers(&mut self) -> Option<u64> {
-        let mut next = None;
-        for t in 0..3u8 {
-            let Some(n) = self.profile.interrupt_for(Source::Timer(t)) else { continue };
-            let period_ms = self.globals[3][n as usize] as u32 as u64;
-            if !self.program.is_running() || period_ms == 0 || !self.interrupts_enabled[n as usize] {
-                self.program.timers[t as usize] = None;
-                continue;
-            }
-            let period = period_ms * 1_000_000;
-            let due = *self.program.timers[t as usize].get_or_insert(self.now_ns + period);
-            if self.now_ns >= due {
-                self.program.set_pending(n);
-                let behind = (self.now_ns - due) / period + 1;
-                self.program.timers[t as usize] = Some(due + behind * period);
-            }
-            let d = self.program.timers[t as usize].expect("set above");
-            next = Some(next.map_or(d, |x: u64| x.min(d)));
-        }
-        next
-    }
-}
-
-/// Instructions that touch neither the motors, the I/O nor time: a batch of
-/// them runs without moving the world.
-fn is_pure(ins: Instruction) -> bool {
-    matches!(
-        ins.opcode,
-        opcode::CALC
-            | opcode::COMP
-            | opcode::JC
-            | opcode::JA
-            | opcode::CSUB
-            | opcode::RSUB
-            | opcode::CALCX
-            | opcode::CLE
-            | opcode::CALCVV
-            | opcode::CALCVA
-            | opcode::CALCAV
-            | opcode::CALCVX
-            | opcode::CALCXV
-            | opcode::CALCV
-            | opcode::DJNZ
-            | opcode::SIV
-            | opcode::GIV
-            | opcode::AIV
-            | opcode::CALL
-            | opcode::RST
-    ) || (matches!(ins.opcode, opcode::SGP | opcode::GGP) && ins.motor == 2)
 }

@@ -1,199 +1,27 @@
-//! A virtual TMCL module: profile, state, EEPROM, motion and world, driven
-//! by `handle_frame` (or `execute`) and `advance`.
+//! A virtual TMCL module: the `Module` struct, a composition of its state
+//! (`state/`), its constructors and accessors, and power-up and reset. What
+//! it does lives in the `impl Module` files: the links (`frames.rs`,
+//! `can.rs`, `ascii.rs`), the commands (`executor.rs`, `commands/`), the
+//! program (`interpreter.rs`), the axes (`mechanics.rs`, `driver.rs`,
+//! `closed_loop.rs`) and virtual time (`time.rs`).
 
-use crate::driver::Driver;
 use crate::eeprom::Eeprom;
-use crate::motion::{self, Motion, RampMode};
-use crate::profile::Profile;
-use crate::program::{Program, RunMode, Source};
-use crate::reference_search::ReferenceSearch;
+use crate::program::{Program, RunMode};
+use crate::state::globals::Globals;
+use crate::state::interrupts::Interrupts;
+use crate::state::io::Io;
+use crate::state::link::Link;
+use crate::state::persistence::Persistence;
 use crate::world::World;
 use std::sync::Arc;
-use tmclsim_protocol::frame::version_string_reply;
-use tmclsim_protocol::{FRAME_LEN, Reply, Request, Status, opcode};
+use tmclsim_profile::Profile;
 
-/// Axis parameter numbers the firmware gives a meaning to.
-pub mod ap {
-    pub const TARGET_POSITION: u8 = 0;
-    pub const ACTUAL_POSITION: u8 = 1;
-    pub const TARGET_SPEED: u8 = 2;
-    pub const ACTUAL_SPEED: u8 = 3;
-    pub const MAX_SPEED: u8 = 4;
-    pub const MAX_ACCELERATION: u8 = 5;
-    pub const MAX_CURRENT: u8 = 6;
-    pub const STANDBY_CURRENT: u8 = 7;
-    pub const POSITION_REACHED: u8 = 8;
-    pub const HOME_SWITCH: u8 = 9;
-    pub const RIGHT_SWITCH: u8 = 10;
-    pub const LEFT_SWITCH: u8 = 11;
-    pub const RIGHT_SWITCH_DISABLE: u8 = 12;
-    pub const LEFT_SWITCH_DISABLE: u8 = 13;
-    pub const MIN_SPEED: u8 = 130;
-    pub const ACTUAL_ACCELERATION: u8 = 135;
-    pub const RAMP_MODE: u8 = 138;
-    pub const SOFT_STOP: u8 = 149;
-    pub const END_SWITCH_POWER_DOWN: u8 = 150;
-    pub const MICROSTEP_RESOLUTION: u8 = 140;
-    pub const CHOPPER_OFF_TIME: u8 = 167;
-    pub const SMART_ENERGY_CURRENT_MINIMUM: u8 = 168;
-    pub const SMART_ENERGY_CURRENT_DOWN_STEP: u8 = 169;
-    pub const SMART_ENERGY_HYSTERESIS: u8 = 170;
-    pub const SMART_ENERGY_CURRENT_UP_STEP: u8 = 171;
-    pub const SMART_ENERGY_HYSTERESIS_START: u8 = 172;
-    pub const STALLGUARD_FILTER: u8 = 173;
-    pub const STALLGUARD_THRESHOLD: u8 = 174;
-    pub const STOP_ON_STALL: u8 = 181;
-    pub const SMART_ENERGY_THRESHOLD_SPEED: u8 = 182;
-    pub const SMART_ENERGY_SLOW_RUN_CURRENT: u8 = 183;
-    pub const LOAD_VALUE: u8 = 206;
-    pub const STALL_THRESHOLD: u8 = 205;
-    pub const ENCODER_POSITION: u8 = 209;
-    pub const ENCODER_PRESCALER: u8 = 210;
-    pub const MAX_ENCODER_DEVIATION: u8 = 212;
-    pub const GROUP_INDEX: u8 = 213;
-    pub const DRIVER_ERROR_FLAGS: u8 = 208;
-    pub const RAMP_DIVISOR: u8 = 153;
-    pub const REFERENCE_SEARCH_MODE: u8 = 193;
-    pub const REFERENCE_SEARCH_SPEED: u8 = 194;
-    pub const REFERENCE_SWITCH_SPEED: u8 = 195;
-    pub const END_SWITCH_DISTANCE: u8 = 196;
-    pub const LAST_REFERENCE_POSITION: u8 = 197;
-    pub const PULSE_DIVISOR: u8 = 154;
-    pub const ACTUAL_CURRENT: u8 = 180;
-    pub const BOOST_CURRENT: u8 = 200;
-    pub const FREEWHEELING: u8 = 204;
-    pub const EXTENDED_ERROR_FLAGS: u8 = 207;
-    pub const POWER_DOWN_DELAY: u8 = 214;
-}
+pub use crate::outcome::{Origin, Outcome, Special};
+pub use crate::parameter_numbers::{ap, gp};
+pub use crate::state::axis::Axis;
+pub use crate::state::registers::{Compare, Registers, error_flag};
 
-/// Global parameter numbers (bank 0) the firmware gives a meaning to.
-pub mod gp {
-    pub const EEPROM_MAGIC: u8 = 64;
-    pub const BAUD_RATE: u8 = 65;
-    pub const SERIAL_ADDRESS: u8 = 66;
-    pub const ASCII_MODE: u8 = 67;
-    pub const HEARTBEAT: u8 = 68;
-    pub const AUTOSTART: u8 = 77;
-    pub const EEPROM_LOCK: u8 = 73;
-    pub const SHUTDOWN_PIN: u8 = 80;
-    pub const CODE_PROTECTION: u8 = 81;
-    pub const TELEGRAM_PAUSE: u8 = 75;
-    pub const HOST_ADDRESS: u8 = 76;
-    pub const END_SWITCH_POLARITY: u8 = 79;
-    pub const COORDINATE_STORAGE: u8 = 84;
-    pub const DONT_RESTORE_USER_VARIABLES: u8 = 85;
-    pub const SECONDARY_ADDRESS: u8 = 87;
-    pub const REVERSE_SHAFT: u8 = 90;
-    pub const APPLICATION_STATUS: u8 = 128;
-    pub const DOWNLOAD_MODE: u8 = 129;
-    pub const PROGRAM_COUNTER: u8 = 130;
-    pub const TICK_TIMER: u8 = 132;
-    pub const RANDOM: u8 = 133;
-    pub const SUPPRESS_REPLY: u8 = 255;
-}
-
-/// One motor axis.
-#[derive(Clone, Debug)]
-pub struct Axis {
-    /// RAM values of the axis parameters (stored ones; measured ones are
-    /// computed on read).
-    pub params: [i32; 256],
-    pub motion: Motion,
-    /// AP 0 as the host wrote it.
-    pub target_word: i32,
-    /// Coordinates 0…N.
-    pub coordinates: Vec<i32>,
-    /// Mechanical position minus motor position counter.
-    pub mech_offset: f64,
-    /// Virtual time (ns) since which the motor stands still.
-    pub standstill_since: Option<u64>,
-    /// A 138 event is due when this axis reaches its target.
-    pub notify_on_arrival: bool,
-    /// The reference search in progress.
-    pub rfs: Option<ReferenceSearch>,
-    pub driver: Driver,
-    /// An interpolated move's ramp (MVP COORD with bit 6), until it ends.
-    pub ramp_override: Option<motion::Ramp>,
-    /// AP 209 minus what the encoder measures (set by SAP 209).
-    pub encoder_offset: i64,
-    pub closed_loop: crate::closed_loop::ClosedLoop,
-}
-
-/// Result of the last comparison (or of an accumulator load against 0).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Compare {
-    Less,
-    #[default]
-    Equal,
-    Greater,
-}
-
-impl Compare {
-    pub fn of(a: i32, b: i32) -> Compare {
-        match a.cmp(&b) {
-            std::cmp::Ordering::Less => Compare::Less,
-            std::cmp::Ordering::Equal => Compare::Equal,
-            std::cmp::Ordering::Greater => Compare::Greater,
-        }
-    }
-}
-
-/// Error flags (CLE / JC ETO…EPO), one bit each.
-pub mod error_flag {
-    pub const TIMEOUT: u8 = 1 << 1;
-    pub const ALARM: u8 = 1 << 2;
-    pub const DEVIATION: u8 = 1 << 3;
-    pub const POSITION: u8 = 1 << 4;
-    pub const SHUTDOWN: u8 = 1 << 5;
-}
-
-/// Accumulator, X register and flags of the TMCL interpreter.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Registers {
-    pub accumulator: i32,
-    pub x: i32,
-    pub compare: Compare,
-    /// Error flags, see [`error_flag`].
-    pub errors: u8,
-}
-
-/// How `execute` was reached: the host (direct mode) or a program.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Origin {
-    Direct,
-    Program,
-}
-
-/// What a command produced besides status and value.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Special {
-    /// A normal reply.
-    None,
-    /// Send these 9 bytes instead of a normal reply.
-    Frame([u8; FRAME_LEN]),
-    /// Send no reply at all.
-    Silent,
-}
-
-/// The result of executing one instruction.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Outcome {
-    pub status: Status,
-    pub value: i32,
-    pub special: Special,
-}
-
-impl Outcome {
-    pub fn ok(value: i32) -> Outcome {
-        Outcome { status: Status::Ok, value, special: Special::None }
-    }
-
-    pub fn error(status: Status, value: i32) -> Outcome {
-        Outcome { status, value, special: Special::None }
-    }
-}
-
-/// A virtual TMCL module.
+/// A virtual TMCL module: a composition of its state, one part per concern.
 #[derive(Clone, Debug)]
 pub struct Module {
     pub(crate) profile: Arc<Profile>,
@@ -201,40 +29,18 @@ pub struct Module {
     pub(crate) now_ns: u64,
     pub(crate) axes: Vec<Axis>,
     /// Global parameter RAM, banks 0…3.
-    pub(crate) globals: [[i32; 256]; 4],
-    pub(crate) outputs: u32,
-    pub(crate) pullups: bool,
+    pub(crate) globals: Globals,
+    pub(crate) io: Io,
     pub(crate) world: World,
-    pub(crate) eeprom: Eeprom,
-    /// Bumped on every EEPROM write; a server saves the image when it changes.
-    pub(crate) eeprom_generation: u64,
+    /// The EEPROM image and whether it was written.
+    pub(crate) persistence: Persistence,
     pub(crate) registers: Registers,
-    /// Interrupt configuration: enabled flags, vectors, global enable.
-    pub(crate) interrupts_enabled: [bool; 256],
-    pub(crate) interrupt_vectors: [Option<u16>; 256],
-    pub(crate) interrupts_global: bool,
-    /// 138: arm for the next MVP (`Some(false)`) or every MVP (`Some(true)`).
-    pub(crate) event_arm: Option<(bool, u32)>,
-    pub(crate) events: Vec<[u8; FRAME_LEN]>,
-    /// Address byte of the last request (events answer with it).
-    pub(crate) last_address: u8,
-    pub(crate) last_frame_ns: u64,
-    pub(crate) heartbeat_tripped: bool,
-    pub(crate) tick_base_ns: u64,
-    pub(crate) tick_offset_ms: i64,
-    pub(crate) rng: u32,
-    pub(crate) restored_from_eeprom: bool,
-    pub(crate) resets: u32,
+    pub(crate) interrupts: Interrupts,
+    /// The host link: last address, heartbeat, ASCII mode.
+    pub(crate) link: Link,
     pub(crate) program: Program,
-    /// Digital inputs and stop switches at the last look, for input-change
-    /// and switch interrupts.
-    pub(crate) last_inputs: u32,
-    pub(crate) last_switches: Vec<(bool, bool)>,
-    /// SAC: the shift register of the SPI device on each chip select.
-    pub(crate) spi: [u32; 3],
-    /// ASCII mode and the line being typed.
-    pub(crate) ascii: bool,
-    pub(crate) ascii_line: crate::ascii::AsciiLine,
+    /// Resets (255) and reinitialisations (137) since the module was created.
+    pub(crate) resets: u32,
 }
 
 impl Module {
@@ -259,32 +65,15 @@ impl Module {
         let mut m = Module {
             world,
             axes: Vec::new(),
-            globals: [[0; 256]; 4],
-            outputs: 0,
-            pullups: true,
-            eeprom_generation: 0,
+            globals: Globals::default(),
+            io: Io::default(),
+            persistence: Persistence::new(eeprom),
             registers: Registers::default(),
-            interrupts_enabled: [false; 256],
-            interrupt_vectors: [None; 256],
-            interrupts_global: false,
-            event_arm: None,
-            events: Vec::new(),
-            last_address: 1,
-            last_frame_ns: 0,
-            heartbeat_tripped: false,
-            tick_base_ns: 0,
-            tick_offset_ms: 0,
-            rng: 0x2545_F491,
-            restored_from_eeprom: false,
+            interrupts: Interrupts::default(),
+            link: Link::default(),
             resets: 0,
             program: Program::new(profile.module.program_memory as usize),
-            last_inputs: 0,
-            last_switches: Vec::new(),
-            spi: [0; 3],
-            ascii: false,
-            ascii_line: Default::default(),
             now_ns: 0,
-            eeprom,
             profile,
         };
         m.power_on();
@@ -309,18 +98,18 @@ impl Module {
     }
 
     pub fn eeprom(&self) -> &Eeprom {
-        &self.eeprom
+        &self.persistence.eeprom
     }
 
     /// Changes whenever a command wrote the EEPROM.
     pub fn eeprom_generation(&self) -> u64 {
-        self.eeprom_generation
+        self.persistence.generation()
     }
 
     /// True when this power-up found stored values in the EEPROM; false
     /// when the module started from factory defaults.
     pub fn restored_from_eeprom(&self) -> bool {
-        self.restored_from_eeprom
+        self.persistence.restored
     }
 
     /// How many times the module was reset (255) or reinitialised (137).
@@ -368,29 +157,23 @@ impl Module {
     /// frame (used by servers for `--address`).
     pub fn set_address(&mut self, address: u8) {
         self.globals[0][gp::SERIAL_ADDRESS as usize] = address as i32;
-        self.eeprom.set_global(0, gp::SERIAL_ADDRESS, address as i32);
-        self.eeprom_generation += 1;
-    }
-
-    /// Does a frame with this address byte reach this module?
-    pub fn answers_to(&self, address: u8) -> bool {
-        address == self.address() || (self.secondary_address() != 0 && address == self.secondary_address())
+        self.persistence.store_global(0, gp::SERIAL_ADDRESS, address as i32);
     }
 
     /// Power cycle: RAM from factory defaults, then what the EEPROM holds.
     pub fn power_on(&mut self) {
         let profile = self.profile.clone();
         if let Some(magic) = profile.features.eeprom_magic {
-            // Any other stored magic re-initialises the EEPROM (TMCM-351: GP 64, 0xE4).
-            if self.eeprom.global(0, magic.parameter).is_some_and(|v| v != magic.value) {
-                self.eeprom.clear();
-                self.eeprom.set_global(0, magic.parameter, magic.value);
-                self.eeprom_generation += 1;
+            // Any magic but 0xE4 re-initialises the EEPROM (TMCM-351 GP 64).
+            if self.persistence.eeprom.global(0, magic.parameter).is_some_and(|v| v != magic.value) {
+                self.persistence.eeprom.clear();
+                self.persistence.eeprom.set_global(0, magic.parameter, magic.value);
+                self.persistence.mark_written();
             }
         }
-        let ee = &self.eeprom;
+        let ee = &self.persistence.eeprom;
         let restored = !ee.axis.is_empty() || !ee.global.is_empty() || !ee.coordinates.is_empty();
-        self.globals = [[0; 256]; 4];
+        self.globals.clear();
         for bank in 0..4u8 {
             for p in profile.global_parameters(bank) {
                 let stored = if p.access.auto || p.access.eeprom { ee.global(bank, p.number) } else { None };
@@ -421,35 +204,16 @@ impl Module {
             // The carriage stays where it is; the position counter restarts at 0.
             let sign = self.shaft_sign();
             let mech = old_axes.get(motor as usize).map_or(self.world.axes[motor as usize].start, |a| a.motion.x * sign + a.mech_offset);
-            let mode = RampMode::from_code(params[ap::RAMP_MODE as usize]);
-            self.axes.push(Axis {
-                params,
-                motion: Motion { mode, ..Motion::default() },
-                target_word: 0,
-                coordinates,
-                mech_offset: mech,
-                standstill_since: Some(self.now_ns),
-                notify_on_arrival: false,
-                rfs: None,
-                driver: Driver::default(),
-                ramp_override: None,
-                encoder_offset: 0,
-                closed_loop: Default::default(),
-            });
+            self.axes.push(Axis::new(params, coordinates, mech, self.now_ns));
         }
-        self.restored_from_eeprom = restored;
-        self.outputs = 0;
-        self.pullups = profile.ports.iter().find(|p| p.direction == crate::profile::PortDirection::Pullup).is_none_or(|p| p.default != 0);
+        self.persistence.restored = restored;
+        self.io.outputs = 0;
+        self.io.pullups =
+            profile.ports.iter().find(|p| p.direction == tmclsim_profile::PortDirection::Pullup).is_none_or(|p| p.default != 0);
         self.registers = Registers::default();
-        self.interrupts_enabled = [false; 256];
-        self.interrupt_vectors = [None; 256];
-        self.interrupts_global = false;
-        self.event_arm = None;
-        self.events.clear();
-        self.last_frame_ns = self.now_ns;
-        self.heartbeat_tripped = false;
-        self.tick_base_ns = self.now_ns;
-        self.tick_offset_ms = 0;
+        self.interrupts.reset();
+        self.link.restart_heartbeat(self.now_ns);
+        self.globals.set_tick_timer(self.now_ns, 0);
         // Program memory from the EEPROM; the interpreter starts afresh.
         let words = self.program.memory.len();
         let (trace, breakpoints, instruction_ns) =
@@ -458,15 +222,15 @@ impl Module {
         self.program.trace = trace.map(|_| Vec::new());
         self.program.breakpoints = breakpoints;
         self.program.instruction_ns = instruction_ns;
-        for (&a, bytes) in &self.eeprom.program {
+        for (&a, bytes) in &self.persistence.eeprom.program {
             if let Some(w) = self.program.memory.get_mut(a as usize) {
                 *w = tmclsim_protocol::Instruction::from_bytes(bytes);
             }
         }
         self.program.download_pointer = self.program.length() as u16;
         self.program.next_ns = self.now_ns;
-        self.last_inputs = self.world.digital_inputs;
-        self.last_switches = (0..self.axes.len())
+        self.io.last_inputs = self.world.digital_inputs;
+        self.io.last_switches = (0..self.axes.len())
             .map(|m| {
                 let (l, r, _) = self.switches(m);
                 (l, r)
@@ -475,374 +239,16 @@ impl Module {
         for m in 0..self.axes.len() {
             self.closed_loop_power_on(m);
         }
-        self.ascii = self.globals[0][gp::ASCII_MODE as usize] & 1 == 1;
-        self.ascii_line = Default::default();
+        self.link.ascii = self.globals[0][gp::ASCII_MODE as usize] & 1 == 1;
+        self.link.ascii_line = Default::default();
         if self.globals[0][gp::AUTOSTART as usize] == 1 && self.program.length() > 0 {
             self.program.mode = RunMode::Run;
         }
-    }
-
-    /// Handles one 9-byte frame from a serial-type link: address filter,
-    /// checksum, execution, reply (decisions.md rules 2–4, 11).
-    pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
-        let (request, checksum_ok) = match Request::decode(frame) {
-            Ok(r) => (r, true),
-            Err(r) => (r, false),
-        };
-        if !self.answers_to(request.address) {
-            return None;
-        }
-        self.last_address = request.address;
-        self.last_frame_ns = self.now_ns;
-        self.heartbeat_tripped = false;
-        let host = self.host_address();
-        if !checksum_ok {
-            if self.replies_suppressed(0) {
-                return None;
-            }
-            return Some(Reply::new(host, request.address, Status::WrongChecksum, 0, 0).encode());
-        }
-        let ins = request.instruction;
-        let outcome =
-            if self.program.download.is_some() && !opcode::is_control(ins.opcode) { self.download_word(ins) } else { self.execute(ins) };
-        let reply = match outcome.special {
-            Special::Silent => return None,
-            Special::Frame(f) => f,
-            Special::None => Reply::new(host, request.address, outcome.status, ins.opcode, outcome.value).encode(),
-        };
-        if ins.opcode == opcode::RESET && outcome.status == Status::Ok {
-            // The reply goes out, then the module restarts.
-            self.reset();
-            return Some(reply);
-        }
-        if self.replies_suppressed(ins.opcode) {
-            return None;
-        }
-        Some(reply)
-    }
-
-    /// GP 255: replies in direct mode are suppressed except for GAP, GGP
-    /// and GIO.
-    fn replies_suppressed(&self, op: u8) -> bool {
-        self.globals[0][gp::SUPPRESS_REPLY as usize] == 1 && !matches!(op, opcode::GAP | opcode::GGP | opcode::GIO)
     }
 
     /// Software reset (255 with 1234): a power cycle.
     pub fn reset(&mut self) {
         self.resets += 1;
         self.power_on();
-    }
-
-    /// Unsolicited frames (138 events) produced since the last call.
-    pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
-        std::mem::take(&mut self.events)
-    }
-
-    pub fn has_events(&self) -> bool {
-        !self.events.is_empty()
-    }
-
-    pub(crate) fn push_event(&mut self, mask: u32) {
-        let reply = Reply::new(self.host_address(), self.last_address, Status::Event, opcode::TARGET_REACHED_EVENT, mask as i32);
-        self.events.push(reply.encode());
-    }
-
-    pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
-        version_string_reply(self.host_address(), &self.profile.version_text())
-    }
-
-    // ----- time -------------------------------------------------------
-
-    /// Advances virtual time by `dt_ns` nanoseconds: the program runs its
-    /// instructions, the motors move, interrupts and events fire, each at
-    /// its own moment.
-    pub fn advance(&mut self, dt_ns: u64) {
-        let end = self.now_ns.saturating_add(dt_ns);
-        self.look_at_inputs();
-        loop {
-            let timer = self.run_timers();
-            if self.program.is_running() {
-                if self.program.wait.is_some() {
-                    self.check_wait();
-                }
-                if self.program.wait.is_some() && self.interrupt_ready() {
-                    // An interrupt is served during a WAIT; RETI resumes it.
-                    self.take_interrupt();
-                }
-                if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
-                    let soon = self.motion_interrupts_armed().then_some(self.now_ns + 1_000_000);
-                    let limit = [Some(end), timer, self.heartbeat_deadline(), soon].into_iter().flatten().min().unwrap_or(end);
-                    self.run_batch(limit);
-                    continue;
-                }
-            }
-            if self.now_ns >= end {
-                break;
-            }
-            // The next moment something happens on its own.
-            let mut t = end;
-            let mut at = |x: Option<u64>| {
-                if let Some(x) = x
-                    && x > self.now_ns
-                {
-                    t = t.min(x);
-                }
-            };
-            at(self.heartbeat_deadline());
-            at(timer);
-            if self.driver_watches() {
-                // Load, stall and deviation are looked at every millisecond.
-                at(Some(self.now_ns + 1_000_000));
-            }
-            if self.program.is_running() {
-                if self.program.wait.is_none() {
-                    at(Some(self.program.next_ns));
-                } else {
-                    at(self.wait_horizon());
-                }
-                if self.motion_interrupts_armed() {
-                    at(Some(self.now_ns + 1_000_000));
-                }
-            }
-            self.step_world(t);
-        }
-    }
-
-    /// Moves the motors to `t` and looks at what changed.
-    fn step_world(&mut self, t: u64) {
-        let dt = t - self.now_ns;
-        for motor in 0..self.axes.len() {
-            self.advance_axis(motor, dt);
-        }
-        self.now_ns = t;
-        if let Some(deadline) = self.heartbeat_deadline()
-            && self.now_ns >= deadline
-        {
-            self.heartbeat_tripped = true;
-            for motor in 0..self.axes.len() {
-                self.motor_stop(motor);
-            }
-        }
-        self.look_at_inputs();
-    }
-
-    /// Raises input-change and stop-switch interrupts for the transitions
-    /// their bank 3 trigger setting selects.
-    fn look_at_inputs(&mut self) {
-        let inputs = self.world.digital_inputs;
-        let changed = inputs ^ self.last_inputs;
-        if changed != 0 {
-            for n in 0..8u8 {
-                if changed & (1 << n) != 0 {
-                    let rising = inputs & (1 << n) != 0;
-                    self.trigger(Source::InputChange(n), rising);
-                }
-            }
-            self.last_inputs = inputs;
-        }
-        for m in 0..self.axes.len() {
-            let (l, r, _) = self.switches(m);
-            let (pl, pr) = self.last_switches.get(m).copied().unwrap_or((l, r));
-            if l != pl {
-                self.trigger(Source::StopLeft(m as u8), l);
-            }
-            if r != pr {
-                self.trigger(Source::StopRight(m as u8), r);
-            }
-            if let Some(s) = self.last_switches.get_mut(m) {
-                *s = (l, r);
-            }
-        }
-    }
-
-    /// An edge on an input: raise its interrupt if bank 3 selects the edge
-    /// (0 off, 1 low→high, 2 high→low, 3 both).
-    fn trigger(&mut self, source: Source, rising: bool) {
-        let Some(n) = self.profile.interrupt_for(source) else { return };
-        let mode = self.globals[3][n as usize];
-        if mode == 3 || (mode == 1 && rising) || (mode == 2 && !rising) {
-            self.raise(source);
-        }
-    }
-
-    /// Advances virtual time to an absolute time (no-op if in the past).
-    pub fn advance_to(&mut self, t_ns: u64) {
-        if t_ns > self.now_ns {
-            self.advance(t_ns - self.now_ns);
-        }
-    }
-
-    pub(crate) fn heartbeat_deadline(&self) -> Option<u64> {
-        let hb = self.globals[0][gp::HEARTBEAT as usize];
-        (hb > 0 && !self.heartbeat_tripped).then(|| self.last_frame_ns + hb as u64 * 1_000_000)
-    }
-
-    /// The next virtual time at which something observable happens on its
-    /// own (a heartbeat stop, a 138 event); `None` if nothing is pending.
-    pub fn next_event_ns(&self) -> Option<u64> {
-        if self.program.is_running() {
-            // A running program does something every instruction; a
-            // server lets it run in steps of a millisecond.
-            return Some(self.now_ns + 1_000_000);
-        }
-        let mut next = self.heartbeat_deadline();
-        for (motor, axis) in self.axes.iter().enumerate() {
-            if axis.notify_on_arrival
-                && let Some(t) = self.time_to_rest(motor)
-            {
-                let t = self.now_ns + (t * 1e9).ceil() as u64;
-                next = Some(next.map_or(t, |n| n.min(t)));
-            }
-        }
-        next
-    }
-
-    fn time_to_rest(&self, motor: usize) -> Option<f64> {
-        let ramp = self.ramp(motor);
-        let mut stops = |x: f64| self.stops_at(motor, x);
-        self.axes[motor].motion.time_to_rest(&ramp, &mut stops)
-    }
-
-    fn advance_axis(&mut self, motor: usize, dt_ns: u64) {
-        let offset = self.axes[motor].mech_offset;
-        let sign = self.shaft_sign();
-        // Switch edges in motor coordinates.
-        let mut edges = [0.0f64; 8];
-        let mut count = 0;
-        for m in self.world.axes[motor].thresholds().take(edges.len()) {
-            edges[count] = (m - offset) * sign;
-            count += 1;
-        }
-        let edges = &edges[..count];
-        let was_moving = self.axes[motor].motion.v != 0.0;
-        let searching = self.axes[motor].rfs.is_some();
-        let mut left = dt_ns as f64 * 1e-9;
-        let mut stopped_at = None;
-        let mut arrived = false;
-        let mut elapsed = 0.0;
-        // A reference search looks at every switch edge it passes; plain
-        // motion goes through the whole step at once.
-        for _ in 0..64 {
-            let ramp = self.ramp(motor);
-            let x_before = self.axes[motor].motion.x;
-            let mut motion = std::mem::take(&mut self.axes[motor].motion);
-            let step = {
-                let mut stops = |x: f64| self.stops_at(motor, x);
-                motion.advance(left, &ramp, &mut stops, edges, searching)
-            };
-            self.axes[motor].motion = motion;
-            self.drive(motor, x_before, step.elapsed);
-            if let Some(t) = step.stopped_at {
-                stopped_at = Some(elapsed + t);
-            }
-            elapsed += step.elapsed;
-            left -= step.elapsed;
-            arrived |= step.arrived;
-            if searching {
-                self.reference_search_step(motor, step.crossed.is_some(), step.arrived);
-            }
-            if !searching || step.crossed.is_none() || left <= 0.0 {
-                break;
-            }
-        }
-        // Time the motion did not use (standing still): the driver and the
-        // closed loop still act.
-        let rest = dt_ns as f64 * 1e-9 - elapsed;
-        if rest > 1e-12 {
-            let x = self.axes[motor].motion.x;
-            self.drive(motor, x, rest);
-        }
-        let moving = self.axes[motor].motion.v != 0.0;
-        let axis = &mut self.axes[motor];
-        if moving {
-            axis.standstill_since = None;
-        } else if let Some(t) = stopped_at {
-            axis.standstill_since = Some(self.now_ns + (t * 1e9) as u64);
-        } else if was_moving || axis.standstill_since.is_none() {
-            axis.standstill_since = Some(self.now_ns);
-        }
-        if arrived {
-            axis.ramp_override = None;
-        }
-        if arrived && axis.notify_on_arrival {
-            axis.notify_on_arrival = false;
-            self.push_event(1 << motor);
-        }
-        if arrived && !searching {
-            self.raise(Source::TargetReached(motor as u8));
-        }
-    }
-
-    pub(crate) fn shaft_sign(&self) -> f64 {
-        if self.globals[0][gp::REVERSE_SHAFT as usize] == 1 { -1.0 } else { 1.0 }
-    }
-
-    /// Mechanical position of an axis for a motor position.
-    pub(crate) fn mech(&self, motor: usize, x: f64) -> f64 {
-        x * self.shaft_sign() + self.axes[motor].mech_offset
-    }
-
-    /// Where the carriage of an axis is, in the world's coordinates.
-    pub fn mechanical_position(&self, motor: usize) -> f64 {
-        self.mech(motor, self.axes[motor].motion.x)
-    }
-
-    /// Logical switch states (after GP 79 polarity): (left, right, home).
-    pub fn switches(&self, motor: usize) -> (bool, bool, bool) {
-        self.switches_at(motor, self.axes[motor].motion.x)
-    }
-
-    pub(crate) fn switches_at(&self, motor: usize, x: f64) -> (bool, bool, bool) {
-        let w = &self.world.axes[motor];
-        let m = self.mech(motor, x);
-        let invert = self.globals[0][gp::END_SWITCH_POLARITY as usize] == 1;
-        (w.left_pressed(m) ^ invert, w.right_pressed(m) ^ invert, w.home_pressed(m))
-    }
-
-    pub(crate) fn stops_at(&self, motor: usize, x: f64) -> motion::Stops {
-        if self.axes[motor].rfs.is_some() {
-            // AP 12/13 do not influence the reference search.
-            return motion::Stops::default();
-        }
-        let (left, right, _) = self.switches_at(motor, x);
-        let p = &self.axes[motor].params;
-        motion::Stops {
-            block_positive: right && p[ap::RIGHT_SWITCH_DISABLE as usize] == 0,
-            block_negative: left && p[ap::LEFT_SWITCH_DISABLE as usize] == 0,
-            soft: p[ap::SOFT_STOP as usize] == 1,
-        }
-    }
-
-    /// Ramp settings of an axis in µsteps and seconds.
-    pub(crate) fn ramp(&self, motor: usize) -> motion::Ramp {
-        if let Some(r) = self.axes[motor].ramp_override {
-            return r;
-        }
-        let p = &self.axes[motor].params;
-        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
-        let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
-        let mut vmax = p[ap::MAX_SPEED as usize].clamp(0, 2047) as f64;
-        let mut target_velocity = p[ap::TARGET_SPEED as usize] as f64;
-        if self.axes[motor].closed_loop.torque_mode {
-            target_velocity = self.torque_mode_velocity(motor);
-        }
-        if let Some(rfs) = &self.axes[motor].rfs {
-            let slow = p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047) as f64;
-            match rfs.current() {
-                Some(seek) => {
-                    let fast = p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047) as f64;
-                    target_velocity = seek.dir * if seek.fast { fast } else { slow };
-                }
-                None => vmax = slow.max(1.0),
-            }
-        }
-        motion::Ramp {
-            vmax: motion::velocity_pps(vmax, pd),
-            vmin: motion::velocity_pps(p[ap::MIN_SPEED as usize].clamp(0, 2047) as f64, pd),
-            accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
-            accel_velocity: motion::accel_pps2(a.max(1) as f64, rd, pd),
-            target_velocity: motion::velocity_pps(target_velocity, pd),
-        }
     }
 }

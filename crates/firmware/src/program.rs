@@ -4,7 +4,7 @@
 //! The interpreter itself lives in `interpreter.rs`; this file holds the
 //! data it works on, so that a reader sees the machine before the loop.
 
-use crate::module::Registers;
+use crate::state::registers::Registers;
 use tmclsim_protocol::{Instruction, WaitCondition};
 
 /// Subroutine stack depth (manual 3.7.20, 3.7.44).
@@ -43,7 +43,7 @@ pub struct Context {
 }
 
 /// What raises an interrupt, derived from the profile's interrupt table.
-pub use crate::profile::InterruptSource as Source;
+pub use tmclsim_profile::InterruptSource as Source;
 
 /// One executed instruction, for `--trace` and the debugger.
 #[derive(Clone, Debug, PartialEq)]

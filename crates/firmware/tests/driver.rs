@@ -1,23 +1,12 @@
 //! stallGuard2, coolStep, stop on stall, driver faults and lost steps
 //! against the load model of docs/world.md.
 
+mod common;
+
+use common::{MS, load, send};
+
 use tmclsim_firmware::Module;
-use tmclsim_firmware::world::Load;
 use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
-
-const MS: u64 = 1_000_000;
-
-fn send(m: &mut Module, line: &str) -> i32 {
-    let f = Request::new(1, parse_line(line).unwrap()).encode();
-    let r = Reply::decode(&m.handle_frame(&f).unwrap()).unwrap();
-    assert_eq!(r.status, 100, "{line}");
-    r.value
-}
-
-fn load(m: &mut Module, torque: f64) {
-    m.world_mut().axes[0].loads = vec![Load { torque, ..Load::default() }];
-}
 
 fn module() -> Module {
     let mut m = Module::built_in("tmcm-1141").unwrap();

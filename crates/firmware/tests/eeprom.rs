@@ -1,16 +1,11 @@
 //! EEPROM behaviour across power cycles: STAP/RSAP, STGP/RSGP, auto-stored
 //! bank 0, user variables and GP 85, and persistence through the file.
 
-use tmclsim_firmware::{Eeprom, Module, Profile};
-use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
+mod common;
 
-fn send(m: &mut Module, line: &str) -> i32 {
-    let f = Request::new(m.address(), parse_line(line).unwrap()).encode();
-    let r = Reply::decode(&m.handle_frame(&f).unwrap()).unwrap();
-    assert_eq!(r.status, 100, "{line}");
-    r.value
-}
+use common::send;
+
+use tmclsim_firmware::{Eeprom, Module, Profile};
 
 fn power_cycle(m: &Module) -> Module {
     Module::with_eeprom(m.profile().clone(), m.eeprom().clone())

@@ -2,18 +2,12 @@
 //! reference notes): the mnemonic encodes to the golden bytes, and the
 //! module's reply matches where the manual gives one.
 
+mod common;
+
+use common::{frame, hex};
+
 use tmclsim_firmware::Module;
-use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Instruction, Reply, Request, Status};
-
-fn frame(line: &str) -> [u8; 9] {
-    Request::new(1, parse_line(line).unwrap_or_else(|e| panic!("{line}: {e}"))).encode()
-}
-
-fn hex(s: &str) -> [u8; 9] {
-    let v: Vec<u8> = s.split_whitespace().map(|b| u8::from_str_radix(b, 16).unwrap()).collect();
-    v.try_into().unwrap()
-}
 
 #[test]
 fn request_frames_encode_as_printed() {

@@ -2,17 +2,12 @@
 //! (decisions.md rules 23–25): durations, exact final positions, velocity
 //! ramps, limit switches.
 
+mod common;
+
+use common::send;
+
 use tmclsim_firmware::Module;
 use tmclsim_firmware::motion::{self, Motion, Ramp};
-use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
-
-fn send(m: &mut Module, line: &str) -> i32 {
-    let f = Request::new(1, parse_line(line).unwrap()).encode();
-    let r = Reply::decode(&m.handle_frame(&f).unwrap()).unwrap();
-    assert_eq!(r.status, 100, "{line}");
-    r.value
-}
 
 /// Polls AP 8 every `poll` ms and returns the virtual time of arrival.
 fn time_to_reach(m: &mut Module, poll_ms: u64, limit_s: u64) -> f64 {

@@ -1,12 +1,14 @@
 //! Standalone programs on the virtual TMCM-1141: download, control
 //! commands, every flow command, WAIT, interrupts, persistence.
 
+mod common;
+
+use common::{MS, reply, send};
+
 use tmclsim_firmware::Module;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Instruction, Reply, Request};
-
-const MS: u64 = 1_000_000;
+use tmclsim_protocol::{Instruction, Request};
 
 fn module() -> Module {
     Module::built_in("tmcm-1141").unwrap()
@@ -16,34 +18,24 @@ fn raw(m: &mut Module, ins: Instruction) -> [u8; 9] {
     m.handle_frame(&Request::new(1, ins).encode()).expect("reply")
 }
 
-fn send(m: &mut Module, line: &str) -> Reply {
-    Reply::decode(&raw(m, parse_line(line).unwrap())).unwrap()
-}
-
-fn value(m: &mut Module, line: &str) -> i32 {
-    let r = send(m, line);
-    assert_eq!(r.status, 100, "{line}");
-    r.value
-}
-
 /// Downloads source lines (numeric operands) over frames, like the IDE.
 fn download(m: &mut Module, lines: &[&str]) {
-    assert_eq!(send(m, "#132 0 0 0").status, 100);
+    assert_eq!(reply(m, "#132 0 0 0").status, 100);
     for l in lines {
-        let r = send(m, l);
+        let r = reply(m, l);
         assert_eq!(r.status, 101, "{l}");
     }
-    assert_eq!(send(m, "#133 0 0 0").status, 100);
+    assert_eq!(reply(m, "#133 0 0 0").status, 100);
 }
 
 fn run(m: &mut Module, lines: &[&str], for_ms: u64) {
     download(m, lines);
-    assert_eq!(send(m, "#129 1 0 0").status, 100);
+    assert_eq!(reply(m, "#129 1 0 0").status, 100);
     m.advance(for_ms * MS);
 }
 
 fn var(m: &mut Module, n: u8) -> i32 {
-    value(m, &format!("GGP {n}, 2"))
+    send(m, &format!("GGP {n}, 2"))
 }
 
 #[test]
@@ -56,25 +48,25 @@ fn download_read_back_and_status() {
     assert_eq!(f[0], 2);
     assert_eq!(&f[1..8], &stored);
     assert_eq!(f[8], tmclsim_protocol::checksum(&f[..8]));
-    assert_eq!(send(&mut m, "#134 0 0 1024").status, 4);
+    assert_eq!(reply(&mut m, "#134 0 0 1024").status, 4);
     // 135 type 0: mode, wait flag, download pointer.
-    assert_eq!(value(&mut m, "#135 0 0 0"), 4);
-    assert_eq!(value(&mut m, "#129 0 0 0"), 0);
+    assert_eq!(send(&mut m, "#135 0 0 0"), 4);
+    assert_eq!(send(&mut m, "#129 0 0 0"), 0);
     m.advance(MS);
-    let status = value(&mut m, "#135 1 0 0");
+    let status = send(&mut m, "#135 1 0 0");
     assert_eq!(status >> 24, 1, "running");
     assert_eq!(status >> 16 & 0xFF, 1, "waiting");
     assert_eq!(status & 0xFFFF, 2, "program counter after the WAIT");
-    assert_eq!(value(&mut m, "GGP 128, 0"), 1);
-    assert_eq!(value(&mut m, "GGP 130, 0"), 2);
-    assert_eq!(send(&mut m, "#128 0 0 0").status, 100);
-    assert_eq!(value(&mut m, "GGP 128, 0"), 0);
+    assert_eq!(send(&mut m, "GGP 128, 0"), 1);
+    assert_eq!(send(&mut m, "GGP 130, 0"), 2);
+    assert_eq!(reply(&mut m, "#128 0 0 0").status, 100);
+    assert_eq!(send(&mut m, "GGP 128, 0"), 0);
     // Download past the end of memory.
-    send(&mut m, "#132 0 0 1023");
-    assert_eq!(send(&mut m, "MST 0").status, 101);
-    assert_eq!(send(&mut m, "MST 0").status, 4);
-    send(&mut m, "#133 0 0 0");
-    assert_eq!(send(&mut m, "#132 0 0 1024").status, 4);
+    reply(&mut m, "#132 0 0 1023");
+    assert_eq!(reply(&mut m, "MST 0").status, 101);
+    assert_eq!(reply(&mut m, "MST 0").status, 4);
+    reply(&mut m, "#133 0 0 0");
+    assert_eq!(reply(&mut m, "#132 0 0 1024").status, 4);
 }
 
 #[test]
@@ -82,8 +74,8 @@ fn counting_loop_with_compare_and_jump() {
     let mut m = module();
     run(&mut m, &["CALC LOAD, 0", "CALC ADD, 1", "COMP 100", "JC LT, 1", "AGP 7, 2", "STOP"], 100);
     assert_eq!(var(&mut m, 7), 100);
-    assert_eq!(value(&mut m, "GGP 128, 0"), 0, "STOP ends the program");
-    assert_eq!(value(&mut m, "#135 2 0 0"), 100);
+    assert_eq!(send(&mut m, "GGP 128, 0"), 0, "STOP ends the program");
+    assert_eq!(send(&mut m, "#135 2 0 0"), 100);
 }
 
 #[test]
@@ -199,7 +191,7 @@ fn wait_pos_and_timeout_sets_eto() {
     assert_eq!(var(&mut m, 41), 1, "CLE cleared the flag");
     // WAIT POS without timeout ends when the motor arrives.
     let mut m = module();
-    send(&mut m, "SAP 4, 0, 2047");
+    reply(&mut m, "SAP 4, 0, 2047");
     run(&mut m, &["MVP ABS, 0, 5000", "WAIT POS, 0, 0", "GAP 1, 0", "AGP 42, 2", "STOP"], 5000);
     assert_eq!(var(&mut m, 42), 5000);
 }
@@ -289,8 +281,8 @@ fn input_change_interrupt_with_trigger_transition() {
 fn target_reached_and_stop_switch_interrupts() {
     let mut m = module();
     m.world_mut().axes[0].right_switch = Some(20000.0);
-    send(&mut m, "SAP 4, 0, 2047");
-    send(&mut m, "SGP 28, 3, 1");
+    reply(&mut m, "SAP 4, 0, 2047");
+    reply(&mut m, "SGP 28, 3, 1");
     let prog = [
         "VECT 3, 8",
         "VECT 28, 10",
@@ -307,20 +299,20 @@ fn target_reached_and_stop_switch_interrupts() {
     ];
     run(&mut m, &prog, 3000);
     assert_eq!(var(&mut m, 90), 1);
-    send(&mut m, "MVP ABS, 0, 30000");
+    reply(&mut m, "MVP ABS, 0, 30000");
     m.advance(3000 * MS);
     assert_eq!(var(&mut m, 91), 1);
-    assert_eq!(value(&mut m, "GAP 1, 0"), 20000);
+    assert_eq!(send(&mut m, "GAP 1, 0"), 20000);
 }
 
 #[test]
 fn direct_mode_keeps_working_and_leaves_the_accumulator_alone() {
     let mut m = module();
     run(&mut m, &["CALC LOAD, 77", "WAIT TICKS, 0, 100", "AGP 5, 2", "STOP"], 10);
-    assert_eq!(value(&mut m, "GAP 4, 0"), 1000);
-    value(&mut m, "GGP 66, 0");
-    value(&mut m, "GIO 0, 0");
-    send(&mut m, "SAP 4, 0, 1500");
+    assert_eq!(send(&mut m, "GAP 4, 0"), 1000);
+    send(&mut m, "GGP 66, 0");
+    send(&mut m, "GIO 0, 0");
+    reply(&mut m, "SAP 4, 0, 1500");
     m.advance(2000 * MS);
     assert_eq!(var(&mut m, 5), 77);
 }
@@ -329,20 +321,20 @@ fn direct_mode_keeps_working_and_leaves_the_accumulator_alone() {
 fn step_and_breakpoints() {
     let mut m = module();
     download(&mut m, &["CALC LOAD, 1", "CALC ADD, 2", "CALC ADD, 3", "STOP"]);
-    send(&mut m, "#130 0 0 0");
+    reply(&mut m, "#130 0 0 0");
     assert_eq!(m.registers().accumulator, 1);
-    send(&mut m, "#130 0 0 0");
+    reply(&mut m, "#130 0 0 0");
     assert_eq!(m.registers().accumulator, 3);
-    assert_eq!(value(&mut m, "GGP 128, 0"), 2, "step mode");
-    send(&mut m, "#131 0 0 0");
+    assert_eq!(send(&mut m, "GGP 128, 0"), 2, "step mode");
+    reply(&mut m, "#131 0 0 0");
     assert_eq!(m.registers().accumulator, 0);
     assert_eq!(m.program().pc, 0);
     m.set_breakpoints(&[2]);
-    send(&mut m, "#129 0 0 0");
+    reply(&mut m, "#129 0 0 0");
     m.advance(10 * MS);
     assert_eq!(m.program().hit_breakpoint, Some(2));
     assert_eq!(m.registers().accumulator, 3);
-    send(&mut m, "#129 0 0 0");
+    reply(&mut m, "#129 0 0 0");
     m.advance(10 * MS);
     assert_eq!(m.registers().accumulator, 6);
     assert_eq!(m.program().mode, RunMode::Stop);
@@ -352,8 +344,8 @@ fn step_and_breakpoints() {
 fn programs_persist_and_autostart() {
     let mut m = module();
     download(&mut m, &["CALCV ADD, 3, 1", "STOP"]);
-    send(&mut m, "SGP 77, 0, 1");
-    send(&mut m, "#255 0 0 1234");
+    reply(&mut m, "SGP 77, 0, 1");
+    reply(&mut m, "#255 0 0 1234");
     m.advance(10 * MS);
     assert_eq!(var(&mut m, 3), 1, "autostarted after the reset");
     let mut m2 = Module::with_eeprom(m.profile().clone(), m.eeprom().clone());
@@ -366,11 +358,11 @@ fn programs_persist_and_autostart() {
 fn code_protection() {
     let mut m = module();
     download(&mut m, &["STOP"]);
-    send(&mut m, "SGP 81, 0, 1");
-    assert_eq!(send(&mut m, "#134 0 0 0").status, 5, "protected against reading");
-    send(&mut m, "SGP 81, 0, 2");
+    reply(&mut m, "SGP 81, 0, 1");
+    assert_eq!(reply(&mut m, "#134 0 0 0").status, 5, "protected against reading");
+    reply(&mut m, "SGP 81, 0, 2");
     assert_eq!(raw(&mut m, Instruction::new(134, 0, 0, 0))[1], 0, "lifting read protection erased the program");
-    assert_eq!(send(&mut m, "#132 0 0 0").status, 5, "protected against overwriting");
+    assert_eq!(reply(&mut m, "#132 0 0 0").status, 5, "protected against overwriting");
 }
 
 #[test]
@@ -409,7 +401,7 @@ fn random_programs_never_panic_or_hang() {
         m.load_program(&words).unwrap();
         m.start_program();
         m.advance(200 * MS);
-        send(&mut m, "#128 0 0 0");
+        reply(&mut m, "#128 0 0 0");
     }
 }
 
@@ -447,6 +439,6 @@ fn one_long_advance_equals_many_short_ones() {
         let trips = var(&mut short, 51);
         assert!(trips > 10, "the stepped module made {trips} trips to {far}");
         assert_eq!(var(&mut long, 51), trips, "trips to {far}");
-        assert_eq!(value(&mut long, "GAP 1, 0"), value(&mut short, "GAP 1, 0"));
+        assert_eq!(send(&mut long, "GAP 1, 0"), send(&mut short, "GAP 1, 0"));
     }
 }

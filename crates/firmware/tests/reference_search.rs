@@ -1,18 +1,13 @@
 //! Reference search modes against a world with switches at known
 //! positions: the zero point, AP 196, AP 197 and the direction sequence.
 
+mod common;
+
+use common::{MS, send};
+
 use tmclsim_firmware::Module;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
-
-const MS: u64 = 1_000_000;
-
-fn send(m: &mut Module, line: &str) -> i32 {
-    let f = Request::new(1, parse_line(line).unwrap()).encode();
-    let r = Reply::decode(&m.handle_frame(&f).unwrap()).unwrap();
-    assert_eq!(r.status, 100, "{line}");
-    r.value
-}
 
 /// Left stop switch pressed from −20000 down to −22000, right from 30000
 /// up to 32000, home switch between 5000 and 6000.

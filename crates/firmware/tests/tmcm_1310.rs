@@ -2,31 +2,16 @@
 //! the status word, the deviation interrupt, ABN and SSI encoders and a
 //! lost encoder signal.
 
-use tmclsim_firmware::world::Load;
+mod common;
+
+use common::{MS, load, reply, send};
+
 use tmclsim_firmware::{Eeprom, Module, Profile, World};
 use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
-
-const MS: u64 = 1_000_000;
 
 fn module() -> Module {
     let p = Profile::built_in("tmcm-1310").unwrap();
     Module::with_world(p, Eeprom::new("TMCM-1310"), World::free(1))
-}
-
-fn reply(m: &mut Module, line: &str) -> Reply {
-    let f = Request::new(1, parse_line(line).unwrap()).encode();
-    Reply::decode(&m.handle_frame(&f).unwrap()).unwrap()
-}
-
-fn send(m: &mut Module, line: &str) -> i32 {
-    let r = reply(m, line);
-    assert_eq!(r.status, 100, "{line}");
-    r.value
-}
-
-fn load(m: &mut Module, torque: f64) {
-    m.world_mut().axes[0].loads = vec![Load { torque, ..Load::default() }];
 }
 
 fn setup(m: &mut Module, closed: bool) {

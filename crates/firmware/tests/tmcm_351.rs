@@ -3,31 +3,17 @@
 //! SAC, the commands it lacks, its reference search, stall detection and
 //! encoders.
 
+mod common;
+
+use common::{MS, hex, reply, send};
+
 use tmclsim_firmware::world::Load;
 use tmclsim_firmware::{Module, World};
+use tmclsim_protocol::Request;
 use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
-
-const MS: u64 = 1_000_000;
 
 fn module() -> Module {
     Module::built_in("tmcm-351").unwrap()
-}
-
-fn reply(m: &mut Module, line: &str) -> Reply {
-    let f = Request::new(1, parse_line(line).unwrap()).encode();
-    Reply::decode(&m.handle_frame(&f).unwrap()).unwrap()
-}
-
-fn send(m: &mut Module, line: &str) -> i32 {
-    let r = reply(m, line);
-    assert_eq!(r.status, 100, "{line}");
-    r.value
-}
-
-fn hex(s: &str) -> [u8; 9] {
-    let v: Vec<u8> = s.split_whitespace().map(|b| u8::from_str_radix(b, 16).unwrap()).collect();
-    v.try_into().unwrap()
 }
 
 #[test]

@@ -1,12 +1,13 @@
 //! The control socket's line protocol: commands change the world and the
 //! link; bad lines get a readable error.
 
+mod common;
+
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::time::Duration;
 use tmclsim_firmware::{Eeprom, Module, Profile, World};
-use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
+use tmclsim_protocol::Reply;
 use tmclsim_server::{ServerConfig, start};
 
 #[test]
@@ -39,7 +40,7 @@ fn control_lines_change_the_world_and_the_link() {
     let mut s = TcpStream::connect(server.endpoints().tcp.unwrap()).unwrap();
     s.set_read_timeout(Some(Duration::from_millis(300))).unwrap();
     let mut ask = |line: &str| -> Option<[u8; 9]> {
-        s.write_all(&Request::new(1, parse_line(line).unwrap()).encode()).unwrap();
+        s.write_all(&common::frame(line)).unwrap();
         let mut b = [0u8; 9];
         s.read_exact(&mut b).ok().map(|_| b)
     };

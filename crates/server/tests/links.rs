@@ -1,12 +1,14 @@
 //! The server's links: TCP (several clients), the pty (reopened by the
 //! host), resynchronisation after a lost byte, 138 events, GP 75, GP 68.
 
+mod common;
+
+use common::{ask, frame, read_reply};
+
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::time::{Duration, Instant};
 use tmclsim_firmware::Module;
-use tmclsim_protocol::mnemonic::parse_line;
-use tmclsim_protocol::{Reply, Request};
 use tmclsim_server::{ServerConfig, ServerHandle, start};
 
 fn serve_tcp() -> ServerHandle {
@@ -14,26 +16,11 @@ fn serve_tcp() -> ServerHandle {
     start(Module::built_in("tmcm-1141").unwrap(), config).unwrap()
 }
 
-fn frame(line: &str) -> [u8; 9] {
-    Request::new(1, parse_line(line).unwrap()).encode()
-}
-
 fn connect(server: &ServerHandle) -> TcpStream {
     let s = TcpStream::connect(server.endpoints().tcp.unwrap()).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     s.set_nodelay(true).unwrap();
     s
-}
-
-fn read_reply(s: &mut impl Read) -> Reply {
-    let mut buf = [0u8; 9];
-    s.read_exact(&mut buf).unwrap();
-    Reply::decode(&buf).expect("reply checksum")
-}
-
-fn ask(s: &mut (impl Read + Write), line: &str) -> Reply {
-    s.write_all(&frame(line)).unwrap();
-    read_reply(s)
 }
 
 #[test]

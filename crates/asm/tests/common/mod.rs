@@ -5,6 +5,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use tmclsim_asm::{MemoryResolver, Profile, Program, assemble};
+use tmclsim_firmware::Module;
+use tmclsim_protocol::mnemonic::parse_line;
+use tmclsim_protocol::{Reply, Request};
+
+/// One millisecond of virtual time.
+pub const MS: u64 = 1_000_000;
 
 pub fn tmcm_1141() -> Arc<Profile> {
     Profile::built_in("tmcm-1141").expect("built-in profile")
@@ -69,4 +75,13 @@ impl Rng {
     pub fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
         &items[self.below(items.len() as u64) as usize]
     }
+}
+
+/// Sends a command (mnemonic or `#op type motor value`) to module address
+/// 1; it must succeed (status 100). Returns its value.
+pub fn send(m: &mut Module, line: &str) -> i32 {
+    let f = Request::new(1, parse_line(line).unwrap()).encode();
+    let r = Reply::decode(&m.handle_frame(&f).unwrap()).unwrap();
+    assert_eq!(r.status, 100, "{line}");
+    r.value
 }

@@ -1,7 +1,12 @@
-//! Starting the real `tmclsim serve` process in tests.
+//! Starting the real `tmclsim serve` process in tests, and talking to it
+//! in frames over TCP.
+#![allow(dead_code)]
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
+use tmclsim_protocol::mnemonic::parse_line;
+use tmclsim_protocol::{Reply, Request};
 
 /// Starts `tmclsim serve` with `args` (plus `--tcp 127.0.0.1:0`) and waits
 /// until it serves; returns the process and its TCP endpoint. Its stdout
@@ -31,4 +36,19 @@ pub fn serve(args: &[&str], stderr: Stdio) -> (Child, String) {
         let _ = out.read_to_end(&mut sink);
     });
     (child, tcp.expect("the server printed its tcp endpoint"))
+}
+
+/// The request frame of a command (mnemonic or `#op type motor value`) to
+/// module address 1.
+pub fn frame(line: &str) -> [u8; 9] {
+    Request::new(1, parse_line(line).unwrap()).encode()
+}
+
+/// Sends a command and reads the reply; `None` when the connection fails
+/// or the reply is not a valid frame.
+pub fn ask(s: &mut TcpStream, line: &str) -> Option<Reply> {
+    s.write_all(&frame(line)).ok()?;
+    let mut buf = [0u8; 9];
+    s.read_exact(&mut buf).ok()?;
+    Reply::decode(&buf)
 }

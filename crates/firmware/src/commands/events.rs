@@ -1,0 +1,129 @@
+//! Interrupt configuration and events: EI, DI, VECT, and 138, which arms
+//! the target-reached events of MVP; the event frames it produces.
+
+use crate::commands::Exec;
+use crate::module::Module;
+use tmclsim_protocol::{Command, FRAME_LEN, Reply, Status, opcode};
+
+impl Module {
+    /// EI, DI, VECT, 138.
+    pub(crate) fn event_command(&mut self, cmd: Command, echo: i32) -> Exec {
+        use Command::*;
+        match cmd {
+            Ei { interrupt } | Di { interrupt } => {
+                let enable = matches!(cmd, Ei { .. });
+                if interrupt == 255 {
+                    self.interrupts.global = enable;
+                } else {
+                    self.profile.interrupt(interrupt).ok_or(Status::WrongType)?;
+                    self.interrupts.enabled[interrupt as usize] = enable;
+                }
+                Ok(echo)
+            }
+            Vect { interrupt, address } => {
+                if interrupt == 255 || self.profile.interrupt(interrupt).is_none() {
+                    return Err(Status::WrongType);
+                }
+                if address < 0 || address >= self.profile.module.program_memory as i32 {
+                    return Err(Status::InvalidValue);
+                }
+                self.interrupts.vectors[interrupt as usize] = Some(address as u16);
+                Ok(echo)
+            }
+            TargetReachedEvent { every_move, mask } => {
+                let valid = (1u32 << self.axes.len()) - 1;
+                if mask <= 0 || mask as u32 & !valid != 0 {
+                    return Err(Status::InvalidValue);
+                }
+                self.interrupts.event_arm = Some((every_move, mask as u32));
+                Ok(mask)
+            }
+            _ => unreachable!("not an interrupt or event command: {cmd:?}"),
+        }
+    }
+
+    /// Unsolicited frames (138 events) produced since the last call.
+    pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
+        std::mem::take(&mut self.interrupts.events)
+    }
+
+    pub fn has_events(&self) -> bool {
+        !self.interrupts.events.is_empty()
+    }
+
+    pub(crate) fn push_event(&mut self, mask: u32) {
+        let reply = Reply::new(self.host_address(), self.link.last_address, Status::Event, opcode::TARGET_REACHED_EVENT, mask as i32);
+        self.interrupts.events.push(reply.encode());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::test_support::{direct, module, ok, status};
+    use tmclsim_protocol::{Reply, Status};
+
+    const MS: u64 = 1_000_000;
+
+    #[test]
+    fn ei_di_and_vect() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "EI 0");
+        assert!(m.interrupts.enabled[0] && !m.interrupts.global);
+        ok(&mut m, "EI 255");
+        assert!(m.interrupts.global);
+        ok(&mut m, "DI 0");
+        assert!(!m.interrupts.enabled[0]);
+        ok(&mut m, "DI 255");
+        assert!(!m.interrupts.global);
+        assert_eq!(status(&mut m, "EI 4"), Status::WrongType, "no interrupt 4 on the TMCM-1141");
+        ok(&mut m, "VECT 0, 50");
+        assert_eq!(m.interrupts.vectors[0], Some(50));
+        assert_eq!(status(&mut m, "VECT 255, 50"), Status::WrongType);
+        assert_eq!(status(&mut m, "VECT 0, 2048"), Status::InvalidValue, "outside program memory");
+        assert_eq!(status(&mut m, "VECT 0, -1"), Status::InvalidValue);
+    }
+
+    #[test]
+    fn arming_138_checks_the_mask() {
+        let mut m = module("tmcm-1141");
+        assert_eq!(direct(&mut m, "#138 0 0 1"), (Status::Ok, 1));
+        assert_eq!(m.interrupts.event_arm, Some((false, 1)));
+        assert_eq!(direct(&mut m, "#138 1 0 1"), (Status::Ok, 1));
+        assert_eq!(m.interrupts.event_arm, Some((true, 1)));
+        assert_eq!(status(&mut m, "#138 0 0 2"), Status::InvalidValue, "one motor");
+        assert_eq!(status(&mut m, "#138 0 0 0"), Status::InvalidValue);
+        assert_eq!(status(&mut m, "#138 0 0 -1"), Status::InvalidValue);
+        assert_eq!(m.interrupts.event_arm, Some((true, 1)), "a refused arming changes nothing");
+        let mut m = module("tmcm-351");
+        assert_eq!(status(&mut m, "#138 0 0 1"), Status::InvalidCommand, "the TMCM-351 lacks 138");
+    }
+
+    #[test]
+    fn the_next_move_reports_its_arrival_once() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "SAP 4, 0, 2047");
+        ok(&mut m, "#138 0 0 1");
+        ok(&mut m, "MVP ABS, 0, 2000");
+        assert!(m.interrupts.event_arm.is_none(), "used up by the move");
+        m.advance(1_000 * MS);
+        let events = m.take_events();
+        assert_eq!(events.len(), 1);
+        let e = Reply::decode(&events[0]).unwrap();
+        assert_eq!((e.status, e.opcode, e.value), (Status::Event.code(), 138, 1));
+        ok(&mut m, "MVP ABS, 0, 0");
+        m.advance(1_000 * MS);
+        assert!(!m.has_events());
+    }
+
+    #[test]
+    fn every_move_and_a_move_already_there() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "#138 1 0 1");
+        ok(&mut m, "MVP ABS, 0, 0");
+        assert_eq!(m.take_events().len(), 1, "already at the target: at once");
+        ok(&mut m, "MVP ABS, 0, 0");
+        assert_eq!(m.take_events().len(), 1, "armed for every move");
+        ok(&mut m, "ROR 0, 10");
+        assert!(!m.axes[0].notify_on_arrival);
+    }
+}

@@ -1,0 +1,362 @@
+//! The parameter commands: SAP, GAP, STAP, RSAP, AAP for axis parameters
+//! and SGP, GGP, STGP, RSGP, AGP for global parameters — their access and
+//! range checks, the side effects of writes and the measured values reads
+//! compute.
+
+use crate::closed_loop::cl;
+use crate::commands::Exec;
+use crate::module::Module;
+use crate::motion::{self, RampMode};
+use crate::outcome::Origin;
+use crate::parameter_numbers::{ap, gp};
+use tmclsim_profile::{Access, Parameter};
+use tmclsim_protocol::{Command, Instruction, Status};
+
+impl Module {
+    /// SAP, GAP, STAP, RSAP, AAP, SGP, GGP, STGP, RSGP, AGP.
+    pub(crate) fn parameter_command(&mut self, cmd: Command, echo: i32, origin: Origin) -> Exec {
+        use Command::*;
+        match cmd {
+            Sap { param, motor, value } => self.set_axis_parameter(param, motor, value).map(|_| echo),
+            Aap { param, motor } => self.set_axis_parameter(param, motor, self.registers.accumulator).map(|_| echo),
+            Gap { param, motor } => {
+                let v = self.get_axis_parameter(param, motor)?;
+                Ok(self.loaded(v, origin))
+            }
+            Stap { param, motor } => {
+                let m = self.motor(motor)?;
+                self.axis_spec(param, |a| a.eeprom)?;
+                if self.eeprom_locked() {
+                    return Err(Status::EepromLocked);
+                }
+                let v = self.axes[m].params[param as usize];
+                self.persistence.eeprom.set_axis(motor, param, v);
+                self.persistence.mark_written();
+                Ok(echo)
+            }
+            Rsap { param, motor } => {
+                let m = self.motor(motor)?;
+                let spec = self.axis_spec(param, |a| a.eeprom)?;
+                let v = self.persistence.eeprom.axis(motor, param).unwrap_or(spec.default_word());
+                self.write_axis_parameter(m, param, v);
+                Ok(echo)
+            }
+            Sgp { param, bank, value } => self.set_global_parameter(param, bank, value).map(|_| echo),
+            Agp { param, bank } => self.set_global_parameter(param, bank, self.registers.accumulator).map(|_| echo),
+            Ggp { param, bank } => {
+                let v = self.get_global_parameter(param, bank)?;
+                Ok(self.loaded(v, origin))
+            }
+            Stgp { param, bank } => {
+                self.global_spec(param, bank, |a| a.eeprom)?;
+                if self.eeprom_locked() {
+                    return Err(Status::EepromLocked);
+                }
+                let v = self.globals[bank as usize][param as usize];
+                self.persistence.store_global(bank, param, v);
+                Ok(echo)
+            }
+            Rsgp { param, bank } => {
+                let spec = self.global_spec(param, bank, |a| a.eeprom)?;
+                let v = self.persistence.eeprom.global(bank, param).unwrap_or(spec.default_word());
+                self.globals[bank as usize][param as usize] = v;
+                Ok(echo)
+            }
+            _ => unreachable!("not a parameter command: {cmd:?}"),
+        }
+    }
+
+    pub fn set_axis_parameter(&mut self, param: u8, motor: u8, value: i32) -> Result<(), Status> {
+        let m = self.motor(motor)?;
+        let spec = self.axis_spec(param, |a| a.write)?;
+        if !spec.accepts(value) {
+            return Err(Status::InvalidValue);
+        }
+        self.write_axis_parameter(m, param, value);
+        Ok(())
+    }
+
+    pub fn get_axis_parameter(&mut self, param: u8, motor: u8) -> Result<i32, Status> {
+        let m = self.motor(motor)?;
+        self.axis_spec(param, |a| a.read)?;
+        Ok(self.read_axis_parameter(m, param))
+    }
+
+    fn axis_spec(&self, param: u8, need: impl Fn(Access) -> bool) -> Result<&Parameter, Status> {
+        let spec = self.profile.axis_parameter(param).ok_or(Status::WrongType)?;
+        if need(spec.access) { Ok(spec) } else { Err(Status::WrongType) }
+    }
+
+    /// Writes a parameter with its side effects (no access check).
+    pub(crate) fn write_axis_parameter(&mut self, m: usize, param: u8, value: i32) {
+        match param {
+            ap::TARGET_POSITION => self.set_target(m, value),
+            ap::ACTUAL_POSITION => {
+                let target = self.axes[m].target_word;
+                let sign = self.shaft_sign();
+                let axis = &mut self.axes[m];
+                // The carriage does not move: only the counter changes.
+                let mech = axis.motion.x * sign + axis.mech_offset;
+                axis.motion.x = value as f64;
+                axis.mech_offset = mech - axis.motion.x * sign;
+                self.set_target(m, target);
+                self.closed_loop_sync(m);
+            }
+            ap::RAMP_MODE => {
+                let axis = &mut self.axes[m];
+                axis.set_ramp_mode(RampMode::from_code(value));
+                // AP 138 keeps the word as written.
+                axis.params[param as usize] = value;
+            }
+            ap::ENCODER_POSITION if self.has_closed_loop() => {
+                let now = self.closed_loop_encoder(m) as f64 - self.axes[m].closed_loop.encoder_offset;
+                self.axes[m].closed_loop.encoder_offset = value as f64 - now;
+            }
+            ap::ENCODER_POSITION => {
+                let now = self.encoder_position(m) as i64 - self.axes[m].encoder_offset;
+                self.axes[m].encoder_offset = value as i64 - now;
+            }
+            cl::TORQUE_TARGET if self.has_closed_loop() => {
+                // Torque mode: the driver sets this current (mA).
+                let axis = &mut self.axes[m];
+                axis.params[param as usize] = value;
+                axis.end_overrides();
+                axis.closed_loop.torque_mode = true;
+                axis.set_ramp_mode(RampMode::Velocity);
+            }
+            cl::MODE if self.has_closed_loop() => {
+                self.axes[m].params[param as usize] = value;
+                self.closed_loop_sync(m);
+            }
+            _ => self.axes[m].params[param as usize] = value,
+        }
+    }
+
+    /// Reads a parameter, computing the measured ones.
+    pub(crate) fn read_axis_parameter(&mut self, m: usize, param: u8) -> i32 {
+        if let Some(v) = self.read_closed_loop(m, param) {
+            return v;
+        }
+        let pd = self.axes[m].params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        let rd = self.axes[m].params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
+        let motion = &self.axes[m].motion;
+        match param {
+            ap::TARGET_POSITION => self.axes[m].target_word,
+            ap::ACTUAL_POSITION => self.actual_position(m),
+            ap::ACTUAL_SPEED => self.actual_speed(m),
+            ap::ACTUAL_ACCELERATION => motion::accel_internal(motion.a, rd, pd).round().clamp(-2047.0, 2047.0) as i32,
+            ap::POSITION_REACHED => (self.actual_position(m) == self.axes[m].target_word) as i32,
+            ap::LEFT_SWITCH => self.switches(m).0 as i32,
+            ap::RIGHT_SWITCH => self.switches(m).1 as i32,
+            ap::HOME_SWITCH => self.switches(m).2 as i32,
+            ap::ACTUAL_CURRENT => self.current_scale(m).round() as i32,
+            ap::LOAD_VALUE => self.axes[m].driver.load_value,
+            ap::ENCODER_POSITION if self.profile.features.encoder != tmclsim_profile::Encoder::None => self.encoder_position(m),
+            ap::DRIVER_ERROR_FLAGS => self.driver_flags(m),
+            ap::EXTENDED_ERROR_FLAGS => {
+                // Cleared by reading.
+                std::mem::take(&mut self.axes[m].params[param as usize])
+            }
+            _ => self.axes[m].params[param as usize],
+        }
+    }
+
+    pub fn set_global_parameter(&mut self, param: u8, bank: u8, value: i32) -> Result<(), Status> {
+        let spec = self.global_spec(param, bank, |a| a.write)?;
+        if !spec.accepts(value) {
+            return Err(Status::InvalidValue);
+        }
+        let auto = spec.access.auto;
+        if bank == 0 && self.profile.features.eeprom_lock == Some(param) {
+            // 1234 locks, 4321 unlocks; the state itself is kept.
+            let locked = match value {
+                1234 => 1,
+                4321 => 0,
+                _ => return Err(Status::InvalidValue),
+            };
+            self.globals[0][param as usize] = locked;
+            self.persistence.store_global(0, param, locked);
+            return Ok(());
+        }
+        if auto && self.eeprom_locked() {
+            return Err(Status::EepromLocked);
+        }
+        match (bank, param) {
+            (0, gp::TICK_TIMER) => self.globals.set_tick_timer(self.now_ns, value as i64),
+            (0, gp::RANDOM) => self.globals.seed_random(value),
+            (0, gp::CODE_PROTECTION) => {
+                let old = self.globals[0][param as usize];
+                if matches!(old, 1 | 3) && matches!(value, 0 | 2) {
+                    // Lifting the protection against reading erases the program.
+                    for w in self.program.memory.iter_mut() {
+                        *w = Instruction::default();
+                    }
+                    self.program.reset();
+                    self.persistence.eeprom.program.clear();
+                    self.persistence.mark_written();
+                }
+                self.globals[0][param as usize] = value;
+            }
+            (3, _) => {
+                self.globals[3][param as usize] = value;
+                // A new period restarts the timer.
+                if let Some(t) = self.program.timers.get_mut(param as usize) {
+                    *t = None;
+                }
+            }
+            _ => self.globals[bank as usize][param as usize] = value,
+        }
+        if auto {
+            self.persistence.store_global(bank, param, value);
+        }
+        Ok(())
+    }
+
+    pub fn get_global_parameter(&mut self, param: u8, bank: u8) -> Result<i32, Status> {
+        self.global_spec(param, bank, |a| a.read)?;
+        Ok(match (bank, param) {
+            (0, gp::TICK_TIMER) => self.globals.tick_timer(self.now_ns),
+            (0, gp::APPLICATION_STATUS) => self.program.mode as i32,
+            (0, gp::DOWNLOAD_MODE) => self.program.download.is_some() as i32,
+            (0, gp::PROGRAM_COUNTER) => self.program.pc as i32,
+            (0, gp::RANDOM) => self.globals.random(),
+            _ => self.globals[bank as usize][param as usize],
+        })
+    }
+
+    fn global_spec(&self, param: u8, bank: u8, need: impl Fn(Access) -> bool) -> Result<&Parameter, Status> {
+        if !self.profile.has_bank(bank) {
+            return Err(Status::InvalidValue);
+        }
+        let spec = self.profile.global_parameter(bank, param).ok_or(Status::WrongType)?;
+        if need(spec.access) { Ok(spec) } else { Err(Status::WrongType) }
+    }
+
+    /// The lock parameter (features `eeprom_lock`, GP 73 on the TMCM-351)
+    /// reads 1: the configuration EEPROM is locked.
+    pub(crate) fn eeprom_locked(&self) -> bool {
+        self.profile.features.eeprom_lock.is_some_and(|n| self.globals[0][n as usize] == 1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::state::registers::Compare;
+    use crate::test_support::{direct, in_program, module, ok, status};
+    use tmclsim_protocol::Status;
+
+    #[test]
+    fn sap_range_and_access_statuses() {
+        let mut m = module("tmcm-1141");
+        assert_eq!(direct(&mut m, "SAP 4, 0, 2047"), (Status::Ok, 2047));
+        assert_eq!(direct(&mut m, "SAP 4, 0, 2048"), (Status::InvalidValue, 2048), "above the range");
+        assert_eq!(status(&mut m, "SAP 4, 0, 0"), Status::InvalidValue, "below the range");
+        assert_eq!(status(&mut m, "SAP 3, 0, 1"), Status::WrongType, "read-only");
+        assert_eq!(status(&mut m, "SAP 250, 0, 1"), Status::WrongType, "not in the table");
+        assert_eq!(status(&mut m, "SAP 4, 1, 100"), Status::InvalidValue, "no motor 1");
+        assert_eq!(status(&mut m, "GAP 14, 0"), Status::WrongType);
+        assert_eq!(status(&mut m, "GAP 4, 1"), Status::InvalidValue);
+        assert_eq!(ok(&mut m, "GAP 4, 0"), 2047, "a failed SAP changes nothing");
+    }
+
+    #[test]
+    fn aap_and_agp_write_the_accumulator() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "CALC LOAD, 1500");
+        ok(&mut m, "AAP 4, 0");
+        assert_eq!(ok(&mut m, "GAP 4, 0"), 1500);
+        ok(&mut m, "CALC LOAD, 9");
+        ok(&mut m, "AGP 10, 2");
+        assert_eq!(ok(&mut m, "GGP 10, 2"), 9);
+        ok(&mut m, "CALC LOAD, 5000");
+        assert_eq!(status(&mut m, "AAP 4, 0"), Status::InvalidValue, "the range applies");
+    }
+
+    #[test]
+    fn reads_load_the_accumulator_only_in_a_program() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "SAP 4, 0, 321");
+        assert_eq!(ok(&mut m, "GAP 4, 0"), 321);
+        assert_eq!(m.registers.accumulator, 0);
+        assert_eq!(in_program(&mut m, "GAP 4, 0"), Ok(321));
+        assert_eq!((m.registers.accumulator, m.registers.compare), (321, Compare::Greater));
+        assert_eq!(in_program(&mut m, "GGP 66, 0"), Ok(1));
+        assert_eq!(m.registers.accumulator, 1);
+    }
+
+    #[test]
+    fn stap_and_rsap_go_through_the_eeprom() {
+        let mut m = module("tmcm-1141");
+        let written = m.eeprom_generation();
+        ok(&mut m, "SAP 4, 0, 1000");
+        ok(&mut m, "STAP 4, 0");
+        assert!(m.eeprom_generation() > written);
+        assert_eq!(m.eeprom().axis(0, 4), Some(1000));
+        ok(&mut m, "SAP 4, 0, 10");
+        ok(&mut m, "RSAP 4, 0");
+        assert_eq!(ok(&mut m, "GAP 4, 0"), 1000);
+        assert_eq!(status(&mut m, "STAP 6, 0"), Status::WrongType, "AP 6 is not stored");
+        // RSAP of a parameter never stored: the default.
+        ok(&mut m, "SAP 5, 0, 7");
+        ok(&mut m, "RSAP 5, 0");
+        assert_eq!(ok(&mut m, "GAP 5, 0"), m.profile().axis_parameter(5).unwrap().default as i32);
+    }
+
+    #[test]
+    fn global_parameters_banks_and_automatic_storage() {
+        let mut m = module("tmcm-1141");
+        assert_eq!(status(&mut m, "GGP 0, 1"), Status::InvalidValue, "no bank 1");
+        assert_eq!(status(&mut m, "GGP 0, 4"), Status::InvalidValue);
+        assert_eq!(status(&mut m, "SGP 128, 0, 1"), Status::WrongType, "read-only");
+        assert_eq!(status(&mut m, "SGP 65, 0, 9"), Status::InvalidValue);
+        // Bank 0 parameters with A are stored by SGP itself.
+        let written = m.eeprom_generation();
+        ok(&mut m, "SGP 76, 0, 5");
+        assert_eq!((m.eeprom().global(0, 76), m.eeprom_generation()), (Some(5), written + 1));
+        // User variables: STGP/RSGP.
+        ok(&mut m, "SGP 7, 2, 1234");
+        ok(&mut m, "STGP 7, 2");
+        ok(&mut m, "SGP 7, 2, 0");
+        ok(&mut m, "RSGP 7, 2");
+        assert_eq!(ok(&mut m, "GGP 7, 2"), 1234);
+    }
+
+    #[test]
+    fn eeprom_lock_gp73() {
+        let mut m = module("tmcm-351");
+        assert_eq!(status(&mut m, "SGP 73, 0, 1"), Status::InvalidValue, "1234 locks, 4321 unlocks");
+        ok(&mut m, "SGP 73, 0, 1234");
+        assert_eq!(ok(&mut m, "GGP 73, 0"), 1);
+        assert_eq!(status(&mut m, "STAP 4, 0"), Status::EepromLocked);
+        assert_eq!(status(&mut m, "STGP 0, 2"), Status::EepromLocked);
+        ok(&mut m, "SGP 73, 0, 4321");
+        assert_eq!(ok(&mut m, "GGP 73, 0"), 0);
+        assert_eq!(status(&mut m, "STAP 4, 0"), Status::Ok);
+    }
+
+    #[test]
+    fn ramp_mode_and_measured_values() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "SAP 138, 0, 2");
+        assert_eq!(m.axes[0].motion.mode, crate::motion::RampMode::Velocity);
+        ok(&mut m, "SAP 1, 0, 4000");
+        assert_eq!((ok(&mut m, "GAP 1, 0"), ok(&mut m, "GAP 0, 0")), (4000, 0));
+        assert_eq!(ok(&mut m, "GAP 8, 0"), 0, "not at the target");
+        ok(&mut m, "SAP 0, 0, 4000");
+        assert_eq!(ok(&mut m, "GAP 8, 0"), 1);
+        m.axes[0].params[207] = 3;
+        assert_eq!((ok(&mut m, "GAP 207, 0"), ok(&mut m, "GAP 207, 0")), (3, 0), "cleared by reading");
+    }
+
+    #[test]
+    fn tick_timer_and_random_seed() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "SGP 132, 0, 1000");
+        m.advance(25_000_000);
+        assert_eq!(ok(&mut m, "GGP 132, 0"), 1025);
+        ok(&mut m, "SGP 133, 0, 99");
+        let a = [ok(&mut m, "GGP 133, 0"), ok(&mut m, "GGP 133, 0")];
+        ok(&mut m, "SGP 133, 0, 99");
+        assert_eq!([ok(&mut m, "GGP 133, 0"), ok(&mut m, "GGP 133, 0")], a, "the same seed, the same numbers");
+    }
+}

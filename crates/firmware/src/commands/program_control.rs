@@ -1,0 +1,236 @@
+//! Program control, 128–135: stop, run, step and reset the program; enter
+//! and leave download mode and store words in it; read program memory and
+//! the application status. Also the same operations for tools.
+
+use crate::module::Module;
+use crate::outcome::{Outcome, Special};
+use crate::parameter_numbers::gp;
+use crate::program::RunMode;
+use tmclsim_protocol::frame::memory_reply;
+use tmclsim_protocol::{Command, Instruction, Status};
+
+impl Module {
+    /// 128–135: program control over any link.
+    pub(crate) fn control(&mut self, cmd: Command) -> Result<Outcome, Status> {
+        let memory = self.program.memory.len() as i32;
+        let ok = Outcome::ok;
+        match cmd {
+            Command::StopApplication => {
+                if self.program.mode != RunMode::Reset {
+                    self.program.mode = RunMode::Stop;
+                }
+                Ok(ok(0))
+            }
+            Command::RunApplication { from } => {
+                if let Some(address) = from {
+                    if !(0..memory).contains(&address) {
+                        return Err(Status::InvalidValue);
+                    }
+                    self.program.pc = address as u16;
+                    self.program.stack.clear();
+                    self.program.wait = None;
+                    self.program.handler = None;
+                }
+                self.start_program();
+                Ok(ok(from.unwrap_or(0)))
+            }
+            Command::StepApplication => {
+                self.program.mode = RunMode::Step;
+                self.program.hit_breakpoint = None;
+                self.program.next_ns = self.now_ns;
+                self.step_program();
+                Ok(ok(0))
+            }
+            Command::ResetApplication => {
+                self.program.reset();
+                self.program.mode = RunMode::Reset;
+                self.registers = Default::default();
+                Ok(ok(0))
+            }
+            Command::EnterDownload { address } => {
+                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 2 | 3) || self.eeprom_locked() {
+                    return Err(Status::EepromLocked);
+                }
+                if !(0..memory).contains(&address) {
+                    return Err(Status::InvalidValue);
+                }
+                self.program.mode = RunMode::Stop;
+                self.program.download = Some(address as u16);
+                self.program.download_pointer = address as u16;
+                Ok(ok(address))
+            }
+            Command::ExitDownload => {
+                if self.program.download.take().is_some() {
+                    // The downloaded words are in the EEPROM image; save it.
+                    self.persistence.mark_written();
+                }
+                Ok(ok(0))
+            }
+            Command::ReadMemory { address } => {
+                if !(0..memory).contains(&address) {
+                    return Err(Status::InvalidValue);
+                }
+                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 1 | 3) {
+                    return Err(Status::EepromLocked);
+                }
+                let stored = self.program.memory[address as usize];
+                Ok(Outcome { status: Status::Ok, value: address, special: Special::Frame(memory_reply(self.host_address(), stored)) })
+            }
+            Command::ApplicationStatus { kind } => {
+                let p = &self.program;
+                let word = |address: u16| ((p.mode as i32) << 24) | ((p.wait.is_some() as i32) << 16) | address as i32;
+                Ok(ok(match kind {
+                    0 => word(p.download_pointer),
+                    1 => word(p.pc),
+                    2 => self.registers.accumulator,
+                    _ => self.registers.x,
+                }))
+            }
+            _ => Err(Status::InvalidCommand),
+        }
+    }
+
+    /// Stores a word in download mode (status 101), decisions.md rule 15.
+    pub(crate) fn download_word(&mut self, ins: Instruction) -> Outcome {
+        let Some(address) = self.program.download else {
+            return Outcome::error(Status::NotAvailable, ins.value);
+        };
+        let Some(slot) = self.program.memory.get_mut(address as usize) else {
+            return Outcome::error(Status::InvalidValue, ins.value);
+        };
+        *slot = ins;
+        self.persistence.eeprom.program.insert(address, ins.to_bytes());
+        // Each word is in the EEPROM when it is acknowledged, as on the module.
+        self.persistence.mark_written();
+        self.program.download = Some(address + 1);
+        self.program.download_pointer = address + 1;
+        Outcome { status: Status::Loaded, value: ins.value, special: Special::None }
+    }
+
+    /// Loads a program into memory from address 0 (as a download would)
+    /// and stores it in the EEPROM.
+    pub fn load_program(&mut self, words: &[Instruction]) -> Result<(), Status> {
+        if words.len() > self.program.memory.len() {
+            return Err(Status::InvalidValue);
+        }
+        self.program.mode = RunMode::Stop;
+        for (a, w) in self.program.memory.iter_mut().enumerate() {
+            *w = words.get(a).copied().unwrap_or_default();
+        }
+        self.persistence.eeprom.program = words.iter().enumerate().map(|(a, w)| (a as u16, w.to_bytes())).collect();
+        self.persistence.mark_written();
+        self.program.download_pointer = words.len() as u16;
+        Ok(())
+    }
+
+    /// Starts (or continues) the program as 129 does.
+    pub fn start_program(&mut self) {
+        // A program paused at a breakpoint resumes with that instruction.
+        self.program.mode = RunMode::Run;
+        self.program.next_ns = self.program.next_ns.max(self.now_ns);
+    }
+
+    /// Pauses the program (step mode), as a debugger does.
+    pub fn pause_program(&mut self) {
+        if self.program.mode == RunMode::Run {
+            self.program.mode = RunMode::Step;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::program::RunMode;
+    use crate::test_support::{direct, module, ok, status};
+    use tmclsim_protocol::mnemonic::parse_line;
+    use tmclsim_protocol::{Instruction, Reply, Status};
+
+    fn program(lines: &[&str]) -> Vec<Instruction> {
+        lines.iter().map(|l| parse_line(l).unwrap()).collect()
+    }
+
+    #[test]
+    fn download_stores_words_in_memory_and_eeprom() {
+        let mut m = module("tmcm-1141");
+        assert_eq!(direct(&mut m, "#132 0 0 10"), (Status::Ok, 10));
+        assert_eq!(ok(&mut m, "GGP 129, 0"), 1, "download mode");
+        let written = m.eeprom_generation();
+        let word = parse_line("MVP ABS, 0, 1000").unwrap();
+        let o = m.download_word(word);
+        assert_eq!((o.status, o.value), (Status::Loaded, 1000));
+        assert_eq!(m.program.memory[10], word);
+        assert_eq!(m.eeprom().program.get(&10), Some(&word.to_bytes()));
+        assert_eq!(m.eeprom_generation(), written + 1, "each word is written at once");
+        assert_eq!(ok(&mut m, "#135 0 0 0") & 0xFFFF, 11, "135 type 0: the download pointer");
+        ok(&mut m, "#133 0 0 0");
+        assert_eq!(ok(&mut m, "GGP 129, 0"), 0);
+        assert_eq!(m.download_word(word).status, Status::NotAvailable, "not in download mode");
+        assert_eq!(status(&mut m, "#132 0 0 2048"), Status::InvalidValue, "outside program memory");
+    }
+
+    #[test]
+    fn read_memory_134_answers_with_the_stored_word() {
+        let mut m = module("tmcm-1141");
+        let words = program(&["SAP 4, 0, 500", "STOP"]);
+        m.load_program(&words).unwrap();
+        let o = m.execute(parse_line("#134 0 0 0").unwrap());
+        let crate::outcome::Special::Frame(frame) = o.special else { panic!("134 answers with a frame") };
+        assert_eq!(frame[1..8], words[0].to_bytes(), "the seven bytes of the word");
+        assert_eq!(status(&mut m, "#134 0 0 -1"), Status::InvalidValue);
+    }
+
+    #[test]
+    fn run_step_stop_and_reset() {
+        let mut m = module("tmcm-1141");
+        m.load_program(&program(&["CALC LOAD, 1", "CALC ADD, 1", "CALC ADD, 1", "JA 1"])).unwrap();
+        ok(&mut m, "#130 0 0 0");
+        assert_eq!((m.program.mode, m.program.pc, m.registers.accumulator), (RunMode::Step, 1, 1), "130 runs one instruction");
+        ok(&mut m, "#130 0 0 0");
+        assert_eq!((m.program.pc, m.registers.accumulator), (2, 2));
+        assert_eq!(direct(&mut m, "#129 1 0 3"), (Status::Ok, 3), "run from address 3");
+        assert_eq!((m.program.mode, m.program.pc), (RunMode::Run, 3));
+        m.advance(1_000_000);
+        assert!(m.registers.accumulator > 2);
+        ok(&mut m, "#128 0 0 0");
+        assert_eq!(m.program.mode, RunMode::Stop);
+        ok(&mut m, "#131 0 0 0");
+        assert_eq!((m.program.mode, m.program.pc, m.registers.accumulator), (RunMode::Reset, 0, 0), "131 clears the registers");
+        ok(&mut m, "#128 0 0 0");
+        assert_eq!(m.program.mode, RunMode::Reset, "128 leaves a reset program alone");
+        assert_eq!(status(&mut m, "#129 1 0 5000"), Status::InvalidValue);
+    }
+
+    #[test]
+    fn application_status_135() {
+        let mut m = module("tmcm-1141");
+        m.load_program(&program(&["WAIT TICKS, 0, 100", "STOP"])).unwrap();
+        ok(&mut m, "#129 0 0 0");
+        m.advance(1_000_000);
+        let word = ok(&mut m, "#135 1 0 0");
+        assert_eq!((word >> 24, (word >> 16) & 0xFF, word & 0xFFFF), (RunMode::Run as i32, 1, 1), "mode, waiting, pc");
+        ok(&mut m, "CALC LOAD, -9");
+        assert_eq!(ok(&mut m, "#135 2 0 0"), -9, "type 2: the accumulator");
+        ok(&mut m, "CALCX LOAD");
+        assert_eq!(ok(&mut m, "#135 3 0 0"), -9, "type 3: X");
+    }
+
+    #[test]
+    fn code_protection_locks_download_and_read() {
+        let mut m = module("tmcm-1141");
+        m.load_program(&program(&["STOP"])).unwrap();
+        ok(&mut m, "SGP 81, 0, 3");
+        assert_eq!(status(&mut m, "#132 0 0 0"), Status::EepromLocked);
+        assert_eq!(status(&mut m, "#134 0 0 0"), Status::EepromLocked);
+        ok(&mut m, "SGP 81, 0, 0");
+        assert_eq!(m.program.length(), 0, "lifting the read protection erases the program");
+    }
+
+    #[test]
+    fn control_commands_in_a_frame_are_answered_in_download_mode() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "#132 0 0 0");
+        let f = tmclsim_protocol::Request::new(1, parse_line("#135 0 0 0").unwrap()).encode();
+        let r = Reply::decode(&m.handle_frame(&f).unwrap()).unwrap();
+        assert_eq!(r.status, Status::Ok.code(), "135 is not stored");
+    }
+}

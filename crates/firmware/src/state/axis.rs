@@ -1,0 +1,149 @@
+//! One motor axis: its parameter RAM, the ramp generator, coordinates, and
+//! the per-axis state of the reference search, the driver and the closed
+//! loop.
+
+use crate::motion::{Motion, Ramp, RampMode};
+use crate::parameter_numbers::ap;
+use crate::reference_search::ReferenceSearch;
+
+/// One motor axis.
+#[derive(Clone, Debug)]
+pub struct Axis {
+    /// RAM values of the axis parameters (stored ones; measured ones are
+    /// computed on read).
+    pub params: [i32; 256],
+    pub motion: Motion,
+    /// AP 0 as the host wrote it.
+    pub target_word: i32,
+    /// Coordinates 0…N.
+    pub coordinates: Vec<i32>,
+    /// Mechanical position minus motor position counter.
+    pub mech_offset: f64,
+    /// Virtual time (ns) since which the motor stands still.
+    pub standstill_since: Option<u64>,
+    /// A 138 event is due when this axis reaches its target.
+    pub notify_on_arrival: bool,
+    /// The reference search in progress.
+    pub rfs: Option<ReferenceSearch>,
+    pub driver: Driver,
+    /// An interpolated move's ramp (MVP COORD with bit 6), until it ends.
+    pub ramp_override: Option<Ramp>,
+    /// AP 209 minus what the encoder measures (set by SAP 209).
+    pub encoder_offset: i64,
+    pub closed_loop: ClosedLoop,
+}
+
+impl Axis {
+    /// An axis at power-up: its parameters and coordinates as restored, the
+    /// ramp generator at rest in the mode AP 138 selects, the carriage
+    /// `mech_offset` away from the position counter's zero.
+    pub fn new(params: [i32; 256], coordinates: Vec<i32>, mech_offset: f64, now_ns: u64) -> Axis {
+        let mode = RampMode::from_code(params[ap::RAMP_MODE as usize]);
+        Axis {
+            params,
+            motion: Motion { mode, ..Motion::default() },
+            target_word: 0,
+            coordinates,
+            mech_offset,
+            standstill_since: Some(now_ns),
+            notify_on_arrival: false,
+            rfs: None,
+            driver: Driver::default(),
+            ramp_override: None,
+            encoder_offset: 0,
+            closed_loop: Default::default(),
+        }
+    }
+
+    /// Selects a ramp mode: AP 138 and the ramp generator's mode together.
+    pub fn set_ramp_mode(&mut self, mode: RampMode) {
+        self.params[ap::RAMP_MODE as usize] = mode as i32;
+        self.motion.mode = mode;
+    }
+
+    /// Ends what takes the ramp generator over from the plain ramp: a
+    /// reference search, an interpolated move's ramp, torque mode.
+    pub fn end_overrides(&mut self) {
+        self.rfs = None;
+        self.ramp_override = None;
+        self.closed_loop.torque_mode = false;
+    }
+}
+
+/// Per-axis driver state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Driver {
+    /// Last stallGuard2 reading, 0…1023.
+    pub load_value: i32,
+    /// coolStep's current scale (0…31), while coolStep regulates.
+    pub cool_scale: Option<f64>,
+    /// Measurements towards the next coolStep decrement.
+    pub down_count: f64,
+}
+
+/// Per-axis closed-loop state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClosedLoop {
+    /// Mechanical offset at which rotor and virtual position agree.
+    pub sync_offset: f64,
+    /// Current scale in effect, %.
+    pub scale: f64,
+    /// Torque mode is selected (SAP 14).
+    pub torque_mode: bool,
+    /// Encoder count at power-up (incremental encoders count from there).
+    pub encoder_zero: f64,
+    /// Last count the encoder delivered (frozen while its signal is lost).
+    pub encoder_last: f64,
+    /// Added by SAP 209.
+    pub encoder_offset: f64,
+    /// A deviation was reported and has not gone away yet.
+    pub deviation_reported: bool,
+    /// The rotor's velocity in µsteps/s over the last step.
+    pub rotor_velocity: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn axis() -> Axis {
+        let mut params = [0; 256];
+        params[ap::RAMP_MODE as usize] = RampMode::Velocity as i32;
+        Axis::new(params, vec![0; 21], 250.0, 7)
+    }
+
+    #[test]
+    fn power_up_state() {
+        let a = axis();
+        assert_eq!(a.motion.mode, RampMode::Velocity, "AP 138 selects the mode");
+        assert_eq!((a.motion.x, a.motion.v, a.target_word), (0.0, 0.0, 0));
+        assert_eq!((a.mech_offset, a.standstill_since), (250.0, Some(7)));
+        assert_eq!(a.coordinates.len(), 21);
+        assert!(a.rfs.is_none() && a.ramp_override.is_none() && !a.notify_on_arrival);
+        assert_eq!(a.driver, Driver::default());
+        assert_eq!(a.closed_loop, ClosedLoop::default());
+    }
+
+    #[test]
+    fn ramp_mode_sets_ap_138_and_the_generator() {
+        let mut a = axis();
+        for mode in [RampMode::Position, RampMode::Soft, RampMode::Velocity] {
+            a.set_ramp_mode(mode);
+            assert_eq!(a.motion.mode, mode);
+            assert_eq!(a.params[ap::RAMP_MODE as usize], mode as i32);
+        }
+    }
+
+    #[test]
+    fn end_overrides_leaves_the_rest() {
+        let mut a = axis();
+        a.rfs = ReferenceSearch::new(1);
+        a.ramp_override = Some(Ramp { vmax: 1.0, vmin: 0.0, accel_position: 1.0, accel_velocity: 1.0, target_velocity: 0.0 });
+        a.closed_loop.torque_mode = true;
+        a.notify_on_arrival = true;
+        a.end_overrides();
+        assert!(a.rfs.is_none() && a.ramp_override.is_none() && !a.closed_loop.torque_mode);
+        assert!(a.notify_on_arrival, "only the overrides end");
+        assert_eq!(a.motion.mode, RampMode::Velocity);
+    }
+}

@@ -1,0 +1,407 @@
+//! Virtual time: advancing the module and what happens on its own — the
+//! program's batches and WAITs, timers, input and switch edges, the
+//! heartbeat, the motors moving and the driver watching them.
+
+use crate::module::Module;
+use crate::parameter_numbers::{ap, gp};
+use crate::program::{RunMode, Source};
+use crate::state::registers::error_flag;
+use tmclsim_profile::StallDetection;
+use tmclsim_protocol::{Instruction, WaitCondition, opcode};
+
+impl Module {
+    /// Advances virtual time by `dt_ns` nanoseconds: the program runs its
+    /// instructions, the motors move, interrupts and events fire, each at
+    /// its own moment.
+    pub fn advance(&mut self, dt_ns: u64) {
+        let end = self.now_ns.saturating_add(dt_ns);
+        self.look_at_inputs();
+        loop {
+            let timer = self.run_timers();
+            if self.program.is_running() {
+                if self.program.wait.is_some() {
+                    self.check_wait();
+                }
+                if self.program.wait.is_some() && self.interrupt_ready() {
+                    // An interrupt is served during a WAIT; RETI resumes it.
+                    self.take_interrupt();
+                }
+                if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
+                    let soon = self.motion_interrupts_armed().then_some(self.now_ns + 1_000_000);
+                    let limit = [Some(end), timer, self.heartbeat_deadline(), soon].into_iter().flatten().min().unwrap_or(end);
+                    self.run_batch(limit);
+                    continue;
+                }
+            }
+            if self.now_ns >= end {
+                break;
+            }
+            // The next moment something happens on its own.
+            let mut t = end;
+            let mut at = |x: Option<u64>| {
+                if let Some(x) = x
+                    && x > self.now_ns
+                {
+                    t = t.min(x);
+                }
+            };
+            at(self.heartbeat_deadline());
+            at(timer);
+            if self.driver_watches() {
+                // Load, stall and deviation are looked at every millisecond.
+                at(Some(self.now_ns + 1_000_000));
+            }
+            if self.program.is_running() {
+                if self.program.wait.is_none() {
+                    at(Some(self.program.next_ns));
+                } else {
+                    at(self.wait_horizon());
+                }
+                if self.motion_interrupts_armed() {
+                    at(Some(self.now_ns + 1_000_000));
+                }
+            }
+            self.step_world(t);
+        }
+    }
+
+    /// Moves the motors to `t` and looks at what changed.
+    fn step_world(&mut self, t: u64) {
+        let dt = t - self.now_ns;
+        for motor in 0..self.axes.len() {
+            self.advance_axis(motor, dt);
+        }
+        self.now_ns = t;
+        if let Some(deadline) = self.heartbeat_deadline()
+            && self.now_ns >= deadline
+        {
+            self.link.heartbeat_tripped = true;
+            for motor in 0..self.axes.len() {
+                self.motor_stop(motor);
+            }
+        }
+        self.look_at_inputs();
+    }
+
+    /// Raises input-change and stop-switch interrupts for the transitions
+    /// their bank 3 trigger setting selects.
+    fn look_at_inputs(&mut self) {
+        let inputs = self.world.digital_inputs;
+        let changed = inputs ^ self.io.last_inputs;
+        if changed != 0 {
+            for n in 0..8u8 {
+                if changed & (1 << n) != 0 {
+                    let rising = inputs & (1 << n) != 0;
+                    self.trigger(Source::InputChange(n), rising);
+                }
+            }
+            self.io.last_inputs = inputs;
+        }
+        for m in 0..self.axes.len() {
+            let (l, r, _) = self.switches(m);
+            let (pl, pr) = self.io.last_switches.get(m).copied().unwrap_or((l, r));
+            if l != pl {
+                self.trigger(Source::StopLeft(m as u8), l);
+            }
+            if r != pr {
+                self.trigger(Source::StopRight(m as u8), r);
+            }
+            if let Some(s) = self.io.last_switches.get_mut(m) {
+                *s = (l, r);
+            }
+        }
+    }
+
+    /// An edge on an input: raise its interrupt if bank 3 selects the edge
+    /// (0 off, 1 low→high, 2 high→low, 3 both).
+    fn trigger(&mut self, source: Source, rising: bool) {
+        let Some(n) = self.profile.interrupt_for(source) else { return };
+        let mode = self.globals[3][n as usize];
+        if mode == 3 || (mode == 1 && rising) || (mode == 2 && !rising) {
+            self.raise(source);
+        }
+    }
+
+    /// Advances virtual time to an absolute time (no-op if in the past).
+    pub fn advance_to(&mut self, t_ns: u64) {
+        if t_ns > self.now_ns {
+            self.advance(t_ns - self.now_ns);
+        }
+    }
+
+    pub(crate) fn heartbeat_deadline(&self) -> Option<u64> {
+        let hb = self.globals[0][gp::HEARTBEAT as usize];
+        (hb > 0 && !self.link.heartbeat_tripped).then(|| self.link.last_frame_ns + hb as u64 * 1_000_000)
+    }
+
+    /// The next virtual time at which something observable happens on its
+    /// own (a heartbeat stop, a 138 event); `None` if nothing is pending.
+    pub fn next_event_ns(&self) -> Option<u64> {
+        if self.program.is_running() {
+            // A running program does something every instruction; a
+            // server lets it run in steps of a millisecond.
+            return Some(self.now_ns + 1_000_000);
+        }
+        let mut next = self.heartbeat_deadline();
+        for (motor, axis) in self.axes.iter().enumerate() {
+            if axis.notify_on_arrival
+                && let Some(t) = self.time_to_rest(motor)
+            {
+                let t = self.now_ns + (t * 1e9).ceil() as u64;
+                next = Some(next.map_or(t, |n| n.min(t)));
+            }
+        }
+        next
+    }
+
+    fn time_to_rest(&self, motor: usize) -> Option<f64> {
+        let ramp = self.ramp(motor);
+        let mut stops = |x: f64| self.stops_at(motor, x);
+        self.axes[motor].motion.time_to_rest(&ramp, &mut stops)
+    }
+
+    fn advance_axis(&mut self, motor: usize, dt_ns: u64) {
+        let offset = self.axes[motor].mech_offset;
+        let sign = self.shaft_sign();
+        // Switch edges in motor coordinates.
+        let mut edges = [0.0f64; 8];
+        let mut count = 0;
+        for m in self.world.axes[motor].thresholds().take(edges.len()) {
+            edges[count] = (m - offset) * sign;
+            count += 1;
+        }
+        let edges = &edges[..count];
+        let was_moving = self.axes[motor].motion.v != 0.0;
+        let searching = self.axes[motor].rfs.is_some();
+        let mut left = dt_ns as f64 * 1e-9;
+        let mut stopped_at = None;
+        let mut arrived = false;
+        let mut elapsed = 0.0;
+        // A reference search looks at every switch edge it passes; plain
+        // motion goes through the whole step at once.
+        for _ in 0..64 {
+            let ramp = self.ramp(motor);
+            let x_before = self.axes[motor].motion.x;
+            let mut motion = std::mem::take(&mut self.axes[motor].motion);
+            let step = {
+                let mut stops = |x: f64| self.stops_at(motor, x);
+                motion.advance(left, &ramp, &mut stops, edges, searching)
+            };
+            self.axes[motor].motion = motion;
+            self.drive(motor, x_before, step.elapsed);
+            if let Some(t) = step.stopped_at {
+                stopped_at = Some(elapsed + t);
+            }
+            elapsed += step.elapsed;
+            left -= step.elapsed;
+            arrived |= step.arrived;
+            if searching {
+                self.reference_search_step(motor, step.crossed.is_some(), step.arrived);
+            }
+            if !searching || step.crossed.is_none() || left <= 0.0 {
+                break;
+            }
+        }
+        // Time the motion did not use (standing still): the driver and the
+        // closed loop still act.
+        let rest = dt_ns as f64 * 1e-9 - elapsed;
+        if rest > 1e-12 {
+            let x = self.axes[motor].motion.x;
+            self.drive(motor, x, rest);
+        }
+        let moving = self.axes[motor].motion.v != 0.0;
+        let axis = &mut self.axes[motor];
+        if moving {
+            axis.standstill_since = None;
+        } else if let Some(t) = stopped_at {
+            axis.standstill_since = Some(self.now_ns + (t * 1e9) as u64);
+        } else if was_moving || axis.standstill_since.is_none() {
+            axis.standstill_since = Some(self.now_ns);
+        }
+        if arrived {
+            axis.ramp_override = None;
+        }
+        if arrived && axis.notify_on_arrival {
+            axis.notify_on_arrival = false;
+            self.push_event(1 << motor);
+        }
+        if arrived && !searching {
+            self.raise(Source::TargetReached(motor as u8));
+        }
+    }
+
+    /// Runs instructions due at `now` (and pure ones after them, up to
+    /// `limit`) without moving the world; returns when the world must catch
+    /// up, the program stops or waits.
+    pub(crate) fn run_batch(&mut self, limit: u64) {
+        loop {
+            self.take_interrupt();
+            let pc = self.program.pc;
+            if !self.program.breakpoints.is_empty() && self.program.breakpoints.contains(&pc) && self.program.hit_breakpoint != Some(pc) {
+                self.program.hit_breakpoint = Some(pc);
+                self.program.mode = RunMode::Step;
+                return;
+            }
+            self.program.hit_breakpoint = None;
+            let Some(ins) = self.program.memory.get(pc as usize).copied() else {
+                self.program.mode = RunMode::Stop;
+                return;
+            };
+            // With the trace on, every instruction sees the world of its
+            // own moment (positions in the trace are exact).
+            let pure = is_pure(ins) && self.program.trace.is_none();
+            if !pure && self.program.next_ns > self.now_ns {
+                return;
+            }
+            self.execute_next();
+            if !self.program.is_running() || self.program.wait.is_some() || !pure || self.program.next_ns > limit {
+                return;
+            }
+        }
+    }
+
+    /// Ends a WAIT whose condition holds or whose time is up.
+    pub(crate) fn check_wait(&mut self) {
+        let Some(w) = self.program.wait else { return };
+        let m = w.motor as usize;
+        let met = match w.condition {
+            WaitCondition::Ticks => w.until_ns.is_none_or(|u| self.now_ns >= u),
+            WaitCondition::Position => self.actual_position(m) == self.axes[m].target_word && self.axes[m].motion.v == 0.0,
+            WaitCondition::ReferenceSwitch => self.switches(m).2,
+            WaitCondition::LimitSwitch => {
+                let (l, r, _) = self.switches(m);
+                l || r
+            }
+            WaitCondition::ReferenceSearch => !self.reference_search_active(m),
+        };
+        if met {
+            self.program.wait = None;
+        } else if w.condition != WaitCondition::Ticks && w.until_ns.is_some_and(|u| self.now_ns >= u) {
+            self.registers.errors |= error_flag::TIMEOUT;
+            self.program.wait = None;
+        }
+        if self.program.wait.is_none() {
+            self.program.next_ns = self.program.next_ns.max(self.now_ns);
+        }
+    }
+
+    /// When the world must be looked at again for the WAIT in progress.
+    pub(crate) fn wait_horizon(&self) -> Option<u64> {
+        let w = self.program.wait?;
+        let mut t = w.until_ns;
+        let m = w.motor as usize;
+        let poll = self.now_ns + 1_000_000;
+        let candidate = match w.condition {
+            WaitCondition::Ticks => None,
+            WaitCondition::Position => {
+                // The ramp is known in closed form: wake up when it ends.
+                let ramp = self.ramp(m);
+                let mut stops = |x: f64| self.stops_at(m, x);
+                match self.axes[m].motion.time_to_rest(&ramp, &mut stops) {
+                    // At rest off the target (a switch stopped it): nothing
+                    // changes by itself; only the timeout ends the wait.
+                    Some(s) if s <= 0.0 => None,
+                    Some(s) => Some(self.now_ns + (s * 1e9).ceil() as u64),
+                    None => Some(poll),
+                }
+            }
+            _ => Some(poll),
+        };
+        if let Some(c) = candidate {
+            t = Some(t.map_or(c, |u| u.min(c)));
+        }
+        t
+    }
+
+    /// Interrupts that depend on motion are enabled: the world must then be
+    /// looked at often (every millisecond) even while the program waits.
+    pub(crate) fn motion_interrupts_armed(&self) -> bool {
+        self.interrupts.global
+            && self.program.is_running()
+            && self.profile.interrupts.iter().any(|i| {
+                self.interrupts.enabled[i.number as usize]
+                    && matches!(
+                        Source::from_symbol(&i.symbol),
+                        Some(
+                            Source::TargetReached(_) | Source::StopLeft(_) | Source::StopRight(_) | Source::Stall(_) | Source::Deviation(_)
+                        )
+                    )
+            })
+    }
+
+    /// Timer interrupts: fire those due, return the next firing time.
+    pub(crate) fn run_timers(&mut self) -> Option<u64> {
+        let mut next = None;
+        for t in 0..3u8 {
+            let Some(n) = self.profile.interrupt_for(Source::Timer(t)) else { continue };
+            let period_ms = self.globals[3][n as usize] as u32 as u64;
+            if !self.program.is_running() || period_ms == 0 || !self.interrupts.enabled[n as usize] {
+                self.program.timers[t as usize] = None;
+                continue;
+            }
+            let period = period_ms * 1_000_000;
+            let due = *self.program.timers[t as usize].get_or_insert(self.now_ns + period);
+            if self.now_ns >= due {
+                self.program.set_pending(n);
+                let behind = (self.now_ns - due) / period + 1;
+                self.program.timers[t as usize] = Some(due + behind * period);
+            }
+            let d = self.program.timers[t as usize].expect("set above");
+            next = Some(next.map_or(d, |x: u64| x.min(d)));
+        }
+        next
+    }
+
+    /// Some moving axis has something the driver must look at often: a
+    /// load, stall detection, coolStep, an encoder deviation limit, or a
+    /// driver that is off.
+    pub(crate) fn driver_watches(&self) -> bool {
+        (0..self.axes.len()).any(|m| {
+            let axis = &self.axes[m];
+            let p = &axis.params;
+            let f = &self.profile.features;
+            let will_move = axis.motion.v != 0.0
+                || match axis.motion.mode {
+                    crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
+                    _ => axis.motion.x != axis.motion.target,
+                };
+            let closed_loop = self.has_closed_loop() && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6);
+            closed_loop
+                || will_move
+                    && (!self.world.axes[m].loads.is_empty()
+                        || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
+                        || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
+                        || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
+                        || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
+                        || self.driver_off(m))
+        })
+    }
+}
+
+/// Instructions that touch neither the motors, the I/O nor time: a batch of
+/// them runs without moving the world.
+fn is_pure(ins: Instruction) -> bool {
+    matches!(
+        ins.opcode,
+        opcode::CALC
+            | opcode::COMP
+            | opcode::JC
+            | opcode::JA
+            | opcode::CSUB
+            | opcode::RSUB
+            | opcode::CALCX
+            | opcode::CLE
+            | opcode::CALCVV
+            | opcode::CALCVA
+            | opcode::CALCAV
+            | opcode::CALCVX
+            | opcode::CALCXV
+            | opcode::CALCV
+            | opcode::DJNZ
+            | opcode::SIV
+            | opcode::GIV
+            | opcode::AIV
+            | opcode::CALL
+            | opcode::RST
+    ) || (matches!(ins.opcode, opcode::SGP | opcode::GGP) && ins.motor == 2)
+}

@@ -1,0 +1,44 @@
+//! Helpers shared by the firmware's integration tests: commands by
+//! mnemonic (or `#op type motor value`) sent as frames to module address 1.
+#![allow(dead_code)]
+
+use tmclsim_firmware::Module;
+use tmclsim_firmware::world::Load;
+use tmclsim_protocol::mnemonic::parse_line;
+use tmclsim_protocol::{Reply, Request};
+
+/// One millisecond of virtual time.
+pub const MS: u64 = 1_000_000;
+
+/// The request frame of a command to address 1.
+pub fn frame(line: &str) -> [u8; 9] {
+    Request::new(1, parse_line(line).unwrap_or_else(|e| panic!("{line}: {e}"))).encode()
+}
+
+/// Sends one command and returns the decoded reply.
+pub fn reply(m: &mut Module, line: &str) -> Reply {
+    Reply::decode(&m.handle_frame(&frame(line)).unwrap_or_else(|| panic!("{line}: no reply"))).unwrap()
+}
+
+/// The status of a command's reply.
+pub fn status(m: &mut Module, line: &str) -> u8 {
+    reply(m, line).status
+}
+
+/// Sends a command that must succeed (status 100) and returns its value.
+pub fn send(m: &mut Module, line: &str) -> i32 {
+    let r = reply(m, line);
+    assert_eq!(r.status, 100, "{line}");
+    r.value
+}
+
+/// Nine bytes from their hex spelling (`"01 04 00 …"`).
+pub fn hex(s: &str) -> [u8; 9] {
+    let v: Vec<u8> = s.split_whitespace().map(|b| u8::from_str_radix(b, 16).unwrap()).collect();
+    v.try_into().unwrap()
+}
+
+/// A constant load on axis 0, in % of the motor's rated torque.
+pub fn load(m: &mut Module, torque: f64) {
+    m.world_mut().axes[0].loads = vec![Load { torque, ..Load::default() }];
+}

@@ -1,0 +1,351 @@
+//! The crate's files depend on each other without cycles: the state files
+//! and leaf types know nothing of `Module`, and only the `impl Module`
+//! files depend on `module.rs`.
+//!
+//! The graph is read from the sources: a file depends on every file whose
+//! module a `use` (with `crate::`, `super::`, `self::` or a child module)
+//! or a `crate::…` path in it names.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+type Graph = BTreeMap<String, BTreeSet<String>>;
+
+#[derive(Clone, Debug, PartialEq)]
+enum Token {
+    Ident(String),
+    PathSep,
+    Punct(char),
+}
+
+/// Identifiers, `::` and punctuation; comments, strings, characters and
+/// numbers are skipped.
+fn tokens(text: &str) -> Vec<Token> {
+    let c: Vec<char> = text.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < c.len() {
+        let ch = c[i];
+        let next = c.get(i + 1).copied();
+        if ch == '/' && next == Some('/') {
+            while i < c.len() && c[i] != '\n' {
+                i += 1;
+            }
+        } else if ch == '/' && next == Some('*') {
+            let mut depth = 0;
+            while i < c.len() {
+                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
+                    depth += 1;
+                    i += 2;
+                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+        } else if ch == 'r' && (next == Some('"') || (next == Some('#') && matches!(c.get(i + 2), Some('"') | Some('#')))) {
+            // Raw string: r"…", r#"…"#.
+            let mut j = i + 1;
+            let mut hashes = 0;
+            while c[j] == '#' {
+                hashes += 1;
+                j += 1;
+            }
+            j += 1;
+            loop {
+                if c[j] == '"' && (0..hashes).all(|h| c.get(j + 1 + h) == Some(&'#')) {
+                    i = j + 1 + hashes;
+                    break;
+                }
+                j += 1;
+            }
+        } else if ch == '"' {
+            i += 1;
+            while c[i] != '"' {
+                i += if c[i] == '\\' { 2 } else { 1 };
+            }
+            i += 1;
+        } else if ch == '\'' {
+            // A character literal ('x', '\n', '\u{..}') or a lifetime ('a).
+            if next == Some('\\') {
+                i += 2;
+                while c[i] != '\'' {
+                    i += 1;
+                }
+                i += 1;
+            } else if c.get(i + 2) == Some(&'\'') {
+                i += 3;
+            } else {
+                i += 1;
+            }
+        } else if ch.is_alphabetic() || ch == '_' {
+            let start = i;
+            while i < c.len() && (c[i].is_alphanumeric() || c[i] == '_') {
+                i += 1;
+            }
+            out.push(Token::Ident(c[start..i].iter().collect()));
+        } else if ch.is_ascii_digit() {
+            while i < c.len() && (c[i].is_alphanumeric() || c[i] == '_' || c[i] == '.') {
+                i += 1;
+            }
+        } else if ch == ':' && next == Some(':') {
+            out.push(Token::PathSep);
+            i += 2;
+        } else {
+            if !ch.is_whitespace() {
+                out.push(Token::Punct(ch));
+            }
+            i += 1;
+        }
+    }
+    out
+}
+
+fn ident(t: Option<&Token>) -> Option<&str> {
+    match t {
+        Some(Token::Ident(s)) => Some(s),
+        _ => None,
+    }
+}
+
+/// Parses a use tree at `i` (after `use`); returns the paths it names and
+/// the index after it.
+fn use_tree(t: &[Token], mut i: usize, prefix: &[String], out: &mut Vec<Vec<String>>) -> usize {
+    let mut path = prefix.to_vec();
+    loop {
+        match t.get(i) {
+            Some(Token::Ident(s)) => {
+                path.push(s.clone());
+                i += 1;
+            }
+            Some(Token::Punct('{')) => {
+                i += 1;
+                while t.get(i) != Some(&Token::Punct('}')) {
+                    i = use_tree(t, i, &path, out);
+                    if t.get(i) == Some(&Token::Punct(',')) {
+                        i += 1;
+                    }
+                }
+                return i + 1;
+            }
+            Some(Token::Punct('*')) => {
+                i += 1;
+            }
+            _ => {}
+        }
+        match t.get(i) {
+            Some(Token::PathSep) => i += 1,
+            Some(Token::Ident(s)) if s == "as" => {
+                out.push(path);
+                return i + 2;
+            }
+            _ => {
+                out.push(path);
+                return i;
+            }
+        }
+    }
+}
+
+/// Module path of a source file (`state/axis.rs` → `state::axis`, `lib.rs`
+/// → the root, ``).
+fn module_of(src: &Path, file: &Path) -> String {
+    let rel = file.strip_prefix(src).unwrap().with_extension("");
+    let mut parts: Vec<String> = rel.iter().map(|p| p.to_string_lossy().into_owned()).collect();
+    if matches!(parts.last().map(String::as_str), Some("lib" | "mod")) {
+        parts.pop();
+    }
+    parts.join("::")
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+fn join(base: &[String], rest: &[String]) -> Vec<String> {
+    base.iter().chain(rest).cloned().collect()
+}
+
+/// The file module a path (from the crate root) lies in: its longest
+/// prefix that is a file.
+fn file_of(path: &[String], files: &BTreeSet<String>) -> String {
+    (0..=path.len()).rev().map(|n| path[..n].join("::")).find(|m| files.contains(m)).unwrap_or_default()
+}
+
+/// The files one source file depends on.
+fn dependencies(text: &str, module: &str, files: &BTreeSet<String>) -> BTreeSet<String> {
+    let t = tokens(text);
+    let file_path: Vec<String> = if module.is_empty() { vec![] } else { module.split("::").map(String::from).collect() };
+    // Inline modules (`mod tests { … }`) open at a brace depth.
+    let mut inline: Vec<(usize, String)> = Vec::new();
+    let mut depth = 0;
+    let mut paths: Vec<(Vec<String>, Vec<String>, bool)> = Vec::new();
+    let mut i = 0;
+    while i < t.len() {
+        let here = join(&file_path, &inline.iter().map(|(_, n)| n.clone()).collect::<Vec<_>>());
+        match &t[i] {
+            Token::Punct('{') => depth += 1,
+            Token::Punct('}') => {
+                if inline.last().is_some_and(|(d, _)| *d == depth) {
+                    inline.pop();
+                }
+                depth -= 1;
+            }
+            Token::Ident(k) if k == "mod" => {
+                if let (Some(name), Some(Token::Punct('{'))) = (ident(t.get(i + 1)), t.get(i + 2)) {
+                    inline.push((depth + 1, name.to_string()));
+                }
+            }
+            Token::Ident(k) if k == "use" => {
+                let mut found = Vec::new();
+                i = use_tree(&t, i + 1, &[], &mut found);
+                paths.extend(found.into_iter().map(|p| (here.clone(), p, true)));
+                continue;
+            }
+            Token::Ident(k) if matches!(k.as_str(), "crate" | "super") && t.get(i + 1) == Some(&Token::PathSep) => {
+                let mut found = Vec::new();
+                i = use_tree(&t, i, &[], &mut found);
+                paths.extend(found.into_iter().map(|p| (here.clone(), p, false)));
+                continue;
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    let mut deps = BTreeSet::new();
+    for (here, path, in_use) in paths {
+        let mut base = here.clone();
+        let mut rest = &path[..];
+        let absolute = match rest.first().map(String::as_str) {
+            Some("crate") => join(&[], &rest[1..]),
+            Some("super") | Some("self") => {
+                while let Some(s) = rest.first().map(String::as_str) {
+                    match s {
+                        "super" => {
+                            base.pop();
+                        }
+                        "self" => {}
+                        _ => break,
+                    }
+                    rest = &rest[1..];
+                }
+                join(&base, rest)
+            }
+            // `use child::…` of a module declared in this one.
+            Some(first) if in_use && files.contains(&join(&here, &[first.to_string()]).join("::")) => join(&here, rest),
+            _ => continue,
+        };
+        deps.insert(file_of(&absolute, files));
+    }
+    deps.remove(module);
+    deps
+}
+
+fn crate_graph() -> Graph {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut paths = Vec::new();
+    rust_files(&src, &mut paths);
+    let files: BTreeSet<String> = paths.iter().map(|p| module_of(&src, p)).collect();
+    paths
+        .iter()
+        .map(|p| {
+            let module = module_of(&src, p);
+            let deps = dependencies(&std::fs::read_to_string(p).unwrap(), &module, &files);
+            (module, deps)
+        })
+        .collect()
+}
+
+fn name(module: &str) -> &str {
+    if module.is_empty() { "lib" } else { module }
+}
+
+/// A cycle of the graph, if it has one.
+fn find_cycle(graph: &Graph) -> Option<Vec<String>> {
+    fn visit(n: &str, graph: &Graph, done: &mut BTreeSet<String>, stack: &mut Vec<String>) -> Option<Vec<String>> {
+        if let Some(at) = stack.iter().position(|s| s == n) {
+            let mut cycle = stack[at..].to_vec();
+            cycle.push(n.to_string());
+            return Some(cycle);
+        }
+        if done.contains(n) {
+            return None;
+        }
+        stack.push(n.to_string());
+        for d in graph.get(n).into_iter().flatten() {
+            if let Some(c) = visit(d, graph, done, stack) {
+                return Some(c);
+            }
+        }
+        stack.pop();
+        done.insert(n.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    graph.keys().find_map(|n| visit(n, graph, &mut done, &mut Vec::new()))
+}
+
+fn reaches(graph: &Graph, from: &str, to: &str) -> bool {
+    let mut seen = BTreeSet::new();
+    let mut todo = vec![from.to_string()];
+    while let Some(n) = todo.pop() {
+        if n == to {
+            return true;
+        }
+        if seen.insert(n.clone()) {
+            todo.extend(graph.get(&n).into_iter().flatten().cloned());
+        }
+    }
+    false
+}
+
+#[test]
+fn the_crate_has_no_import_cycles() {
+    let graph = crate_graph();
+    if let Some(cycle) = find_cycle(&graph) {
+        let cycle: Vec<&str> = cycle.iter().map(|m| name(m)).collect();
+        panic!("import cycle: {}", cycle.join(" → "));
+    }
+}
+
+#[test]
+fn state_and_leaf_types_do_not_depend_on_module() {
+    let graph = crate_graph();
+    let leaves = ["outcome", "parameter_numbers", "program", "motion", "reference_search", "eeprom", "world", "world_file"];
+    let checked: Vec<&String> = graph.keys().filter(|m| m.starts_with("state") || leaves.contains(&m.as_str())).collect();
+    assert!(checked.iter().any(|m| m.starts_with("state::")), "the state files are found");
+    for m in checked {
+        assert!(!reaches(&graph, m, "module"), "{m} depends on module.rs");
+    }
+}
+
+#[test]
+fn the_graph_sees_the_dependencies() {
+    let graph = crate_graph();
+    let deps = |m: &str| graph.get(m).unwrap_or_else(|| panic!("no file {m}"));
+    assert!(deps("commands::motion").contains("module"), "use crate::module::Module");
+    assert!(deps("module").contains("state::axis"), "pub use crate::state::axis::Axis");
+    assert!(deps("").contains("module"), "pub use module::{{…}} in lib.rs");
+}
+
+#[test]
+fn a_cycle_is_found() {
+    let files: BTreeSet<String> = ["", "a", "b", "b::c"].map(String::from).into();
+    let a = dependencies("use crate::b::c::Thing; // crate::x\nfn f() { let s = \"crate::a\"; }", "a", &files);
+    let c = dependencies("use super::Y;\nmod tests {\n    use super::X;\n}\nfn g() { crate::a::f() }", "b::c", &files);
+    assert_eq!(a, ["b::c".to_string()].into());
+    assert_eq!(c, ["a".to_string(), "b".to_string()].into(), "super in an inline module names the file itself");
+    let graph: Graph = [("a".to_string(), a), ("b::c".to_string(), c)].into();
+    assert_eq!(find_cycle(&graph), Some(vec!["a".to_string(), "b::c".to_string(), "a".to_string()]));
+}
