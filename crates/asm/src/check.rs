@@ -5,7 +5,7 @@
 //! memory. Each finding is a column and a message.
 //!
 //! These are the checks that would make the module answer a direct-mode
-//! command with an error status (decisions.md rule 6) and skip it in a
+//! command with an error status (docs/behaviour.md rule 6) and skip it in a
 //! program (rule 21).
 
 use tmclsim_profile::Profile;

@@ -112,7 +112,7 @@ fn routines_start_with_129_type_1_at_addresses_0_1_2() {
 }
 
 /// The CALL example of 3.7.44, run as printed. Loads of the accumulator
-/// set the flags (decisions.md rule 18; the example's own `GAP 2, 0` /
+/// set the flags (docs/behaviour.md rule 18; the example's own `GAP 2, 0` /
 /// `JC ZE` needs that), so a subroutine's last load decides the next CALL:
 /// the example turns right, stops from standstill, and turns left, but
 /// RunLeft's `CALC MUL, -1` and MotorStop's `GAP 2, 0` leave GT behind and

@@ -10,7 +10,7 @@ use tmclsim_protocol::{FRAME_LEN, Reply, Request, Status, opcode};
 
 impl Module {
     /// Handles one 9-byte frame from a serial-type link: address filter,
-    /// checksum, execution, reply (decisions.md rules 2–4, 11).
+    /// checksum, execution, reply (docs/behaviour.md rules 2–4, 11).
     pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
         let (request, checksum_ok) = match Request::decode(frame) {
             Ok(r) => (r, true),

@@ -101,7 +101,7 @@ impl Module {
     }
 
     /// One program instruction; `Err` when it failed and was skipped
-    /// (decisions.md rule 21).
+    /// (docs/behaviour.md rule 21).
     fn program_instruction(&mut self, ins: Instruction, at: u64) -> Result<(), Status> {
         if !self.profile.has_opcode(ins.opcode) || opcode::is_control(ins.opcode) {
             return Err(Status::InvalidCommand);
@@ -183,7 +183,7 @@ impl Module {
     }
 
     /// Enters the handler of the most urgent pending interrupt, if the
-    /// program may take one now (decisions.md rule 22).
+    /// program may take one now (docs/behaviour.md rule 22).
     /// An enabled interrupt with a vector is pending and may be taken.
     pub(crate) fn interrupt_ready(&self) -> bool {
         self.interrupts.global

@@ -1,6 +1,6 @@
 //! The TMC429/TMC428 ramp generator in continuous time.
 //!
-//! Units and formulas follow decisions.md rules 23–25:
+//! Units and formulas follow docs/behaviour.md rules 23–25:
 //! `v_pps = fclk·v / 2^(pulse_div+16)`,
 //! `a_pps = fclk²·a / 2^(ramp_div+pulse_div+29)`, fclk = 16 MHz.
 //!

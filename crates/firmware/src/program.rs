@@ -11,7 +11,7 @@ use tmclsim_protocol::{Instruction, WaitCondition};
 pub const STACK_DEPTH: usize = 8;
 
 /// Virtual time one program instruction takes by default: 25 µs, i.e.
-/// 40 000 instructions per second (decisions.md rule 20).
+/// 40 000 instructions per second (docs/behaviour.md rule 20).
 pub const DEFAULT_INSTRUCTION_NS: u64 = 25_000;
 
 /// GP 128 / 135: what the interpreter is doing.
@@ -54,7 +54,7 @@ pub struct TraceRecord {
     pub instruction: Instruction,
     /// Registers after the instruction.
     pub registers: Registers,
-    /// Status when the command failed and was skipped (decisions.md rule 21).
+    /// Status when the command failed and was skipped (docs/behaviour.md rule 21).
     pub failed: Option<u8>,
     /// Per axis after the instruction: actual position and actual speed
     /// (internal units).

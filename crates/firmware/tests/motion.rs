@@ -1,5 +1,5 @@
 //! Motion of the virtual TMCM-1141 against the TMC429 closed forms
-//! (decisions.md rules 23–25): durations, exact final positions, velocity
+//! (docs/behaviour.md rules 23–25): durations, exact final positions, velocity
 //! ramps, limit switches.
 
 mod common;

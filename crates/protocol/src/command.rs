@@ -625,7 +625,7 @@ impl Command {
         }
     }
 
-    /// Branch and flow commands: program-only (decisions.md rule 7).
+    /// Branch and flow commands: program-only (docs/behaviour.md rule 7).
     pub fn is_program_only(&self) -> bool {
         use Command::*;
         matches!(self, Jc { .. } | Ja { .. } | Csub { .. } | Rsub | Call { .. } | Djnz { .. } | Rst { .. } | Wait { .. } | Stop | Reti)

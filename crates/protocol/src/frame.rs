@@ -105,7 +105,7 @@ impl Reply {
 }
 
 /// The special reply of 136 type 0: the host address followed by eight ASCII
-/// characters such as `1141V146`, without checksum (decisions.md rule 8).
+/// characters such as `1141V146`, without checksum (docs/behaviour.md rule 8).
 pub fn version_string_reply(host: u8, text: &[u8; 8]) -> [u8; FRAME_LEN] {
     let mut f = [host, 0, 0, 0, 0, 0, 0, 0, 0];
     f[1..].copy_from_slice(text);
@@ -113,7 +113,7 @@ pub fn version_string_reply(host: u8, text: &[u8; 8]) -> [u8; FRAME_LEN] {
 }
 
 /// The special reply of 134 (read program memory): the module address byte
-/// is replaced by the stored instruction (decisions.md rule 16).
+/// is replaced by the stored instruction (docs/behaviour.md rule 16).
 pub fn memory_reply(host: u8, stored: Instruction) -> [u8; FRAME_LEN] {
     let i = stored.to_bytes();
     let mut f = [host, i[0], i[1], i[2], i[3], i[4], i[5], i[6], 0];

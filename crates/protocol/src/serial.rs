@@ -2,7 +2,7 @@
 //!
 //! [`FrameAssembler`] collects bytes into frames. A gap longer than the
 //! inter-byte timeout discards a partial frame, so a host that lost a byte
-//! resynchronises (decisions.md rule 1). Time is passed in by the caller,
+//! resynchronises (docs/behaviour.md rule 1). Time is passed in by the caller,
 //! which keeps this codec free of I/O and clocks.
 
 use crate::frame::FRAME_LEN;

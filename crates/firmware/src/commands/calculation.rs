@@ -147,7 +147,7 @@ impl Module {
     }
 }
 
-/// 32-bit two's complement arithmetic (decisions.md rule 19).
+/// 32-bit two's complement arithmetic (docs/behaviour.md rule 19).
 fn calculate(op: CalcOp, a: i32, b: i32) -> Exec {
     Ok(match op {
         CalcOp::Add => a.wrapping_add(b),

@@ -24,7 +24,7 @@ impl Module {
     }
 
     /// A read in a program loads the accumulator and sets the flags; a
-    /// direct-mode read leaves them alone (decisions.md rules 7, 18).
+    /// direct-mode read leaves them alone (docs/behaviour.md rules 7, 18).
     pub(crate) fn loaded(&mut self, v: i32, origin: Origin) -> i32 {
         if origin == Origin::Program {
             self.registers.load(v);

@@ -90,7 +90,7 @@ impl Module {
         }
     }
 
-    /// Stores a word in download mode (status 101), decisions.md rule 15.
+    /// Stores a word in download mode (status 101), docs/behaviour.md rule 15.
     pub(crate) fn download_word(&mut self, ins: Instruction) -> Outcome {
         let Some(address) = self.program.download else {
             return Outcome::error(Status::NotAvailable, ins.value);
