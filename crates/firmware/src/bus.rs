@@ -124,7 +124,7 @@ impl Bus {
     /// The next virtual time at which something happens on its own on any
     /// module (`None`: nothing until a request comes).
     pub fn next_deadline(&self) -> Option<u64> {
-        self.modules.iter().filter_map(Module::next_event_ns).min()
+        self.modules.iter().filter_map(Module::next_deadline).min()
     }
 
     /// One 9-byte frame on the link: every module sees it, the addressed

@@ -9,6 +9,20 @@ use crate::state::registers::error_flag;
 use tmclsim_profile::StallDetection;
 use tmclsim_protocol::{Instruction, WaitCondition, opcode};
 
+/// The driver measures load, stall and encoder deviation of a watched,
+/// moving motor once a millisecond (docs/behaviour.md rule 81).
+const DRIVER_SAMPLE_NS: u64 = 1_000_000;
+
+/// How far ahead a switch edge is looked for.
+const EDGE_HORIZON_S: f64 = 3600.0;
+
+fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
 impl Module {
     /// Advances virtual time by `dt_ns` nanoseconds: the program runs its
     /// instructions, the motors move, interrupts and events fire, each at
@@ -27,8 +41,9 @@ impl Module {
                     self.take_interrupt();
                 }
                 if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
-                    let soon = self.motion_interrupts_armed().then_some(self.now_ns + 1_000_000);
-                    let limit = [Some(end), timer, self.heartbeat_deadline(), soon].into_iter().flatten().min().unwrap_or(end);
+                    // Pure instructions run ahead of the world only up to
+                    // the world's next event.
+                    let limit = self.world_deadline(timer).map_or(end, |d| d.min(end));
                     self.run_batch(limit);
                     continue;
                 }
@@ -37,30 +52,7 @@ impl Module {
                 break;
             }
             // The next moment something happens on its own.
-            let mut t = end;
-            let mut at = |x: Option<u64>| {
-                if let Some(x) = x
-                    && x > self.now_ns
-                {
-                    t = t.min(x);
-                }
-            };
-            at(self.heartbeat_deadline());
-            at(timer);
-            if self.driver_watches() {
-                // Load, stall and deviation are looked at every millisecond.
-                at(Some(self.now_ns + 1_000_000));
-            }
-            if self.program.is_running() {
-                if self.program.wait.is_none() {
-                    at(Some(self.program.next_ns));
-                } else {
-                    at(self.wait_horizon());
-                }
-                if self.motion_interrupts_armed() {
-                    at(Some(self.now_ns + 1_000_000));
-                }
-            }
+            let t = self.deadline_after(timer).filter(|&d| d > self.now_ns).map_or(end, |d| d.min(end));
             self.step_world(t);
         }
     }
@@ -134,22 +126,97 @@ impl Module {
         (hb > 0 && !self.link.heartbeat_tripped).then(|| self.link.last_frame_ns + hb as u64 * 1_000_000)
     }
 
-    /// The next virtual time at which something observable happens on its
-    /// own (a heartbeat stop, a 138 event); `None` if nothing is pending.
-    pub fn next_event_ns(&self) -> Option<u64> {
-        if self.program.is_running() {
-            // A running program does something every instruction; a
-            // server lets it run in steps of a millisecond.
-            return Some(self.now_ns + 1_000_000);
+    /// The next virtual time at which something happens on its own: a timer
+    /// interrupt, the end of a WAIT, the next program instruction, a motor
+    /// arriving or crossing a switch edge that a WAIT, an interrupt or a
+    /// 138 event watches, a heartbeat stop, the driver's next measurement
+    /// of a watched moving motor (docs/behaviour.md rule 81). `None`: nothing
+    /// happens until a request comes. A deadline at or before now means
+    /// "due now". [`Module::advance`] moves from one deadline to the next.
+    pub fn next_deadline(&self) -> Option<u64> {
+        self.deadline_after(self.next_timer())
+    }
+
+    /// [`Module::next_deadline`] with the timers' next firing given.
+    fn deadline_after(&self, timer: Option<u64>) -> Option<u64> {
+        let program = if !self.program.is_running() {
+            None
+        } else if self.program.wait.is_none() {
+            Some(self.program.next_ns)
+        } else if self.interrupt_ready() {
+            // An interrupt is served during the WAIT.
+            Some(self.now_ns)
+        } else {
+            self.wait_horizon()
+        };
+        earliest(self.world_deadline(timer), program)
+    }
+
+    /// The next event of the world and the interrupt system (everything but
+    /// the program's own next instruction or WAIT).
+    fn world_deadline(&self, timer: Option<u64>) -> Option<u64> {
+        let mut next = earliest(self.heartbeat_deadline(), timer);
+        if self.driver_watches() {
+            next = earliest(next, Some(self.now_ns + DRIVER_SAMPLE_NS));
         }
-        let mut next = self.heartbeat_deadline();
+        let armed = self.motion_interrupts_armed();
         for (motor, axis) in self.axes.iter().enumerate() {
-            if axis.notify_on_arrival
-                && let Some(t) = self.time_to_rest(motor)
-            {
-                let t = self.now_ns + (t * 1e9).ceil() as u64;
-                next = Some(next.map_or(t, |n| n.min(t)));
+            if axis.motion.v == 0.0 && !axis.notify_on_arrival && !armed {
+                continue;
             }
+            if axis.notify_on_arrival || armed {
+                next = earliest(next, self.rest_deadline(motor));
+            }
+            if armed {
+                next = earliest(next, self.edge_deadline(motor));
+            }
+        }
+        next
+    }
+
+    /// When the motor comes to rest, if it moves and will.
+    fn rest_deadline(&self, motor: usize) -> Option<u64> {
+        match self.time_to_rest(motor) {
+            Some(s) if s > 0.0 => Some(self.now_ns + (s * 1e9).ceil() as u64),
+            _ => None,
+        }
+    }
+
+    /// When the carriage next reaches a switch edge (within an hour), by
+    /// walking the planned ramp without moving.
+    fn edge_deadline(&self, motor: usize) -> Option<u64> {
+        if self.axes[motor].motion.v == 0.0 && self.time_to_rest(motor).is_some_and(|s| s <= 0.0) {
+            return None;
+        }
+        let offset = self.axes[motor].mech_offset;
+        let sign = self.shaft_sign();
+        let mut edges = [0.0f64; 8];
+        let mut count = 0;
+        for m in self.world.axes[motor].thresholds().take(edges.len()) {
+            edges[count] = (m - offset) * sign;
+            count += 1;
+        }
+        if count == 0 {
+            return None;
+        }
+        let ramp = self.ramp(motor);
+        let mut probe = self.axes[motor].motion.clone();
+        let mut stops = |x: f64| self.stops_at(motor, x);
+        let step = probe.advance(EDGE_HORIZON_S, &ramp, &mut stops, &edges[..count], true);
+        step.crossed.map(|_| self.now_ns + (step.elapsed * 1e9).ceil().max(1.0) as u64)
+    }
+
+    /// The next firing of the timer interrupts, without firing them.
+    fn next_timer(&self) -> Option<u64> {
+        let mut next = None;
+        for t in 0..3u8 {
+            let Some(n) = self.profile.interrupt_for(Source::Timer(t)) else { continue };
+            let period_ms = self.globals[3][n as usize] as u32 as u64;
+            if !self.program.is_running() || period_ms == 0 || !self.interrupts.enabled[n as usize] {
+                continue;
+            }
+            let due = self.program.timers[t as usize].unwrap_or(self.now_ns + period_ms * 1_000_000);
+            next = earliest(next, Some(due));
         }
         next
     }
@@ -290,7 +357,6 @@ impl Module {
         let w = self.program.wait?;
         let mut t = w.until_ns;
         let m = w.motor as usize;
-        let poll = self.now_ns + 1_000_000;
         let candidate = match w.condition {
             WaitCondition::Ticks => None,
             WaitCondition::Position => {
@@ -302,10 +368,13 @@ impl Module {
                     // changes by itself; only the timeout ends the wait.
                     Some(s) if s <= 0.0 => None,
                     Some(s) => Some(self.now_ns + (s * 1e9).ceil() as u64),
-                    None => Some(poll),
+                    None => self.edge_deadline(m),
                 }
             }
-            _ => Some(poll),
+            // Switch waits end at the next edge the carriage reaches; a
+            // reference search ends at an edge or where it arrives.
+            WaitCondition::ReferenceSwitch | WaitCondition::LimitSwitch => self.edge_deadline(m),
+            WaitCondition::ReferenceSearch => earliest(self.edge_deadline(m), self.rest_deadline(m)),
         };
         if let Some(c) = candidate {
             t = Some(t.map_or(c, |u| u.min(c)));
