@@ -37,6 +37,7 @@ pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
     );
 
     programs()?;
+    served_programs(args.idle_seconds)?;
 
     // Over the links of a `tmclsim serve` process.
     let dir = std::env::temp_dir().join(format!("tmclsim-bench-{}", std::process::id()));
@@ -184,6 +185,67 @@ fn programs() -> Result<(), String> {
     println!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), lines as f64 / wall / 1e6);
     Ok(())
 }
+
+/// Served modules that run standalone programs while no host talks to them:
+/// the server's CPU share comes only from the programs' own deadlines.
+fn served_programs(seconds: f64) -> Result<(), String> {
+    let profile = tmclsim_firmware::Profile::built_in("tmcm-1141")?;
+    let asm =
+        |src: &str| tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d));
+    let module = |program: &tmclsim_asm::Program| -> Result<Module, String> {
+        let mut m = Module::new(profile.clone());
+        m.load_program(&program.instructions).map_err(|s| s.to_string())?;
+        m.start_program();
+        Ok(m)
+    };
+    let waiting = asm("Loop:\n  WAIT TICKS, 0, 1000\n  JA Loop\n")?;
+    let config =
+        |port: u16| tmclsim_server::ServerConfig { tcp: Some(std::net::SocketAddr::from(([127, 0, 0, 1], port))), ..Default::default() };
+    let one = tmclsim_server::start(module(&waiting)?, config(0)).map_err(|e| e.to_string())?;
+    idle_row("served module, program looping on `WAIT TICKS, 0, 1000`", 1, seconds, &one)?;
+    one.stop();
+    let timer = asm(TIMER_INTERRUPT)?;
+    let links = (0..1000)
+        .map(|_| Ok(tmclsim_server::LinkSpec { modules: vec![(module(&timer)?, None)], config: config(0) }))
+        .collect::<Result<Vec<_>, String>>()?;
+    let fleet = tmclsim_server::start_fleet(links).map_err(|e| e.to_string())?;
+    idle_row("fleet of 1000 modules on TCP, each running the manual's timer-interrupt example", 1000, seconds, &fleet)?;
+    fleet.stop();
+    Ok(())
+}
+
+/// CPU used by this process (the server's thread) while nobody talks to
+/// it, with the clock's wake-ups.
+fn idle_row(name: &str, modules: usize, seconds: f64, server: &tmclsim_server::ServerHandle) -> Result<(), String> {
+    std::thread::sleep(Duration::from_millis(200));
+    let (cpu0, wake0) = (self_cpu(), server.stats().wakeups);
+    let t = Instant::now();
+    std::thread::sleep(Duration::from_secs_f64(seconds));
+    let wall = t.elapsed().as_secs_f64();
+    let (cpu, wakeups) = (self_cpu() - cpu0, server.stats().wakeups - wake0);
+    println!(
+        "| {name}, {seconds:.0} s idle | {modules} modules | {:.3} % of one core, {:.0} clock wake-ups/s |",
+        cpu.as_secs_f64() / wall * 100.0,
+        wakeups as f64 / wall
+    );
+    Ok(())
+}
+
+/// User plus system CPU time of this process, to the microsecond.
+fn self_cpu() -> Duration {
+    // SAFETY: getrusage writes into the struct we pass.
+    let usage = unsafe {
+        let mut u: libc::rusage = std::mem::zeroed();
+        libc::getrusage(libc::RUSAGE_SELF, &mut u);
+        u
+    };
+    let tv = |t: libc::timeval| Duration::from_secs(t.tv_sec as u64) + Duration::from_micros(t.tv_usec as u64);
+    tv(usage.ru_utime) + tv(usage.ru_stime)
+}
+
+/// The TMCM-1141 manual's timer-interrupt example (3.6.6.4), toggling OUT1
+/// in the main loop (the module has no output 3).
+const TIMER_INTERRUPT: &str = "  VECT 0, Timer0Irq\n  SGP 0, 3, 1000\n  EI 0\n  EI 255\nLoop:\n  SIO 1, 2, 1\n  WAIT TICKS, 0, 50\n  SIO 1, 2, 0\n  WAIT TICKS, 0, 50\n  JA Loop\nTimer0Irq:\n  GIO 0, 2\n  JC NZ, Out0Off\n  SIO 0, 2, 1\n  RETI\nOut0Off:\n  SIO 0, 2, 0\n  RETI\n";
 
 const FIRST_STEPS: &str = "  ROL 0, 1000\n  WAIT TICKS, 0, 500\n  MST 0\n  ROR 0, 100\n  WAIT TICKS, 0, 500\n  MST 0\n  SAP 4, 0, 100\n  SAP 5, 0, 100\nLoop:\n  MVP ABS, 0, 512000\n  WAIT POS, 0, 0\n  MVP ABS, 0, -512000\n  WAIT POS, 0, 0\n  JA Loop\n";
 

@@ -55,6 +55,9 @@ pub struct BenchArgs {
     /// Round trips per link.
     #[arg(long, default_value_t = 20_000)]
     pub round_trips: usize,
+    /// Seconds each idle served-program measurement lasts.
+    #[arg(long, default_value_t = 10.0)]
+    pub idle_seconds: f64,
 }
 
 #[derive(Args)]
