@@ -38,10 +38,11 @@ def ethercat(veth):
     """Starts slaves on the veth pair: ethercat(n) → master interface."""
     procs = []
 
-    def start(slaves=1):
+    def start(slaves=1, eeprom=None):
         master, slave = veth
+        extra = ["--eeprom", str(eeprom)] if eeprom else []
         p = subprocess.Popen(
-            [tmclsim_binary(), "serve", "--module", "tmcm-1310", "--world", "free", "--ethercat", slave, "--slaves", str(slaves)],
+            [tmclsim_binary(), "serve", "--module", "tmcm-1310", "--world", "free", "--ethercat", slave, "--slaves", str(slaves), *extra],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,

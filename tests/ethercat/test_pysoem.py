@@ -108,6 +108,21 @@ def test_tmcl_over_the_mailbox(ethercat):
     m.close()
 
 
+def test_stap_over_the_mailbox_reaches_the_eeprom_file(ethercat, tmp_path):
+    # The slave's module is on a bus like every front end's: its EEPROM
+    # writes are saved, and a restart powers up from them.
+    eeprom = tmp_path / "slave.json"
+    m = open_master(ethercat(eeprom=eeprom))
+    s = m.slaves[0]
+    assert tmcl(s, 5, 4, 0, 1234) == (100, 1234)  # SAP 4
+    assert tmcl(s, 7, 4, 0, 0)[0] == 100  # STAP 4
+    m.close()
+    deadline = time.time() + 5
+    while '"0/4": 1234' not in eeprom.read_text() if eeprom.exists() else True:
+        assert time.time() < deadline, "the EEPROM file was not written"
+        time.sleep(0.05)
+
+
 def test_the_state_machine_refuses_invalid_transitions(ethercat):
     m = open_master(ethercat())
     s = m.slaves[0]

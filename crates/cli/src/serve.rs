@@ -71,14 +71,26 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
     if args.slaves == 0 || args.slaves > 256 {
         return Err("--slaves takes 1…256".into());
     }
-    let slaves = (0..args.slaves)
+    // --eeprom FILE: the one slave's EEPROM, or FILE.1, FILE.2, … for several.
+    let eeproms: Vec<Option<std::path::PathBuf>> = (0..args.slaves)
         .map(|i| {
+            args.eeprom
+                .as_ref()
+                .map(|f| if args.slaves == 1 { f.clone() } else { std::path::PathBuf::from(format!("{}.{}", f.display(), i + 1)) })
+        })
+        .collect();
+    let modules = eeproms
+        .iter()
+        .map(|path| {
             let world = crate::load_world(&args.world, 1)?;
-            let m = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), world);
-            Ok(tmclsim_ethercat::Slave::new(m, 1 + i as u32))
+            let image = match path {
+                Some(p) => tmclsim_firmware::eeprom::load_for(p, &profile.module.name)?.0,
+                None => Eeprom::new(&profile.module.name),
+            };
+            Ok(Module::with_world(profile.clone(), image, world))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let handle = tmclsim_server::ethercat::serve(iface, tmclsim_ethercat::Segment::new(slaves))
+    let handle = tmclsim_server::ethercat::serve(iface, tmclsim_ethercat::Segment::new(modules), eeproms)
         .map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
     println!("tmclsim: {} virtual {} EtherCAT slave(s) on {iface}", args.slaves, profile.module.name);
     println!("connect with: an EtherCAT master on {iface}'s peer, e.g. pysoem: master.open(\"<peer interface>\")");

@@ -1,32 +1,45 @@
 //! Slaves in a line: a frame passes through each in turn, as on the
-//! wire, and comes back from the last one.
+//! wire, and comes back from the last one. The modules behind the slaves
+//! are a [`Bus`] (one clock for the segment; EEPROM writes and events are
+//! its effects, as on every other front end).
 
 use crate::frame;
 use crate::slave::Slave;
+use tmclsim_firmware::{Bus, Module};
 
 pub struct Segment {
     pub slaves: Vec<Slave>,
+    /// The modules, slave `i` in front of module `i`.
+    pub bus: Bus,
 }
 
 impl Segment {
-    pub fn new(mut slaves: Vec<Slave>) -> Segment {
-        let n = slaves.len();
-        for (i, s) in slaves.iter_mut().enumerate() {
-            s.esc.next_port_open = i + 1 < n;
-        }
-        Segment { slaves }
+    /// One slave per module, in line, with serial numbers 1, 2, …
+    pub fn new(modules: Vec<Module>) -> Segment {
+        let n = modules.len();
+        let slaves = (0..n)
+            .map(|i| {
+                let mut s = Slave::new(1 + i as u32);
+                s.esc.next_port_open = i + 1 < n;
+                s
+            })
+            .collect();
+        Segment { slaves, bus: Bus::new(modules) }
     }
 
-    /// Processes a frame at virtual time `now_ns`; `false` when it is not
-    /// an EtherCAT frame or is malformed (an ESC drops it unchanged).
-    pub fn process(&mut self, frame: &mut [u8], now_ns: u64) -> bool {
+    /// Processes a frame at the bus clock's now; `false` when it is not an
+    /// EtherCAT frame or is malformed (an ESC drops it unchanged).
+    pub fn process(&mut self, frame: &mut [u8]) -> bool {
         let Some(datagrams) = frame::datagrams(frame) else { return false };
-        for slave in &mut self.slaves {
-            slave.before_frame(now_ns);
+        self.bus.catch_up();
+        let now_ns = self.bus.now_ns();
+        for (i, slave) in self.slaves.iter_mut().enumerate() {
+            let module = self.bus.module_mut(i);
+            slave.before_frame(module, now_ns);
             for d in &datagrams {
                 slave.esc.datagram(frame, *d);
             }
-            slave.after_frame(now_ns);
+            slave.after_frame(module, now_ns);
         }
         // Frames that passed a slave carry its mark in the source address.
         frame[6] |= 0x02;

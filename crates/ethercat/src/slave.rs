@@ -18,7 +18,6 @@ const PROTECTED_GLOBALS: [u8; 3] = [66, 76, 87];
 
 pub struct Slave {
     pub esc: Esc,
-    pub module: Module,
     tmcl_reply: [u8; 8],
     /// Valid outputs arrived since SafeOp was entered.
     outputs_valid: bool,
@@ -27,29 +26,28 @@ pub struct Slave {
 }
 
 impl Slave {
-    pub fn new(module: Module, serial: u32) -> Slave {
-        Slave { esc: Esc::new(sii::image(serial)), module, tmcl_reply: [0; 8], outputs_valid: false, last_outputs_ns: 0, applied: None }
+    pub fn new(serial: u32) -> Slave {
+        Slave { esc: Esc::new(sii::image(serial)), tmcl_reply: [0; 8], outputs_valid: false, last_outputs_ns: 0, applied: None }
     }
 
     /// Before a frame passes: time moves on, inputs are fresh.
-    pub fn before_frame(&mut self, now_ns: u64) {
-        self.module.advance_to(now_ns);
+    pub fn before_frame(&mut self, m: &mut Module, now_ns: u64) {
         if self.esc.state() >= state::SAFE_OP && self.esc.state() != state::BOOTSTRAP {
-            let inputs = self.inputs();
+            let inputs = self.inputs(m);
             let at = sii::INPUTS as usize;
             self.esc.mem[at..at + inputs.len()].copy_from_slice(&inputs);
         }
-        self.watchdog(now_ns);
+        self.watchdog(m, now_ns);
     }
 
     /// After the frame: AL control, mailbox, outputs.
-    pub fn after_frame(&mut self, now_ns: u64) {
+    pub fn after_frame(&mut self, m: &mut Module, now_ns: u64) {
         let events = std::mem::take(&mut self.esc.events);
         if events.al_control {
-            self.al_control();
+            self.al_control(m);
         }
         if events.mailbox_written {
-            self.mailbox();
+            self.mailbox(m);
         }
         if events.outputs_written && self.esc.outputs_fresh {
             self.esc.outputs_fresh = false;
@@ -57,13 +55,13 @@ impl Slave {
             self.esc.set_watchdog_expired(false);
             match self.esc.state() {
                 state::SAFE_OP => self.outputs_valid = true,
-                state::OP => self.apply_outputs(),
+                state::OP => self.apply_outputs(m),
                 _ => {}
             }
         }
     }
 
-    fn al_control(&mut self) {
+    fn al_control(&mut self, m: &mut Module) {
         let control = self.esc.al_control();
         let requested = (control & 0x0F) as u8;
         let ack = control & 0x10 != 0;
@@ -86,7 +84,7 @@ impl Slave {
         let down = requested < current && current != state::BOOTSTRAP || (current == state::BOOTSTRAP && requested == state::INIT);
         if down {
             if current == state::OP {
-                self.safe_outputs();
+                self.safe_outputs(m);
             }
             self.esc.set_state(requested, None);
             return;
@@ -135,29 +133,29 @@ impl Slave {
         None
     }
 
-    fn watchdog(&mut self, now_ns: u64) {
+    fn watchdog(&mut self, m: &mut Module, now_ns: u64) {
         let wd = self.esc.watchdog_ns();
         let enabled = self.esc.sync_manager(2).control & 0x40 != 0;
         if self.esc.state() == state::OP && enabled && wd > 0 && now_ns.saturating_sub(self.last_outputs_ns) > wd {
             self.esc.set_watchdog_expired(true);
-            self.safe_outputs();
+            self.safe_outputs(m);
             self.esc.set_state(state::SAFE_OP, Some(code::SM_WATCHDOG));
             self.outputs_valid = false;
         }
     }
 
     /// Outputs in a safe state: the motor stops.
-    fn safe_outputs(&mut self) {
-        self.run(Command::Mst { motor: 0 }.encode());
+    fn safe_outputs(&mut self, m: &mut Module) {
+        self.run(m, Command::Mst { motor: 0 }.encode());
         self.applied = None;
     }
 
     /// Controller mode and set-point (little endian) at 0x1000.
-    fn apply_outputs(&mut self) {
+    fn apply_outputs(&mut self, m: &mut Module) {
         let at = sii::OUTPUTS as usize;
-        let m = &self.esc.mem;
-        let mode = u32::from_le_bytes([m[at], m[at + 1], m[at + 2], m[at + 3]]);
-        let setpoint = i32::from_le_bytes([m[at + 4], m[at + 5], m[at + 6], m[at + 7]]);
+        let mem = &self.esc.mem;
+        let mode = u32::from_le_bytes([mem[at], mem[at + 1], mem[at + 2], mem[at + 3]]);
+        let setpoint = i32::from_le_bytes([mem[at + 4], mem[at + 5], mem[at + 6], mem[at + 7]]);
         if self.applied == Some((mode, setpoint)) {
             return;
         }
@@ -168,19 +166,18 @@ impl Slave {
             3 => Command::Sap { param: 14, motor: 0, value: setpoint },
             _ => return,
         };
-        self.run(command.encode());
+        self.run(m, command.encode());
     }
 
-    fn run(&mut self, ins: Instruction) -> tmclsim_firmware::Outcome {
-        self.module.execute(ins)
+    fn run(&mut self, m: &mut Module, ins: Instruction) -> tmclsim_firmware::Outcome {
+        m.execute(ins)
     }
 
     /// The twelve input fields (tmcm-1310.md), little endian. The error
     /// flags are AP 208 with AP 207 above it (peeked: reading AP 207 over
     /// TMCL clears it, process data must not).
-    fn inputs(&mut self) -> [u8; 48] {
-        let extended = self.module.axis(0).params[207];
-        let m = &mut self.module;
+    fn inputs(&mut self, m: &mut Module) -> [u8; 48] {
+        let extended = m.axis(0).params[207];
         let mut ap = |n: u8| m.get_axis_parameter(n, 0).unwrap_or(0);
         let fields = [ap(0), ap(1), ap(233), ap(209), ap(2), ap(3), ap(131), ap(18), ap(208) | extended << 8, ap(123), ap(14), ap(230)];
         let mut out = [0u8; 48];
@@ -191,7 +188,7 @@ impl Slave {
     }
 
     /// A message arrived in the output mailbox.
-    fn mailbox(&mut self) {
+    fn mailbox(&mut self, m: &mut Module) {
         let Some(msg) = self.esc.take_mailbox() else { return };
         if self.esc.state() == state::INIT {
             return;
@@ -199,19 +196,19 @@ impl Slave {
         let reply = match mailbox::parse(&msg) {
             Ok(None) => return,
             Err((index, subindex, code)) => mailbox::abort_response(0, index, subindex, code),
-            Ok(Some((counter, sdo))) => self.sdo(counter, sdo),
+            Ok(Some((counter, sdo))) => self.sdo(m, counter, sdo),
         };
         self.esc.post_mailbox(&reply);
     }
 
-    fn sdo(&mut self, counter: u8, sdo: Sdo) -> Vec<u8> {
+    fn sdo(&mut self, m: &mut Module, counter: u8, sdo: Sdo) -> Vec<u8> {
         use mailbox::abort;
         match sdo {
             Sdo::Download { index: mailbox::TMCL_OBJECT, subindex: 0, data } => {
                 if data.len() != 8 {
                     return mailbox::abort_response(counter, mailbox::TMCL_OBJECT, 0, abort::LENGTH);
                 }
-                self.tmcl_reply = self.tmcl(&data);
+                self.tmcl_reply = self.tmcl(m, &data);
                 mailbox::download_response(counter, mailbox::TMCL_OBJECT, 0)
             }
             Sdo::Upload { index: mailbox::TMCL_OBJECT, subindex: 0 } => {
@@ -274,21 +271,21 @@ impl Slave {
 
     /// One TMCL request over the mailbox: `[address][opcode][type][motor]
     /// [value]` → `[host][address][status][opcode][value]`.
-    fn tmcl(&mut self, req: &[u8]) -> [u8; 8] {
+    fn tmcl(&mut self, m: &mut Module, req: &[u8]) -> [u8; 8] {
         let ins = Instruction::new(req[1], req[2], req[3], i32::from_be_bytes([req[4], req[5], req[6], req[7]]));
-        let host = self.module.host_address();
-        let address = self.module.address();
+        let host = m.host_address();
+        let address = m.address();
         let protected = matches!(ins.opcode, opcode::SGP | opcode::STGP | opcode::AGP | opcode::RSGP)
             && ins.motor == 0
             && PROTECTED_GLOBALS.contains(&ins.kind);
         let (status, value, special) = if protected {
             (PASSWORD_PROTECTED, ins.value, None)
-        } else if self.module.program().download.is_some() && !opcode::is_control(ins.opcode) {
-            let f = self.module.handle_frame(&tmclsim_protocol::Request::new(address, ins).encode());
+        } else if m.program().download.is_some() && !opcode::is_control(ins.opcode) {
+            let f = m.handle_frame(&tmclsim_protocol::Request::new(address, ins).encode());
             let r = f.and_then(|f| tmclsim_protocol::Reply::decode(&f));
             (r.map_or(Status::InvalidValue.code(), |r| r.status), ins.value, None)
         } else {
-            let o = self.module.execute(ins);
+            let o = m.execute(ins);
             let special = match o.special {
                 Special::Frame(f) => Some(f),
                 _ => None,

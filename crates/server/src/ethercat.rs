@@ -3,10 +3,12 @@
 //! the same interface, as from the last slave of a line.
 
 use std::io;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use tmclsim_ethercat::Segment;
+use tmclsim_firmware::eeprom::save_atomic;
 
 const ETH_P_ALL: u16 = 0x0003;
 const PACKET_OUTGOING: u8 = 4;
@@ -81,15 +83,16 @@ fn open(iface: &str) -> io::Result<(libc::c_int, libc::c_int)> {
     }
 }
 
-/// Serves `segment` on `iface` in a background thread.
-pub fn serve(iface: &str, segment: Segment) -> io::Result<EthercatHandle> {
+/// Serves `segment` on `iface` in a background thread, in wall-clock
+/// time; module `i`'s EEPROM is saved to `eeproms[i]` on every write.
+pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<PathBuf>>) -> io::Result<EthercatHandle> {
     let (fd, index) = open(iface)?;
+    segment.bus.set_stepped(false);
     let stop = Arc::new(AtomicBool::new(false));
     let segment = Arc::new(Mutex::new(segment));
     let counters = Arc::new(Mutex::new((0u64, 0u64)));
     let (t_stop, t_segment, t_counters) = (stop.clone(), segment.clone(), counters.clone());
     let thread = std::thread::Builder::new().name("tmclsim-ethercat".into()).spawn(move || {
-        let start = Instant::now();
         let mut buf = vec![0u8; 2048];
         while !t_stop.load(Ordering::Relaxed) {
             // SAFETY: receiving into a buffer we own, with its length.
@@ -106,8 +109,19 @@ pub fn serve(iface: &str, segment: Segment) -> io::Result<EthercatHandle> {
             if frame.len() < 14 || u16::from_be_bytes([frame[12], frame[13]]) != tmclsim_ethercat::frame::ETHERTYPE {
                 continue;
             }
-            let now = start.elapsed().as_nanos() as u64;
-            let processed = t_segment.lock().unwrap_or_else(|p| p.into_inner()).process(frame, now);
+            let processed = {
+                let mut seg = t_segment.lock().unwrap_or_else(|p| p.into_inner());
+                let processed = seg.process(frame);
+                // Effects: EEPROM writes are saved; events have no link.
+                for i in seg.bus.take_effects().eeprom_written {
+                    if let Some(Some(path)) = eeproms.get(i)
+                        && let Err(e) = save_atomic(path, seg.bus.module(i).eeprom())
+                    {
+                        eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
+                    }
+                }
+                processed
+            };
             {
                 let mut c = t_counters.lock().unwrap_or_else(|p| p.into_inner());
                 if processed { c.0 += 1 } else { c.1 += 1 }
