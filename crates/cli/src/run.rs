@@ -7,8 +7,8 @@ use std::io::{BufRead, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use tmclsim_firmware::Module;
 use tmclsim_firmware::program::RunMode;
+use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::mnemonic;
 
 #[derive(clap::Args)]
@@ -88,6 +88,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     };
     let mut samples = args.plot.as_ref().map(|_| crate::plot::Samples::new(profile.module.axes as usize));
     module.start_program();
+    // The run drives a bus of one in stepped time, as every front end does.
+    let mut bus = Bus::single(module);
     let started = Instant::now();
     let end = args.duration;
     // The run goes in slices: a plot gets 2000 samples, a trace is written
@@ -96,36 +98,41 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let mut debugging = args.debug;
     let stdin = std::io::stdin();
     let mut lines = stdin.lock().lines();
-    while module.now_ns() < end {
-        if debugging || module.program().hit_breakpoint.is_some() {
-            if let Some(pc) = module.program().hit_breakpoint {
+    while bus.now_ns() < end {
+        if debugging || bus.module(0).program().hit_breakpoint.is_some() {
+            if let Some(pc) = bus.module(0).program().hit_breakpoint {
                 println!("breakpoint at {pc}");
             }
-            match debugger(&mut module, &program, &mut lines, end)? {
+            let answer = debugger(bus.module_mut(0), &program, &mut lines, end)?;
+            // Steps moved the module; the bus follows.
+            bus.advance_to(bus.module(0).now_ns());
+            match answer {
                 Debug::Continue => debugging = false,
                 Debug::Quit => break,
             }
             continue;
         }
-        let next = (module.now_ns() + slice).min(end);
-        module.advance_to(next);
+        let next = (bus.now_ns() + slice).min(end);
+        bus.advance_to(next);
         if let Some(w) = &mut trace {
-            write_trace(w, &mut module)?;
+            write_trace(w, bus.module_mut(0))?;
         }
         if let Some(s) = &mut samples {
-            s.take(&module);
+            s.take(bus.module(0));
         }
-        if module.program().mode != RunMode::Run && module.program().hit_breakpoint.is_none() && trace.is_none() && samples.is_none() {
+        let p = bus.module(0).program();
+        if p.mode != RunMode::Run && p.hit_breakpoint.is_none() && trace.is_none() && samples.is_none() {
             // Stopped for good: the rest is motion only.
-            module.advance_to(end);
+            bus.advance_to(end);
         }
     }
+    let module = bus.module_mut(0);
     if let Some(mut w) = trace {
-        write_trace(&mut w, &mut module)?;
+        write_trace(&mut w, module)?;
         w.flush().map_err(|e| e.to_string())?;
     }
     let wall = started.elapsed();
-    summary(&module, &program.symbols, wall);
+    summary(module, &program.symbols, wall);
     if let (Some(path), Some(s)) = (&args.plot, &samples) {
         s.write_png(path)?;
         println!("plot: {}", path.display());
