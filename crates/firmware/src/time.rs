@@ -387,13 +387,11 @@ impl Module {
     pub(crate) fn motion_interrupts_armed(&self) -> bool {
         self.interrupts.global
             && self.program.is_running()
-            && self.profile.interrupts.iter().any(|i| {
-                self.interrupts.enabled[i.number as usize]
+            && self.profile.interrupt_sources().iter().any(|&(source, n)| {
+                self.interrupts.enabled[n as usize]
                     && matches!(
-                        Source::from_symbol(&i.symbol),
-                        Some(
-                            Source::TargetReached(_) | Source::StopLeft(_) | Source::StopRight(_) | Source::Stall(_) | Source::Deviation(_)
-                        )
+                        source,
+                        Source::TargetReached(_) | Source::StopLeft(_) | Source::StopRight(_) | Source::Stall(_) | Source::Deviation(_)
                     )
             })
     }

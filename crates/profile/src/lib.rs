@@ -239,6 +239,8 @@ pub struct Profile {
     global: [Vec<Option<Parameter>>; BANKS],
     pub ports: Vec<Port>,
     pub interrupts: Vec<Interrupt>,
+    /// The interrupts' sources, read from their symbols once.
+    sources: Vec<(InterruptSource, u8)>,
     opcode_set: [bool; 256],
     ascii_set: [bool; 256],
 }
@@ -307,6 +309,7 @@ impl Profile {
             axis,
             global,
             ports: file.port,
+            sources: file.interrupt.iter().filter_map(|i| InterruptSource::from_symbol(&i.symbol).map(|s| (s, i.number))).collect(),
             interrupts: file.interrupt,
             opcode_set,
             ascii_set,
@@ -374,7 +377,12 @@ impl Profile {
     /// The interrupt number of a source, by the symbols of the interrupt
     /// table.
     pub fn interrupt_for(&self, source: InterruptSource) -> Option<u8> {
-        self.interrupts.iter().find(|i| InterruptSource::from_symbol(&i.symbol) == Some(source)).map(|i| i.number)
+        self.sources.iter().find(|(s, _)| *s == source).map(|(_, n)| *n)
+    }
+
+    /// Every interrupt with a known source: (source, number).
+    pub fn interrupt_sources(&self) -> &[(InterruptSource, u8)] {
+        &self.sources
     }
 
     /// Bits per second of a GP 65 baud rate code (features `baud_rates`);
