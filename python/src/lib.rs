@@ -39,6 +39,7 @@ fn _tmclsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(asm::disassemble, m)?)?;
     m.add_function(wrap_pyfunction!(profiles, m)?)?;
     m.add_function(wrap_pyfunction!(module::_time_core, m)?)?;
+    m.add_function(wrap_pyfunction!(status_text, m)?)?;
     Ok(())
 }
 
@@ -49,4 +50,17 @@ fn _tmclsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyfunction]
 fn profiles() -> Vec<&'static str> {
     tmclsim_firmware::Profile::names()
+}
+
+/// status_text(status: int) -> str
+/// --
+///
+/// A TMCL status code in words, as the firmware describes it (e.g.
+/// ``status_text(4) == "invalid value"``).
+#[pyfunction]
+fn status_text(status: u8) -> String {
+    match tmclsim_protocol::Status::from_code(status) {
+        Some(s) => s.describe().to_string(),
+        None => format!("status {status}"),
+    }
 }

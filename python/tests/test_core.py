@@ -57,3 +57,14 @@ def test_events_wait_on_the_bus_for_an_in_process_reader():
     events = m.take_events()
     assert [e.status for e in events] == [128]
     assert m.take_events() == []
+
+
+def test_status_words_come_from_the_firmware():
+    assert tmclsim.status_text(4) == "invalid value"
+    err = None
+    try:
+        tmclsim.Module().set_axis_parameter(4, 0, 99999)
+    except tmclsim.TmclError as e:
+        err = e
+    assert err is not None and err.status == 4
+    assert err.description == tmclsim.status_text(4)

@@ -35,6 +35,7 @@ from ._tmclsim import (
     assemble_file,
     disassemble,
     profiles,
+    status_text,
 )
 from .errors import AssemblyError, Diagnostic, TmclError
 
@@ -54,6 +55,7 @@ __all__ = [
     "assemble_file",
     "disassemble",
     "profiles",
+    "status_text",
     "serve",
 ]
 

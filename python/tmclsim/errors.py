@@ -6,20 +6,6 @@
 
 from typing import List, NamedTuple
 
-#: TMCL status codes (TMCM-1141 manual, table 4).
-STATUS = {
-    1: "wrong checksum",
-    2: "invalid command",
-    3: "wrong type",
-    4: "invalid value",
-    5: "configuration EEPROM locked",
-    6: "command not available",
-    100: "ok",
-    101: "command loaded into program memory",
-    128: "target position reached",
-}
-
-
 class TmclError(Exception):
     """A module answered a command with an error status.
 
@@ -36,7 +22,9 @@ class TmclError(Exception):
     @property
     def description(self) -> str:
         """The status in words, e.g. ``"invalid value"``."""
-        return STATUS.get(self.status, f"status {self.status}")
+        from ._tmclsim import status_text
+
+        return status_text(self.status)
 
     def __str__(self) -> str:
         return self.message
