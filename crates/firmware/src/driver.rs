@@ -93,7 +93,7 @@ impl Module {
     }
 
     pub(crate) fn microsteps(&self, m: usize) -> f64 {
-        2f64.powi(self.axes[m].params[ap::MICROSTEP_RESOLUTION as usize].clamp(0, 8))
+        crate::motion::pow2(self.axes[m].params[ap::MICROSTEP_RESOLUTION as usize].clamp(0, 8))
     }
 
     /// Torque margin `1 − load/available` at the axis's state now.

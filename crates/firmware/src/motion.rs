@@ -12,32 +12,38 @@
 
 pub const FCLK: f64 = 16_000_000.0;
 
+/// 2^e, exactly (the same value as `pow2(e)`, without the call).
+#[inline]
+pub fn pow2(e: i32) -> f64 {
+    if (-1022..=1023).contains(&e) { f64::from_bits(((e + 1023) as u64) << 52) } else { 2f64.powi(e) }
+}
+
 /// Microsteps per second of an internal velocity value.
 pub fn velocity_pps(v: f64, pulse_div: u32) -> f64 {
-    FCLK * v / 2f64.powi(pulse_div as i32 + 16)
+    FCLK * v / pow2(pulse_div as i32 + 16)
 }
 
 /// Internal velocity units of a step rate.
 pub fn velocity_internal(pps: f64, pulse_div: u32) -> f64 {
-    pps * 2f64.powi(pulse_div as i32 + 16) / FCLK
+    pps * pow2(pulse_div as i32 + 16) / FCLK
 }
 
 /// Microsteps per second² of an internal acceleration value.
 pub fn accel_pps2(a: f64, ramp_div: u32, pulse_div: u32) -> f64 {
-    FCLK * FCLK * a / 2f64.powi((ramp_div + pulse_div) as i32 + 29)
+    FCLK * FCLK * a / pow2((ramp_div + pulse_div) as i32 + 29)
 }
 
 /// Internal acceleration units of an acceleration in µsteps/s².
 pub fn accel_internal(pps2: f64, ramp_div: u32, pulse_div: u32) -> f64 {
-    pps2 * 2f64.powi((ramp_div + pulse_div) as i32 + 29) / (FCLK * FCLK)
+    pps2 * pow2((ramp_div + pulse_div) as i32 + 29) / (FCLK * FCLK)
 }
 
 /// The acceleration the TMC429 can use for positioning ramps: AP 5 clamped
 /// to `[2^(rd−pd−1), min(2047, 2^(rd−pd+12)−1)]` (manual 6.1.3).
 pub fn positioning_accel(a: u32, ramp_div: u32, pulse_div: u32) -> f64 {
     let e = ramp_div as i32 - pulse_div as i32;
-    let lower = 2f64.powi(e - 1);
-    let upper = (2f64.powi(e + 12) - 1.0).min(2047.0);
+    let lower = pow2(e - 1);
+    let upper = (pow2(e + 12) - 1.0).min(2047.0);
     (a as f64).clamp(lower.min(upper), upper)
 }
 
@@ -528,6 +534,13 @@ impl Motion {
 mod tests {
     use super::*;
 
+    #[test]
+    fn pow2_is_exact() {
+        for e in -1100..1100 {
+            assert_eq!(pow2(e), 2f64.powi(e), "2^{e}");
+        }
+    }
+
     fn ramp(vmax: f64, a: f64, vmin: f64) -> Ramp {
         Ramp { vmax, vmin, accel_position: a, accel_velocity: a, target_velocity: 0.0 }
     }
@@ -555,7 +568,7 @@ mod tests {
         assert_eq!(positioning_accel(1, 7, 3), 8.0); // 2^(4-1)
         assert_eq!(positioning_accel(2047, 7, 3), 2047.0);
         assert_eq!(positioning_accel(2047, 3, 3), 2047.0);
-        assert_eq!(positioning_accel(2047, 0, 3), 2f64.powi(9) - 1.0);
+        assert_eq!(positioning_accel(2047, 0, 3), pow2(9) - 1.0);
     }
 
     #[test]
