@@ -163,7 +163,7 @@ impl Server {
             wire_timing,
             ..ServerConfig::default()
         };
-        shared.with_bus(|b| *b = std::mem::replace(b, tmclsim_firmware::Bus::new(Vec::new())).with_wire_timing(wire_timing));
+        shared.with_bus(|b| b.set_wire_timing(wire_timing));
         let handle = tmclsim_server::start_shared(shared.clone(), config).map_err(|e| os_error(format!("cannot serve: {e}")))?;
         for r in refs.iter_mut() {
             r.served = true;

@@ -71,9 +71,9 @@ impl Bus {
         Bus::new(vec![module])
     }
 
-    pub fn with_wire_timing(mut self, on: bool) -> Bus {
+    /// Replies wait for the time the bytes take on the wire (GP 65).
+    pub fn set_wire_timing(&mut self, on: bool) {
         self.wire_timing = on;
-        self
     }
 
     pub fn clock(&self) -> Clock {
@@ -222,13 +222,6 @@ impl Bus {
         self.modules.iter().position(|m| m.answers_to(address))
     }
 
-    /// Replaces module `index` (a module swapped in keeps the bus's time).
-    pub fn replace(&mut self, index: usize, mut module: Module) -> Module {
-        module.advance_to(self.now_ns);
-        self.saved[index] = module.eeprom_generation();
-        std::mem::replace(&mut self.modules[index], module)
-    }
-
     /// Takes the modules out of the bus.
     pub fn into_modules(self) -> Vec<Module> {
         self.modules
@@ -330,7 +323,8 @@ mod tests {
 
     #[test]
     fn wire_timing_adds_the_bytes_time() {
-        let mut bus = Bus::single(module(1)).with_wire_timing(true);
+        let mut bus = Bus::single(module(1));
+        bus.set_wire_timing(true);
         // 9600 baud (GP 65 = 0): 180 bits.
         assert_eq!(bus.handle_frame(&frame(1, 6, 1, 0)).delay_ns, 18_750_000);
     }

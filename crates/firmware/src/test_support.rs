@@ -7,6 +7,9 @@ use crate::outcome::Origin;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Command, Instruction, Status};
 
+/// One millisecond of virtual time.
+pub const MS: u64 = 1_000_000;
+
 pub fn module(profile: &str) -> Module {
     Module::built_in(profile).unwrap()
 }

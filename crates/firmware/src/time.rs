@@ -188,14 +188,7 @@ impl Module {
         if self.axes[motor].motion.v == 0.0 && self.time_to_rest(motor).is_some_and(|s| s <= 0.0) {
             return None;
         }
-        let offset = self.axes[motor].mech_offset;
-        let sign = self.shaft_sign();
-        let mut edges = [0.0f64; 8];
-        let mut count = 0;
-        for m in self.world.axes[motor].thresholds().take(edges.len()) {
-            edges[count] = (m - offset) * sign;
-            count += 1;
-        }
+        let (edges, count) = self.switch_edges(motor);
         if count == 0 {
             return None;
         }
@@ -206,17 +199,35 @@ impl Module {
         step.crossed.map(|_| self.now_ns + (step.elapsed * 1e9).ceil().max(1.0) as u64)
     }
 
+    /// Where the switches of an axis change state, in motor coordinates
+    /// (at most eight edges): the edges and how many there are.
+    fn switch_edges(&self, motor: usize) -> ([f64; 8], usize) {
+        let offset = self.axes[motor].mech_offset;
+        let sign = self.shaft_sign();
+        let mut edges = [0.0f64; 8];
+        let mut count = 0;
+        for m in self.world.axes[motor].thresholds().take(edges.len()) {
+            edges[count] = (m - offset) * sign;
+            count += 1;
+        }
+        (edges, count)
+    }
+
+    /// Timer `t`'s interrupt number and period in ns, while it runs (the
+    /// program runs, the period is not 0, the interrupt is enabled).
+    fn timer_period(&self, t: u8) -> Option<(u8, u64)> {
+        let n = self.profile.interrupt_for(Source::Timer(t))?;
+        let period_ms = self.globals[3][n as usize] as u32 as u64;
+        (self.program.is_running() && period_ms != 0 && self.interrupts.enabled[n as usize]).then_some((n, period_ms * 1_000_000))
+    }
+
     /// The next firing of the timer interrupts, without firing them.
     fn next_timer(&self) -> Option<u64> {
         let mut next = None;
         for t in 0..3u8 {
-            let Some(n) = self.profile.interrupt_for(Source::Timer(t)) else { continue };
-            let period_ms = self.globals[3][n as usize] as u32 as u64;
-            if !self.program.is_running() || period_ms == 0 || !self.interrupts.enabled[n as usize] {
-                continue;
+            if let Some((_, period)) = self.timer_period(t) {
+                next = earliest(next, Some(self.program.timers[t as usize].unwrap_or(self.now_ns + period)));
             }
-            let due = self.program.timers[t as usize].unwrap_or(self.now_ns + period_ms * 1_000_000);
-            next = earliest(next, Some(due));
         }
         next
     }
@@ -228,15 +239,7 @@ impl Module {
     }
 
     fn advance_axis(&mut self, motor: usize, dt_ns: u64) {
-        let offset = self.axes[motor].mech_offset;
-        let sign = self.shaft_sign();
-        // Switch edges in motor coordinates.
-        let mut edges = [0.0f64; 8];
-        let mut count = 0;
-        for m in self.world.axes[motor].thresholds().take(edges.len()) {
-            edges[count] = (m - offset) * sign;
-            count += 1;
-        }
+        let (edges, count) = self.switch_edges(motor);
         let edges = &edges[..count];
         let was_moving = self.axes[motor].motion.v != 0.0;
         let searching = self.axes[motor].rfs.is_some();
@@ -359,18 +362,14 @@ impl Module {
         let m = w.motor as usize;
         let candidate = match w.condition {
             WaitCondition::Ticks => None,
-            WaitCondition::Position => {
-                // The ramp is known in closed form: wake up when it ends.
-                let ramp = self.ramp(m);
-                let mut stops = |x: f64| self.stops_at(m, x);
-                match self.axes[m].motion.time_to_rest(&ramp, &mut stops) {
-                    // At rest off the target (a switch stopped it): nothing
-                    // changes by itself; only the timeout ends the wait.
-                    Some(s) if s <= 0.0 => None,
-                    Some(s) => Some(self.now_ns + (s * 1e9).ceil() as u64),
-                    None => self.edge_deadline(m),
-                }
-            }
+            // The ramp is known in closed form: wake up when it ends. At
+            // rest off the target (a switch stopped it) nothing changes by
+            // itself and only the timeout ends the wait; a motor that never
+            // rests (velocity mode) may still meet a switch.
+            WaitCondition::Position => match self.time_to_rest(m) {
+                None => self.edge_deadline(m),
+                Some(_) => self.rest_deadline(m),
+            },
             // Switch waits end at the next edge the carriage reaches; a
             // reference search ends at an edge or where it arrives.
             WaitCondition::ReferenceSwitch | WaitCondition::LimitSwitch => self.edge_deadline(m),
@@ -400,13 +399,10 @@ impl Module {
     pub(crate) fn run_timers(&mut self) -> Option<u64> {
         let mut next = None;
         for t in 0..3u8 {
-            let Some(n) = self.profile.interrupt_for(Source::Timer(t)) else { continue };
-            let period_ms = self.globals[3][n as usize] as u32 as u64;
-            if !self.program.is_running() || period_ms == 0 || !self.interrupts.enabled[n as usize] {
+            let Some((n, period)) = self.timer_period(t) else {
                 self.program.timers[t as usize] = None;
                 continue;
-            }
-            let period = period_ms * 1_000_000;
+            };
             let due = *self.program.timers[t as usize].get_or_insert(self.now_ns + period);
             if self.now_ns >= due {
                 self.program.set_pending(n);

@@ -81,15 +81,11 @@ impl SharedBus {
         shared
     }
 
-    /// One module and its EEPROM file, in wall-clock time.
-    pub fn single(module: Module, eeprom: Option<PathBuf>) -> SharedBus {
-        SharedBus::wall(vec![(module, eeprom)], false)
-    }
-
     /// Modules with their EEPROM files on one link, in wall-clock time.
     pub fn wall(modules: Vec<(Module, Option<PathBuf>)>, wire_timing: bool) -> SharedBus {
         let (modules, eeproms): (Vec<Module>, Vec<Option<PathBuf>>) = modules.into_iter().unzip();
-        let mut bus = Bus::new(modules).with_wire_timing(wire_timing);
+        let mut bus = Bus::new(modules);
+        bus.set_wire_timing(wire_timing);
         bus.set_stepped(false);
         SharedBus::new(bus, eeproms)
     }

@@ -59,10 +59,8 @@ impl Module {
 
 #[cfg(test)]
 mod tests {
-    use crate::test_support::{direct, module, ok, status};
+    use crate::test_support::{MS, direct, module, ok, status};
     use tmclsim_protocol::{Reply, Status};
-
-    const MS: u64 = 1_000_000;
 
     #[test]
     fn ei_di_and_vect() {

@@ -261,10 +261,8 @@ impl Module {
 mod tests {
     use crate::motion::RampMode;
     use crate::parameter_numbers::ap;
-    use crate::test_support::{direct, in_program, module, ok, status};
+    use crate::test_support::{MS, direct, in_program, module, ok, status};
     use tmclsim_protocol::Status;
-
-    const MS: u64 = 1_000_000;
 
     #[test]
     fn ror_rol_and_mst_select_velocity_mode() {
