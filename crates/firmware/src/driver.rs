@@ -96,24 +96,33 @@ impl Module {
         crate::motion::pow2(self.axes[m].params[ap::MICROSTEP_RESOLUTION as usize].clamp(0, 8))
     }
 
-    /// Torque margin `1 − load/available` at the axis's state now.
-    fn margin(&self, m: usize, scale: f64) -> f64 {
+    /// Torque margin `1 − load/available` at the axis's state now; `off`:
+    /// the driver is switched off ([`Module::driver_off`]).
+    fn margin(&self, m: usize, scale: f64, off: bool) -> f64 {
         let axis = &self.axes[m];
-        let fullsteps = axis.motion.v.abs() / self.microsteps(m);
-        let available = if self.driver_off(m) { 0.0 } else { (scale + 1.0) / 32.0 * (1.0 - fullsteps / CORNER_FULLSTEPS).max(0.0) * 100.0 };
-        let load = self.world.axes[m].load_at(self.mech(m, axis.motion.x), self.now_ns as f64 * 1e-9);
+        let world = &self.world.axes[m];
+        let load = if world.loads.is_empty() { 0.0 } else { world.load_at(self.mech(m, axis.motion.x), self.now_ns as f64 * 1e-9) };
         if scale <= 0.0 && self.motor_current(m) == 0 {
             return if load > 0.0 { -1.0 } else { 1.0 };
         }
+        if off {
+            return -1.0;
+        }
+        if load == 0.0 {
+            // Nothing to carry: the whole torque is margin, at any speed.
+            return 1.0;
+        }
+        let fullsteps = axis.motion.v.abs() / self.microsteps(m);
+        let available = (scale + 1.0) / 32.0 * (1.0 - fullsteps / CORNER_FULLSTEPS).max(0.0) * 100.0;
         if available <= 0.0 {
-            return if load > 0.0 || self.driver_off(m) { -1.0 } else { 1.0 };
+            return if load > 0.0 { -1.0 } else { 1.0 };
         }
         1.0 - load / available
     }
 
     fn stallguard(&self, m: usize, margin: f64) -> i32 {
         let sgt = self.axes[m].params[ap::STALLGUARD_THRESHOLD as usize];
-        (800.0 * margin + 8.0 * sgt as f64).round().clamp(0.0, 1023.0) as i32
+        round_in(800.0 * margin + 8.0 * sgt as f64, 1023.0)
     }
 
     /// After the motion controller moved the axis from `x_before` during
@@ -123,10 +132,10 @@ impl Module {
         let moved = self.axes[m].motion.x - x_before;
         let moving = self.axes[m].motion.v != 0.0 || moved != 0.0;
         let p = self.axes[m].params;
-        let v_int = self.actual_speed(m).abs();
+        let off = self.driver_off(m);
         // coolStep regulates above its threshold speed, when enabled.
         let semin = if self.profile.features.coolstep { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
-        let cool = semin > 0 && moving && v_int >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
+        let cool = semin > 0 && moving && self.actual_speed(m).abs() >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
         if cool {
             let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
             let min =
@@ -140,7 +149,7 @@ impl Module {
             let down_every = [32.0, 8.0, 2.0, 1.0][p[ap::SMART_ENERGY_CURRENT_DOWN_STEP as usize].clamp(0, 3) as usize];
             let mut count = self.axes[m].driver.down_count;
             for _ in 0..measurements.ceil() as usize {
-                let sg = self.stallguard(m, self.margin(m, cs));
+                let sg = self.stallguard(m, self.margin(m, cs, off));
                 if sg < lower {
                     cs = (cs + up).min(max);
                     count = 0.0;
@@ -158,14 +167,14 @@ impl Module {
             self.axes[m].driver.cool_scale = None;
         }
         let scale = self.current_scale(m);
-        let margin = self.margin(m, scale);
+        let margin = self.margin(m, scale, off);
         if self.profile.features.stall_detection == StallDetection::Stallguard2 {
             if moving {
                 self.axes[m].driver.load_value = self.stallguard(m, margin);
             }
             // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
             let stall_speed = p[ap::STOP_ON_STALL as usize];
-            if moving && stall_speed > 0 && v_int >= stall_speed && self.axes[m].driver.load_value == 0 {
+            if moving && stall_speed > 0 && self.actual_speed(m).abs() >= stall_speed && self.axes[m].driver.load_value == 0 {
                 self.stop_now(m);
                 self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
                 self.raise(Source::Stall(m as u8));
@@ -174,7 +183,7 @@ impl Module {
             // TMC249 load indicator (TMCM-351): 0…7, higher is more load;
             // a reading above AP 205 (not 0) stops the motor.
             if moving {
-                self.axes[m].driver.load_value = (7.0 * (1.0 - margin)).round().clamp(0.0, 7.0) as i32;
+                self.axes[m].driver.load_value = round_in(7.0 * (1.0 - margin), 7.0);
             }
             let threshold = p[ap::STALL_THRESHOLD as usize];
             if moving && threshold > 0 && self.axes[m].driver.load_value > threshold {
@@ -182,7 +191,7 @@ impl Module {
             }
         }
         // The carriage follows the motor unless it cannot.
-        let slips = moved != 0.0 && (margin < 0.0 || self.driver_off(m));
+        let slips = moved != 0.0 && (margin < 0.0 || off);
         if self.has_closed_loop() {
             self.closed_loop_step(m, moved, dt, slips);
             return;
@@ -245,5 +254,34 @@ impl Module {
         }
         let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * 10;
         if still_ms >= delay { standby } else { run }
+    }
+}
+
+/// `x` rounded half away from zero and clamped to `0..=max` (`max` a whole
+/// number): `x.round().clamp(0.0, max) as i32` without a call into the
+/// maths library (NaN gives 0, as there).
+fn round_in(x: f64, max: f64) -> i32 {
+    let x = x.clamp(0.0, max);
+    let whole = x as i32;
+    whole + (x - whole as f64 >= 0.5) as i32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_in;
+
+    #[test]
+    fn round_in_is_round_then_clamp() {
+        let cases =
+            [0.0, -0.0, 0.5, 0.49999999999999994, 1.5, 2.5, 6.5, 7.4, 7.6, -0.4, -3.0, 1022.5, 1023.2, 5e9, f64::NAN, f64::INFINITY];
+        for x in cases {
+            for max in [7.0, 1023.0] {
+                assert_eq!(round_in(x, max), x.round().clamp(0.0, max) as i32, "{x} in 0..={max}");
+            }
+        }
+        for i in 0..100_000 {
+            let x = i as f64 * 0.012_345 - 50.0;
+            assert_eq!(round_in(x, 1023.0), x.round().clamp(0.0, 1023.0) as i32, "{x}");
+        }
     }
 }

@@ -16,7 +16,8 @@ impl Module {
     /// AP 3: the actual speed in internal units.
     pub fn actual_speed(&self, m: usize) -> i32 {
         let pd = self.axes[m].params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        motion::velocity_internal(self.axes[m].motion.v, pd).trunc() as i32
+        // `as` truncates towards zero (and saturates), as the register does.
+        motion::velocity_internal(self.axes[m].motion.v, pd) as i32
     }
 
     /// Sign-extends to the module's position width (32 or 24 bits).

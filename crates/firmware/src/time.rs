@@ -216,9 +216,12 @@ impl Module {
     /// Timer `t`'s interrupt number and period in ns, while it runs (the
     /// program runs, the period is not 0, the interrupt is enabled).
     fn timer_period(&self, t: u8) -> Option<(u8, u64)> {
-        let n = self.profile.interrupt_for(Source::Timer(t))?;
+        if !self.program.is_running() {
+            return None;
+        }
+        let n = self.profile.timer_interrupt(t)?;
         let period_ms = self.globals[3][n as usize] as u32 as u64;
-        (self.program.is_running() && period_ms != 0 && self.interrupts.enabled[n as usize]).then_some((n, period_ms * 1_000_000))
+        (period_ms != 0 && self.interrupts.enabled[n as usize]).then_some((n, period_ms * 1_000_000))
     }
 
     /// The next firing of the timer interrupts, without firing them.
@@ -319,12 +322,15 @@ impl Module {
             };
             // With the trace on, every instruction sees the world of its
             // own moment (positions in the trace are exact).
-            let pure = is_pure(ins) && self.program.trace.is_none();
+            let traced = self.program.trace.is_some();
+            let pure = is_pure(ins) && !traced;
             if !pure && self.program.next_ns > self.now_ns {
                 return;
             }
             self.execute_next();
-            if !self.program.is_running() || self.program.wait.is_some() || !pure || self.program.next_ns > limit {
+            // After an instruction that changed the world, `limit` is stale.
+            let world_unchanged = pure || (observes_only(ins) && !traced);
+            if !self.program.is_running() || self.program.wait.is_some() || !world_unchanged || self.program.next_ns > limit {
                 return;
             }
         }
@@ -439,6 +445,14 @@ impl Module {
                         || self.driver_off(m))
         })
     }
+}
+
+/// Instructions that read the world at their own moment (docs/behaviour.md
+/// rule 81) but change
+/// nothing the world's next event depends on: pure instructions after them
+/// may still run ahead of the world.
+fn observes_only(ins: Instruction) -> bool {
+    matches!(ins.opcode, opcode::GAP | opcode::GGP | opcode::GIO)
 }
 
 /// Instructions that touch neither the motors, the I/O nor time: a batch of

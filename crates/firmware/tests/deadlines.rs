@@ -84,3 +84,31 @@ fn wait_refsw_ends_at_the_home_switch_edge() {
     let p = send(&mut m, "GAP 1, 0");
     assert!(p >= 100_000, "{p}");
 }
+
+#[test]
+fn a_polling_loop_leaves_when_the_move_ends_however_time_is_sliced() {
+    // GAP 8 / JC polls while the motor moves; the loop reads the tick
+    // timer when it leaves. WAIT POS gives the arrival itself.
+    let polling = ["MVP ABS, 0, 51200", "GAP 8, 0", "JC ZE, 1", "GGP 132, 0", "STOP"];
+    let waiting = ["MVP ABS, 0, 51200", "WAIT POS, 0, 0", "GGP 132, 0", "STOP"];
+    let run = |lines: &[&str], slice: u64| {
+        let mut m = Module::built_in("tmcm-1141").unwrap();
+        program(&mut m, lines);
+        let mut t = 0;
+        while t < 20_000 * MS {
+            t += slice;
+            m.advance_to(t);
+        }
+        (m.registers().accumulator, m.program().executed, m.actual_position(0))
+    };
+    let (arrival_ms, _, _) = run(&waiting, 20_000 * MS);
+    let (left_ms, executed, position) = run(&polling, 20_000 * MS);
+    assert_eq!(position, 51200);
+    assert!((arrival_ms..=arrival_ms + 1).contains(&left_ms), "polling left at {left_ms} ms, the move ended at {arrival_ms} ms");
+    // One GAP and one JC every 50 µs until then.
+    let pairs = (executed - 3) / 2;
+    assert!((pairs * 50_000).abs_diff(left_ms as u64 * MS) <= MS, "{pairs} polls in {left_ms} ms");
+    for slice in [MS, 25_000, 77_777] {
+        assert_eq!(run(&polling, slice), (left_ms, executed, position), "sliced in {slice} ns");
+    }
+}

@@ -241,6 +241,9 @@ pub struct Profile {
     pub interrupts: Vec<Interrupt>,
     /// The interrupts' sources, read from their symbols once.
     sources: Vec<(InterruptSource, u8)>,
+    /// The interrupt numbers of timers 0, 1 and 2 (looked up on every
+    /// step of virtual time).
+    timers: [Option<u8>; 3],
     opcode_set: [bool; 256],
     ascii_set: [bool; 256],
 }
@@ -303,13 +306,18 @@ impl Profile {
         if file.module.axes == 0 {
             return Err("a module has at least one axis".into());
         }
+        let sources: Vec<(InterruptSource, u8)> =
+            file.interrupt.iter().filter_map(|i| InterruptSource::from_symbol(&i.symbol).map(|s| (s, i.number))).collect();
+        let timer = |t: u8| sources.iter().find(|(s, _)| *s == InterruptSource::Timer(t)).map(|(_, n)| *n);
+        let timers = [timer(0), timer(1), timer(2)];
         let profile = Profile {
             module: file.module,
             features: file.features,
             axis,
             global,
             ports: file.port,
-            sources: file.interrupt.iter().filter_map(|i| InterruptSource::from_symbol(&i.symbol).map(|s| (s, i.number))).collect(),
+            sources,
+            timers,
             interrupts: file.interrupt,
             opcode_set,
             ascii_set,
@@ -378,6 +386,11 @@ impl Profile {
     /// table.
     pub fn interrupt_for(&self, source: InterruptSource) -> Option<u8> {
         self.sources.iter().find(|(s, _)| *s == source).map(|(_, n)| *n)
+    }
+
+    /// The interrupt number of timer `t` (0…2), if the module has it.
+    pub fn timer_interrupt(&self, t: u8) -> Option<u8> {
+        self.timers.get(t as usize).copied().flatten()
     }
 
     /// Every interrupt with a known source: (source, number).
@@ -491,5 +504,18 @@ mod tests {
             "{base}\n[[axis_parameter]]\nnumber = 4\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\ndefault_source = \"assumed\"\n"
         );
         assert!(Profile::from_toml(&dup).unwrap_err().contains("twice"));
+    }
+
+    #[test]
+    fn timer_interrupts_are_the_timer_symbols() {
+        for (name, _) in BUILT_IN {
+            let p = Profile::built_in(name).unwrap();
+            for t in 0..3 {
+                assert_eq!(p.timer_interrupt(t), p.interrupt_for(InterruptSource::Timer(t)), "{name} timer {t}");
+            }
+            assert_eq!(p.timer_interrupt(3), None);
+        }
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        assert_eq!((p.timer_interrupt(0), p.timer_interrupt(2)), (Some(0), Some(2)), "TI_TIMER0…2 are interrupts 0…2");
     }
 }
