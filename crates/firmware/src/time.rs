@@ -448,9 +448,8 @@ impl Module {
 }
 
 /// Instructions that read the world at their own moment (docs/behaviour.md
-/// rule 81) but change
-/// nothing the world's next event depends on: pure instructions after them
-/// may still run ahead of the world.
+/// rule 81) but change nothing the world's next event depends on: pure
+/// instructions after them may still run ahead of the world.
 fn observes_only(ins: Instruction) -> bool {
     matches!(ins.opcode, opcode::GAP | opcode::GGP | opcode::GIO)
 }
