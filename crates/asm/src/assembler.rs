@@ -14,6 +14,7 @@ use crate::encoder::{encode, encode_raw};
 use crate::eval::Evaluator;
 use crate::include::{IncludeResolver, built_in};
 use crate::lexer::strip_comments;
+use crate::limits::{MAX_LINE_BYTES, MAX_TOTAL_SOURCE_BYTES};
 use crate::parser::{Body, parse_line};
 
 /// How deeply includes may nest (a cycle is reported before this).
@@ -35,6 +36,8 @@ struct Loader<'r> {
     stack: Vec<(String, String)>,
     /// Keys of every file read so far (each file is read once).
     seen: HashSet<String>,
+    /// Bytes of source read so far.
+    loaded: usize,
 }
 
 impl Loader<'_> {
@@ -45,10 +48,24 @@ impl Loader<'_> {
     fn load(&mut self, key: String, name: &str, text: &str) {
         let file = self.reporter.add_file(name);
         self.seen.insert(key.clone());
+        self.loaded += text.len();
+        if self.loaded > MAX_TOTAL_SOURCE_BYTES {
+            let loc = self.next_loc(file, 0);
+            return self.reporter.error(
+                loc,
+                0,
+                format!("the sources pass {} MiB, the limit of one assembly", MAX_TOTAL_SOURCE_BYTES >> 20),
+            );
+        }
         self.stack.push((key, name.to_string()));
-        let (lines, unterminated) = strip_comments(text);
+        let (lines, unterminated, too_long) = strip_comments(text, MAX_LINE_BYTES);
         for (index, line) in lines.iter().enumerate() {
             let number = index + 1;
+            if too_long.binary_search(&number).is_ok() {
+                let loc = self.next_loc(file, number);
+                self.reporter.error(loc, 1, format!("line longer than {MAX_LINE_BYTES} bytes"));
+                continue;
+            }
             let (parsed, error) = parse_line(line);
             let loc = self.next_loc(file, number);
             if let Some((column, message)) = error {
@@ -110,7 +127,8 @@ pub fn assemble(
     resolver: &dyn IncludeResolver,
     profile: Option<&Profile>,
 ) -> Result<Program, Vec<Diagnostic>> {
-    let mut loader = Loader { resolver, reporter: Reporter::default(), statements: Vec::new(), stack: Vec::new(), seen: HashSet::new() };
+    let mut loader =
+        Loader { resolver, reporter: Reporter::default(), statements: Vec::new(), stack: Vec::new(), seen: HashSet::new(), loaded: 0 };
     loader.load(resolver.key(file_name), file_name, source);
     let Loader { mut reporter, statements, .. } = loader;
     let mut evaluator = Evaluator::new();

@@ -120,11 +120,37 @@ pub(crate) struct Loc {
     pub line: usize,
 }
 
-/// Collects the diagnostics of one assembly.
+/// Collects the diagnostics of one assembly: the first
+/// [`MAX_ERRORS`](crate::limits::MAX_ERRORS) in source order, and how many
+/// there were in all.
 #[derive(Debug, Default)]
 pub(crate) struct Reporter {
     pub files: Vec<String>,
-    items: Vec<(usize, Diagnostic)>,
+    /// The earliest errors so far, the latest of them on top.
+    items: std::collections::BinaryHeap<Ranked>,
+    total: usize,
+}
+
+/// A diagnostic ordered by its place in the source.
+#[derive(Debug, PartialEq, Eq)]
+struct Ranked {
+    seq: usize,
+    column: usize,
+    /// Order of arrival: equal places keep it.
+    arrival: usize,
+    diagnostic: Diagnostic,
+}
+
+impl Ord for Ranked {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        (self.seq, self.column, self.arrival).cmp(&(other.seq, other.column, other.arrival))
+    }
+}
+
+impl PartialOrd for Ranked {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
 }
 
 impl Reporter {
@@ -134,8 +160,17 @@ impl Reporter {
     }
 
     pub fn error(&mut self, at: Loc, column: usize, message: impl Into<String>) {
+        let limit = crate::limits::MAX_ERRORS;
+        let ranked = |diagnostic, arrival| Ranked { seq: at.seq, column, arrival, diagnostic };
+        self.total += 1;
+        if self.items.len() == limit && self.items.peek().is_some_and(|top| (top.seq, top.column) <= (at.seq, column)) {
+            return;
+        }
         let file = self.files.get(at.file).cloned().unwrap_or_default();
-        self.items.push((at.seq, Diagnostic::new(file, at.line, column, message)));
+        self.items.push(ranked(Diagnostic::new(file, at.line, column, message), self.total));
+        if self.items.len() > limit {
+            self.items.pop();
+        }
     }
 
     /// `file:line:column` of a place, for "first defined at …".
@@ -147,9 +182,15 @@ impl Reporter {
         self.items.is_empty()
     }
 
-    /// The diagnostics in source order.
-    pub fn finish(mut self) -> Vec<Diagnostic> {
-        self.items.sort_by_key(|(seq, d)| (*seq, d.column));
-        self.items.into_iter().map(|(_, d)| d).collect()
+    /// The diagnostics in source order; past the limit, a last one says
+    /// how many more there were.
+    pub fn finish(self) -> Vec<Diagnostic> {
+        let shown = self.items.len();
+        let mut out: Vec<Diagnostic> = self.items.into_sorted_vec().into_iter().map(|r| r.diagnostic).collect();
+        if self.total > shown {
+            let file = self.files.first().cloned().unwrap_or_default();
+            out.push(Diagnostic::new(file, 0, 0, format!("{} more errors not shown (the first {shown} are)", self.total - shown)));
+        }
+        out
     }
 }

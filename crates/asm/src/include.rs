@@ -85,12 +85,12 @@ impl IncludeResolver for FileResolver {
             if !path.is_file() {
                 continue;
             }
-            let text = std::fs::read(path).map_err(|e| format!("cannot read include file '{}': {e}", path.display()))?;
+            let text = crate::limits::read_source(path).map_err(|e| format!("cannot read include file '{}': {e}", path.display()))?;
             let key = std::fs::canonicalize(path).unwrap_or_else(|_| normalize(path));
             return Ok(IncludedFile {
                 key: key.to_string_lossy().into_owned(),
                 name: normalize(path).to_string_lossy().into_owned(),
-                text: String::from_utf8_lossy(&text).into_owned(),
+                text,
             });
         }
         let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();

@@ -79,12 +79,19 @@ pub struct Unterminated {
 }
 
 /// Splits a source text into lines with comments blanked out. A `/*`
-/// without `*/` blanks the rest of the file and is reported.
-pub fn strip_comments(source: &str) -> (Vec<String>, Option<Unterminated>) {
+/// without `*/` blanks the rest of the file and is reported. A line longer
+/// than `max_line` bytes is left empty; its number is in the third part.
+pub fn strip_comments(source: &str, max_line: usize) -> (Vec<String>, Option<Unterminated>, Vec<usize>) {
     let mut lines = Vec::new();
     let mut open: Option<Unterminated> = None;
+    let mut too_long = Vec::new();
     for (index, raw) in source.split('\n').enumerate() {
         let raw = raw.strip_suffix('\r').unwrap_or(raw);
+        if raw.len() > max_line {
+            too_long.push(index + 1);
+            lines.push(String::new());
+            continue;
+        }
         let chars: Vec<char> = raw.chars().collect();
         let mut out = String::with_capacity(raw.len());
         let mut i = 0;
@@ -113,7 +120,7 @@ pub fn strip_comments(source: &str) -> (Vec<String>, Option<Unterminated>) {
         }
         lines.push(out);
     }
-    (lines, open)
+    (lines, open, too_long)
 }
 
 fn is_name_start(c: char) -> bool {
@@ -216,10 +223,10 @@ mod tests {
 
     #[test]
     fn comments_become_blanks() {
-        let (lines, open) = strip_comments("ROL 0, 1000 // spin\n/* a\nb */ MST 0\r\nSTOP");
+        let (lines, open, _) = strip_comments("ROL 0, 1000 // spin\n/* a\nb */ MST 0\r\nSTOP", 100);
         assert_eq!(lines, vec!["ROL 0, 1000        ", "    ", "     MST 0", "STOP"]);
         assert_eq!(open, None);
-        let (_, open) = strip_comments("STOP\n  /* never closed");
+        let (_, open, _) = strip_comments("STOP\n  /* never closed", 100);
         assert_eq!(open, Some(Unterminated { line: 2, column: 3 }));
     }
 

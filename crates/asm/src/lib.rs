@@ -20,7 +20,8 @@
 //! - `assembler.rs`: the passes that tie these together;
 //! - `binary.rs`, `symbol_file.rs`: output formats;
 //! - `disasm.rs`: the disassembler;
-//! - `diagnostic.rs`: error messages with file, line and column.
+//! - `diagnostic.rs`: error messages with file, line and column;
+//! - `limits.rs`: how much source is read and how many errors reported.
 
 mod assembler;
 pub mod binary;
@@ -32,6 +33,7 @@ mod eval;
 mod expr;
 pub mod include;
 mod lexer;
+pub mod limits;
 mod parser;
 pub mod symbol_file;
 
@@ -88,6 +90,6 @@ impl Program {
 pub fn assemble_file(path: impl AsRef<Path>, profile: Option<&Profile>) -> Result<Program, Vec<Diagnostic>> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| vec![Diagnostic::new(name.clone(), 0, 0, format!("cannot read the file: {e}"))])?;
-    assemble(&String::from_utf8_lossy(&bytes), &name, &FileResolver::new(), profile)
+    let text = limits::read_source(path).map_err(|e| vec![Diagnostic::new(name.clone(), 0, 0, format!("cannot read the file: {e}"))])?;
+    assemble(&text, &name, &FileResolver::new(), profile)
 }

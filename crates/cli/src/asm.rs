@@ -67,13 +67,15 @@ pub fn asm(args: AsmArgs) -> Result<ExitCode, String> {
 }
 
 pub fn disasm(args: DisasmArgs) -> Result<ExitCode, String> {
-    let bytes = std::fs::read(&args.binary).map_err(|e| format!("{}: {e}", args.binary.display()))?;
+    use tmclsim_firmware::files::{MAX_BINARY_BYTES, MAX_CONFIG_BYTES, read_limited, read_text_limited};
+    let bytes = read_limited(&args.binary, MAX_BINARY_BYTES, "a program binary")?;
     let words = Program::from_binary(&bytes).map_err(|e| format!("{}: {e}", args.binary.display()))?;
     let sym_path = args.symbols.clone().unwrap_or_else(|| args.binary.with_extension("sym"));
-    let symbols = match std::fs::read_to_string(&sym_path) {
-        Ok(text) => Some(Program::parse_symbol_file(&text).map_err(|e| format!("{}: {e}", sym_path.display()))?),
-        Err(_) if args.symbols.is_none() => None,
-        Err(e) => return Err(format!("{}: {e}", sym_path.display())),
+    let symbols = if args.symbols.is_none() && !sym_path.exists() {
+        None
+    } else {
+        let text = read_text_limited(&sym_path, MAX_CONFIG_BYTES, "a symbol file")?;
+        Some(Program::parse_symbol_file(&text).map_err(|e| format!("{}: {e}", sym_path.display()))?)
     };
     let text = disassemble(&words, symbols.as_ref());
     match args.output {

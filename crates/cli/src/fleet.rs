@@ -66,9 +66,13 @@ pub struct Link {
     pub wire_timing: bool,
 }
 
+/// Most modules one fleet serves (about 32 KiB each).
+pub const MAX_MODULES: usize = 10_000;
+
 /// Reads a fleet file and expands counts and buses.
 pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    use tmclsim_firmware::files::{MAX_CONFIG_BYTES, read_text_limited};
+    let text = read_text_limited(path, MAX_CONFIG_BYTES, "a fleet file")?;
     let f: FleetFile = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut out = Vec::new();
     for (i, l) in f.link.iter().enumerate() {
@@ -89,11 +93,27 @@ pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
         if modules.is_empty() {
             return Err(format!("{}: no modules (give modules = [...] or bus = ...)", what()));
         }
+        if let Some(a) = tmclsim_firmware::bus::duplicate_address(modules.iter().map(|(_, a)| *a)) {
+            return Err(format!("{}: two modules at address {a} (each module of a bus has its own address)", what()));
+        }
         if l.tcp.is_none() && l.pty.is_none() {
             return Err(format!("{}: give tcp = \"ADDR\" or pty = \"PATH\"", what()));
         }
+        if l.count == 0 {
+            return Err(format!("{}: count is at least 1", what()));
+        }
+        let total = out.iter().map(|l: &Link| l.modules.len()).sum::<usize>();
+        if l.count.saturating_mul(modules.len()).saturating_add(total) > MAX_MODULES {
+            return Err(format!("{}: the fleet would have more than {MAX_MODULES} modules, the limit of one fleet", what()));
+        }
+        if let Some(a) = l.tcp
+            && a.port() != 0
+            && a.port() as usize + (l.count - 1) > u16::MAX as usize
+        {
+            return Err(format!("{}: {} links from port {} would pass port 65535", what(), l.count, a.port()));
+        }
         for k in 0..l.count {
-            let tcp = l.tcp.map(|a| SocketAddr::new(a.ip(), a.port() + if a.port() == 0 { 0 } else { k as u16 }));
+            let tcp = l.tcp.map(|a| SocketAddr::new(a.ip(), if a.port() == 0 { 0 } else { a.port() + k as u16 }));
             let pty = l.pty.as_ref().map(|p| if l.count > 1 { PathBuf::from(format!("{}-{k}", p.display())) } else { p.clone() });
             out.push(Link {
                 tcp,
@@ -162,12 +182,24 @@ pub struct FleetBenchArgs {
     /// The fleet file to serve and drive.
     #[arg(long, value_name = "FILE")]
     pub fleet: PathBuf,
-    /// Commands per second to each module.
-    #[arg(long, default_value_t = 10.0)]
+    /// Commands per second to each module (more than 0, at most 100000).
+    #[arg(long, default_value_t = 10.0, value_parser = parse_rate)]
     pub rate: f64,
     /// How long to drive the fleet.
     #[arg(long = "for", value_name = "DURATION", default_value = "10s", value_parser = crate::run::parse_duration)]
     pub duration: u64,
+}
+
+/// Most commands per second to one module `fleet-bench` sends.
+const MAX_RATE: f64 = 100_000.0;
+
+fn parse_rate(text: &str) -> Result<f64, String> {
+    let rate: f64 = text.parse().map_err(|_| format!("'{text}' is not a number"))?;
+    if rate > 0.0 && rate <= MAX_RATE {
+        Ok(rate)
+    } else {
+        Err(format!("the rate is more than 0 and at most {MAX_RATE} commands per second"))
+    }
 }
 
 /// Serves the fleet in a child process, drives every module at `rate`

@@ -156,6 +156,16 @@ struct ProfileArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Serve(_) | Command::Bench(_) | Command::FleetBench(_)) {
+        // A command whose output goes to a reader that stops early
+        // (`tmclsim profile | head`) ends quietly, as other tools do.
+        // Servers keep ignoring the signal: their links report a closed
+        // peer as an error of that link only.
+        // SAFETY: called before any other thread exists.
+        unsafe {
+            libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        }
+    }
     let result = match cli.command {
         Command::Serve(a) => serve::run(a),
         Command::Send(a) => send::run(a),

@@ -20,6 +20,9 @@ fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {
     if modules.is_empty() {
         return Err("--bus names no module".into());
     }
+    if let Some(a) = tmclsim_firmware::bus::duplicate_address(modules.iter().map(Module::address)) {
+        return Err(format!("--bus: two modules at address {a} (each module of a bus has its own address)"));
+    }
     Ok(modules)
 }
 

@@ -29,7 +29,8 @@ pub struct UploadArgs {
 
 pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
     let words: Vec<Instruction> = if args.program.extension().is_some_and(|e| e == "bin") {
-        let bytes = std::fs::read(&args.program).map_err(|e| format!("{}: {e}", args.program.display()))?;
+        use tmclsim_firmware::files::{MAX_BINARY_BYTES, read_limited};
+        let bytes = read_limited(&args.program, MAX_BINARY_BYTES, "a program binary")?;
         Program::from_binary(&bytes)?
     } else {
         crate::asm::assemble(&args.program, &args.module)?.0.instructions

@@ -244,6 +244,13 @@ impl Bus {
     }
 }
 
+/// The first address two modules share, if any: on one link every module
+/// needs its own address, or two would answer one frame.
+pub fn duplicate_address(addresses: impl IntoIterator<Item = u8>) -> Option<u8> {
+    let mut seen = [false; 256];
+    addresses.into_iter().find(|&a| std::mem::replace(&mut seen[a as usize], true))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -327,5 +334,12 @@ mod tests {
         bus.set_wire_timing(true);
         // 9600 baud (GP 65 = 0): 180 bits.
         assert_eq!(bus.handle_frame(&frame(1, 6, 1, 0)).delay_ns, 18_750_000);
+    }
+
+    #[test]
+    fn a_shared_address_is_found() {
+        assert_eq!(super::duplicate_address([1, 2, 3]), None);
+        assert_eq!(super::duplicate_address([1, 2, 1, 2]), Some(1));
+        assert_eq!(super::duplicate_address([]), None);
     }
 }

@@ -14,6 +14,7 @@ mod commands;
 pub mod driver;
 pub mod eeprom;
 pub mod executor;
+pub mod files;
 mod frames;
 mod interpreter;
 mod mechanics;
