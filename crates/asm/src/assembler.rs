@@ -14,7 +14,7 @@ use crate::encoder::{encode, encode_raw};
 use crate::eval::Evaluator;
 use crate::include::{IncludeResolver, built_in};
 use crate::lexer::strip_comments;
-use crate::limits::{MAX_LINE_BYTES, MAX_TOTAL_SOURCE_BYTES};
+use crate::limits::{MAX_LINE_BYTES, MAX_STATEMENTS, MAX_TOTAL_SOURCE_BYTES};
 use crate::parser::{Body, parse_line};
 
 /// How deeply includes may nest (a cycle is reported before this).
@@ -38,6 +38,8 @@ struct Loader<'r> {
     seen: HashSet<String>,
     /// Bytes of source read so far.
     loaded: usize,
+    /// The statement limit was reached: nothing more is read.
+    full: bool,
 }
 
 impl Loader<'_> {
@@ -60,6 +62,9 @@ impl Loader<'_> {
         self.stack.push((key, name.to_string()));
         let (lines, unterminated, too_long) = strip_comments(text, MAX_LINE_BYTES);
         for (index, line) in lines.iter().enumerate() {
+            if self.full {
+                break;
+            }
             let number = index + 1;
             if too_long.binary_search(&number).is_ok() {
                 let loc = self.next_loc(file, number);
@@ -78,6 +83,11 @@ impl Loader<'_> {
                 Body::Include { file, column } => Some((file.clone(), *column)),
                 _ => None,
             };
+            if self.statements.len() == MAX_STATEMENTS {
+                self.reporter.error(loc, 1, format!("more than {MAX_STATEMENTS} statements, the limit of one assembly"));
+                self.full = true;
+                break;
+            }
             self.statements.push(Statement { loc, labels: parsed.labels, body: parsed.body });
             if let Some((wanted, column)) = include {
                 self.include(name, &wanted, loc, column);
@@ -127,8 +137,15 @@ pub fn assemble(
     resolver: &dyn IncludeResolver,
     profile: Option<&Profile>,
 ) -> Result<Program, Vec<Diagnostic>> {
-    let mut loader =
-        Loader { resolver, reporter: Reporter::default(), statements: Vec::new(), stack: Vec::new(), seen: HashSet::new(), loaded: 0 };
+    let mut loader = Loader {
+        resolver,
+        reporter: Reporter::default(),
+        statements: Vec::new(),
+        stack: Vec::new(),
+        seen: HashSet::new(),
+        loaded: 0,
+        full: false,
+    };
     loader.load(resolver.key(file_name), file_name, source);
     let Loader { mut reporter, statements, .. } = loader;
     let mut evaluator = Evaluator::new();

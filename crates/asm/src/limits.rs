@@ -8,9 +8,12 @@ use std::path::Path;
 /// with comments is a few hundred KiB at most).
 pub const MAX_SOURCE_BYTES: u64 = 2 << 20;
 /// Bytes of all the source one assembly reads, includes counted.
-pub const MAX_TOTAL_SOURCE_BYTES: usize = 8 << 20;
+pub const MAX_TOTAL_SOURCE_BYTES: usize = 4 << 20;
 /// Bytes of one source line; a longer line is an error and not parsed.
 pub const MAX_LINE_BYTES: usize = 4096;
+/// Statements (lines with a label, an instruction, a constant or an
+/// include) of one assembly: twenty times the largest program memory.
+pub const MAX_STATEMENTS: usize = 100_000;
 /// Errors reported by one assembly; the rest are counted in a last line.
 pub const MAX_ERRORS: usize = 100;
 

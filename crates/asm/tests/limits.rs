@@ -61,3 +61,15 @@ fn includes_count_towards_one_budget() {
     assert_eq!(d[0].message, format!("the sources pass {} MiB, the limit of one assembly", MAX_TOTAL_SOURCE_BYTES >> 20));
     assert!(d[0].file.ends_with("c.inc") || d[0].file.ends_with("d.inc"), "{}", d[0]);
 }
+
+#[test]
+fn statements_past_the_limit_end_the_assembly_with_one_error() {
+    use tmclsim_asm::limits::MAX_STATEMENTS;
+    let source = (0..MAX_STATEMENTS + 5).map(|i| format!("L{i}:\n")).collect::<String>();
+    let d = assemble(&source, "labels.tmc", &NoIncludes, None).unwrap_err();
+    assert_eq!(d.len(), 1, "{:?}", &d[..d.len().min(3)]);
+    assert_eq!(d[0].line, MAX_STATEMENTS + 1);
+    assert_eq!(d[0].message, format!("more than {MAX_STATEMENTS} statements, the limit of one assembly"));
+    let fits = (0..MAX_STATEMENTS).map(|i| format!("L{i}:\n")).collect::<String>();
+    assert!(assemble(&fits, "labels.tmc", &NoIncludes, None).is_ok());
+}
