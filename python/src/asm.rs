@@ -197,8 +197,7 @@ pub fn assemble(
 pub fn assemble_file(py: Python<'_>, path: PathBuf, profile: Option<&str>, include_path: Option<Vec<PathBuf>>) -> PyResult<Program> {
     let profile = profile_by_name(profile)?;
     let name = path.display().to_string();
-    let bytes = std::fs::read(&path).map_err(|e| crate::errors::os_error(format!("{name}: {e}")))?;
-    let source = String::from_utf8_lossy(&bytes);
+    let source = tmclsim_asm::limits::read_source(&path).map_err(|e| crate::errors::os_error(format!("{name}: {e}")))?;
     let inner = tmclsim_asm::assemble(&source, &name, &resolver(include_path), profile.as_deref()).map_err(|d| assembly_error(py, &d))?;
     Ok(Program { inner })
 }
