@@ -76,14 +76,26 @@ pub struct Parameter {
     pub default_source: DefaultSource,
     pub unit: Option<String>,
     pub note: Option<String>,
+    /// When the values within `min…max` are not all valid: the valid
+    /// ones, as inclusive ranges (e.g. AP 193's modes 1–8, 65–68, 133–136).
+    pub ranges: Vec<(i64, i64)>,
 }
 
 impl Parameter {
-    /// Checks a wire value against the range. Ranges above 2^31−1 (the
-    /// timer periods of bank 3) read the 32 bits as unsigned.
+    /// Checks a wire value against the range (and the valid ranges within
+    /// it). Ranges above 2^31−1 (the timer periods of bank 3) read the 32
+    /// bits as unsigned.
     pub fn accepts(&self, value: i32) -> bool {
         let v = if self.max > i32::MAX as i64 { value as u32 as i64 } else { value as i64 };
-        (self.min..=self.max).contains(&v)
+        (self.min..=self.max).contains(&v) && (self.ranges.is_empty() || self.ranges.iter().any(|&(lo, hi)| (lo..=hi).contains(&v)))
+    }
+
+    /// The valid values for messages: "1…8, 65…68, 133…136" or "0…2047".
+    pub fn range_text(&self) -> String {
+        if self.ranges.is_empty() {
+            return format!("{}…{}", self.min, self.max);
+        }
+        self.ranges.iter().map(|(lo, hi)| if lo == hi { lo.to_string() } else { format!("{lo}…{hi}") }).collect::<Vec<_>>().join(", ")
     }
 
     /// The default as the 32-bit word the module holds.
@@ -176,6 +188,9 @@ struct ParameterRow {
     source: Option<String>,
     #[serde(default)]
     note: Option<String>,
+    /// Valid values as inclusive `[from, to]` ranges within min…max.
+    #[serde(default)]
+    ranges: Vec<[i64; 2]>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -266,6 +281,15 @@ impl Profile {
             if !(row.min..=row.max).contains(&row.default) {
                 return Err(format!("parameter {} ({}): default {} outside {}…{}", row.number, row.name, row.default, row.min, row.max));
             }
+            if row.ranges.iter().any(|&[lo, hi]| lo > hi || lo < row.min || hi > row.max) {
+                return Err(format!(
+                    "parameter {} ({}): ranges must lie within {}…{}, each from ≤ to",
+                    row.number, row.name, row.min, row.max
+                ));
+            }
+            if !row.ranges.is_empty() && !row.ranges.iter().any(|&[lo, hi]| (lo..=hi).contains(&row.default)) {
+                return Err(format!("parameter {} ({}): default {} outside its ranges", row.number, row.name, row.default));
+            }
             let _ = &row.source;
             for n in row.number..=row.last.unwrap_or(row.number) {
                 if table[n as usize].is_some() {
@@ -281,6 +305,7 @@ impl Profile {
                     default_source: row.default_source,
                     unit: row.unit.clone(),
                     note: row.note.clone(),
+                    ranges: row.ranges.iter().map(|&[lo, hi]| (lo, hi)).collect(),
                 });
             }
             Ok(())
@@ -517,5 +542,19 @@ mod tests {
         }
         let p = Profile::built_in("tmcm-1141").unwrap();
         assert_eq!((p.timer_interrupt(0), p.timer_interrupt(2)), (Some(0), Some(2)), "TI_TIMER0…2 are interrupts 0…2");
+    }
+
+    #[test]
+    fn reference_search_mode_takes_only_the_manual_modes() {
+        for name in ["tmcm-1141", "tmcm-1310"] {
+            let p = Profile::built_in(name).unwrap();
+            let mode = p.axis_parameter(193).unwrap();
+            let valid: Vec<i32> = (-5..300).filter(|&v| mode.accepts(v)).collect();
+            let expected: Vec<i32> = (1..=8).chain(65..=68).chain(133..=136).collect();
+            assert_eq!(valid, expected, "{name}");
+            assert_eq!(mode.range_text(), "1…8, 65…68, 133…136");
+        }
+        let bad = BUILT_IN[0].1.replace("ranges = [[1, 8], [65, 68], [133, 136]]", "ranges = [[1, 8], [65, 200]]");
+        assert!(Profile::from_toml(&bad).unwrap_err().contains("ranges must lie within 1…136"));
     }
 }

@@ -260,6 +260,19 @@ mod tests {
     }
 
     #[test]
+    fn reference_search_mode_takes_the_manuals_modes_only() {
+        // AP 193: modes 1–8, +64 on modes 1–4, +128 on modes 5–8.
+        let mut m = module("tmcm-1141");
+        for v in [1, 4, 8, 65, 68, 133, 136] {
+            assert_eq!(status(&mut m, &format!("SAP 193, 0, {v}")), Status::Ok, "mode {v}");
+        }
+        for v in [0, 9, 50, 64, 69, 100, 132, 137] {
+            assert_eq!(status(&mut m, &format!("SAP 193, 0, {v}")), Status::InvalidValue, "mode {v}");
+        }
+        assert_eq!(ok(&mut m, "GAP 193, 0"), 136, "a refused mode changes nothing");
+    }
+
+    #[test]
     fn aap_and_agp_write_the_accumulator() {
         let mut m = module("tmcm-1141");
         ok(&mut m, "CALC LOAD, 1500");
