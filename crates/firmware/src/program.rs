@@ -119,6 +119,13 @@ impl Program {
         matches!(self.mode, RunMode::Run)
     }
 
+    /// The program counter as the module reports it (GP 130, 135 type 1):
+    /// during a WAIT it is held at the WAIT's own address
+    /// (docs/behaviour.md rule 35); `pc` already points past it.
+    pub fn counter(&self) -> u16 {
+        if self.wait.is_some() { self.pc.wrapping_sub(1) } else { self.pc }
+    }
+
     pub fn set_pending(&mut self, n: u8) {
         self.pending[n as usize / 64] |= 1 << (n % 64);
     }

@@ -104,7 +104,7 @@ impl ModuleSnapshot {
         let p = m.program();
         let program = ProgramSnapshot {
             state: p.mode,
-            pc: p.pc,
+            pc: p.counter(),
             accumulator: r.accumulator,
             x: r.x,
             compare: match r.compare {

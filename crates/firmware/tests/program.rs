@@ -56,9 +56,9 @@ fn download_read_back_and_status() {
     let status = send(&mut m, "#135 1 0 0");
     assert_eq!(status >> 24, 1, "running");
     assert_eq!(status >> 16 & 0xFF, 1, "waiting");
-    assert_eq!(status & 0xFFFF, 2, "program counter after the WAIT");
+    assert_eq!(status & 0xFFFF, 1, "the program counter is held at the WAIT");
     assert_eq!(send(&mut m, "GGP 128, 0"), 1);
-    assert_eq!(send(&mut m, "GGP 130, 0"), 2);
+    assert_eq!(send(&mut m, "GGP 130, 0"), 1);
     assert_eq!(reply(&mut m, "#128 0 0 0").status, 100);
     assert_eq!(send(&mut m, "GGP 128, 0"), 0);
     // Download past the end of memory.

@@ -137,9 +137,8 @@ fn stop_and_status() {
     assert_eq!(send(&mut m, "RFS STATUS, 0"), 0);
     m.advance(5_000 * MS);
     assert_eq!(send(&mut m, "GAP 3, 0"), 0, "stopped");
-    // A mode the module does not have.
-    send(&mut m, "SAP 193, 0, 69");
-    let f = Request::new(1, parse_line("RFS START, 0").unwrap()).encode();
+    // A mode the module does not have is refused by AP 193 itself.
+    let f = Request::new(1, parse_line("SAP 193, 0, 69").unwrap()).encode();
     assert_eq!(Reply::decode(&m.handle_frame(&f).unwrap()).unwrap().status, 4);
 }
 

@@ -67,6 +67,9 @@ impl Module {
             }
             CalcV { op, var, value } => {
                 let v = self.user_variable(var as usize);
+                // NOT inverts the variable itself, the value is ignored
+                // (manual 3.7.45).
+                let value = if op == CalcOp::Not { v } else { value };
                 self.calc_into(op, v, value, |m, r| m.set_user_variable(var as usize, r), |_, _| {})?;
                 Ok(echo)
             }
@@ -268,6 +271,8 @@ mod tests {
         assert_eq!(m.user_variable(3), -42);
         ok(&mut m, "CALCXV NOT, 2");
         assert_eq!(m.registers.x, !142);
+        ok(&mut m, "CALCV NOT, 2, 5");
+        assert_eq!(m.user_variable(2), !142, "CALCV NOT inverts the variable, the value is ignored");
         assert_eq!(direct(&mut m, "CALCVV ADD, 1, 300").0, Status::InvalidValue, "no user variable 300");
     }
 

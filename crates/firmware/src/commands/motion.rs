@@ -391,8 +391,12 @@ mod tests {
     #[test]
     fn rfs_with_a_mode_the_module_lacks() {
         let mut m = module("tmcm-1141");
-        ok(&mut m, "SAP 193, 0, 69");
-        assert_eq!(status(&mut m, "RFS START, 0"), Status::InvalidValue, "+64 only with modes 1–4");
+        // +64 only with modes 1–4: AP 193 refuses 69 (status 4), and a
+        // mode that got past it (EEPROM written by an older tmclsim) stops
+        // RFS with status 4.
+        assert_eq!(status(&mut m, "SAP 193, 0, 69"), Status::InvalidValue);
+        m.axes[0].params[193] = 69;
+        assert_eq!(status(&mut m, "RFS START, 0"), Status::InvalidValue);
         assert_eq!(ok(&mut m, "RFS STATUS, 0"), 0);
     }
 }

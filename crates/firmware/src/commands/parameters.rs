@@ -218,7 +218,7 @@ impl Module {
             (0, gp::TICK_TIMER) => self.globals.tick_timer(self.now_ns),
             (0, gp::APPLICATION_STATUS) => self.program.mode as i32,
             (0, gp::DOWNLOAD_MODE) => self.program.download.is_some() as i32,
-            (0, gp::PROGRAM_COUNTER) => self.program.pc as i32,
+            (0, gp::PROGRAM_COUNTER) => self.program.counter() as i32,
             (0, gp::RANDOM) => self.globals.random(),
             _ => self.globals[bank as usize][param as usize],
         })

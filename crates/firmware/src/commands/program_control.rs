@@ -81,7 +81,7 @@ impl Module {
                 let word = |address: u16| ((p.mode as i32) << 24) | ((p.wait.is_some() as i32) << 16) | address as i32;
                 Ok(ok(match kind {
                     0 => word(p.download_pointer),
-                    1 => word(p.pc),
+                    1 => word(p.counter()),
                     2 => self.registers.accumulator,
                     _ => self.registers.x,
                 }))
@@ -207,7 +207,11 @@ mod tests {
         ok(&mut m, "#129 0 0 0");
         m.advance(1_000_000);
         let word = ok(&mut m, "#135 1 0 0");
-        assert_eq!((word >> 24, (word >> 16) & 0xFF, word & 0xFFFF), (RunMode::Run as i32, 1, 1), "mode, waiting, pc");
+        assert_eq!((word >> 24, (word >> 16) & 0xFF, word & 0xFFFF), (RunMode::Run as i32, 1, 0), "mode, waiting, pc held at the WAIT");
+        assert_eq!(ok(&mut m, "GGP 130, 0"), 0, "GP 130 too");
+        m.advance(1_000_000_000);
+        let word = ok(&mut m, "#135 1 0 0");
+        assert_eq!((word >> 24, (word >> 16) & 0xFF, word & 0xFFFF), (RunMode::Stop as i32, 0, 2), "after the WAIT and STOP");
         ok(&mut m, "CALC LOAD, -9");
         assert_eq!(ok(&mut m, "#135 2 0 0"), -9, "type 2: the accumulator");
         ok(&mut m, "CALCX LOAD");
