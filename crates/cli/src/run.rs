@@ -99,7 +99,10 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let stdin = std::io::stdin();
     let mut lines = stdin.lock().lines();
     while bus.now_ns() < end {
-        if debugging || bus.module(0).program().hit_breakpoint.is_some() {
+        // A breakpoint stops the program (step mode); after `continue` the
+        // program runs on past the breakpoint it stood on.
+        let at_breakpoint = bus.module(0).program().hit_breakpoint.is_some() && bus.module(0).program().mode != RunMode::Run;
+        if debugging || at_breakpoint {
             if let Some(pc) = bus.module(0).program().hit_breakpoint {
                 println!("breakpoint at {pc}");
             }

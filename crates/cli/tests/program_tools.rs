@@ -85,6 +85,26 @@ fn run_prints_a_summary_and_writes_trace_and_plot() {
 }
 
 #[test]
+fn continue_at_a_breakpoint_runs_to_the_next_hit() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["run", example("djnz_3_7_43.tmc").to_str().unwrap(), "--for", "60s", "--break", "Loop"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write;
+    child.stdin.as_mut().unwrap().write_all(b"c\nc\nc\nq\n").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let t = String::from_utf8_lossy(&out.stdout);
+    // Each pass of the loop (a move and a 5 s WAIT) hits Loop once more.
+    let times: Vec<f64> =
+        t.split("[").skip(1).filter(|p| p.contains("] 1: MVP REL")).map(|p| p.split(" s]").next().unwrap().parse().unwrap()).collect();
+    assert_eq!(times.len(), 4, "{t}");
+    assert!(times.windows(2).all(|w| w[1] - w[0] > 5.0), "every continue runs one pass of the loop: {times:?}");
+    assert_eq!(t.matches("breakpoint at 1").count(), 4, "{t}");
+}
+
+#[test]
 fn run_with_breakpoint_and_scripted_debugger() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
         .args(["run", example("djnz_3_7_43.tmc").to_str().unwrap(), "--for", "60s", "--break", "Loop"])
