@@ -1,119 +1,277 @@
-//! `--plot`: position and velocity over time per axis, as a PNG.
+//! `tmclsim run --plot FILE.png|FILE.svg` and `--samples FILE.csv`: the
+//! motion of a run sampled at a fixed step of virtual time.
 //!
-//! One panel per axis: position in blue, velocity in orange, each scaled
-//! to its own range; grey lines mark zero. The ranges are written into the
-//! PNG's text chunks and printed by `tmclsim run`.
+//! The plot has one panel per quantity and axis, all on one time axis:
+//! position (with the target), velocity, and — where they change within
+//! the window — the load reading (AP 206), the motor current and the
+//! digital outputs. Axes carry their units, every panel a legend.
 
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::io::Write;
 use std::path::Path;
 use tmclsim_firmware::Module;
 
+/// The motion of a run, one row per sample.
 pub struct Samples {
     time: Vec<f64>,
-    /// Per axis: (position, speed) per sample.
-    axes: Vec<Vec<(f64, f64)>>,
+    axes: Vec<AxisSeries>,
+    outputs: Vec<u32>,
+    /// How many digital outputs the module has (bits of `outputs`).
+    output_count: u32,
 }
 
-const WIDTH: usize = 1000;
-const PANEL: usize = 300;
-const MARGIN: usize = 10;
+#[derive(Default)]
+struct AxisSeries {
+    position: Vec<f64>,
+    target: Vec<f64>,
+    speed: Vec<f64>,
+    load: Vec<f64>,
+    current: Vec<f64>,
+}
+
+const WIDTH: u32 = 1200;
+const PANEL_HEIGHT: u32 = 230;
+/// Points drawn per line at most; denser series are drawn as their
+/// minimum and maximum per slice of time, so that no extreme is lost.
+const MAX_POINTS: usize = 4000;
+
+const BLUE: RGBColor = RGBColor(31, 119, 180);
+const ORANGE: RGBColor = RGBColor(255, 127, 14);
+const GREEN: RGBColor = RGBColor(44, 160, 44);
+const RED: RGBColor = RGBColor(214, 39, 40);
+const PURPLE: RGBColor = RGBColor(148, 103, 189);
+const PALETTE: [RGBColor; 8] = [BLUE, ORANGE, GREEN, RED, PURPLE, RGBColor(140, 86, 75), RGBColor(227, 119, 194), RGBColor(127, 127, 127)];
+
+/// One line of a panel: its legend, colour and points (time, value).
+type Line = (String, RGBColor, Vec<(f64, f64)>);
+
+/// One panel: a title, the y axis's label and its lines.
+struct Panel {
+    title: String,
+    y_label: String,
+    lines: Vec<Line>,
+}
 
 impl Samples {
-    pub fn new(axes: usize) -> Samples {
-        Samples { time: Vec::new(), axes: vec![Vec::new(); axes] }
+    pub fn new(axes: usize, output_count: u32) -> Samples {
+        Samples { time: Vec::new(), axes: (0..axes).map(|_| AxisSeries::default()).collect(), outputs: Vec::new(), output_count }
     }
 
+    /// Takes one sample of the module as it is now.
     pub fn take(&mut self, m: &Module) {
         self.time.push(m.now_ns() as f64 * 1e-9);
-        for (a, series) in self.axes.iter_mut().enumerate() {
-            series.push((m.actual_position(a) as f64, m.actual_speed(a) as f64));
+        for (a, s) in self.axes.iter_mut().enumerate() {
+            let axis = m.axis(a);
+            s.position.push(m.actual_position(a) as f64);
+            s.target.push(axis.target_word as f64);
+            s.speed.push(m.actual_speed(a) as f64);
+            s.load.push(axis.driver.load_value as f64);
+            s.current.push(m.motor_current(a) as f64);
         }
+        self.outputs.push(m.outputs());
     }
 
-    pub fn write_png(&self, path: &Path) -> Result<(), String> {
-        let height = PANEL * self.axes.len().max(1);
-        let mut img = vec![255u8; WIDTH * height * 3];
-        let t_end = self.time.last().copied().unwrap_or(1.0).max(1e-9);
-        let mut texts = vec![("Title".to_string(), "tmclsim run: position (blue) and velocity (orange) per axis".to_string())];
-        for (a, series) in self.axes.iter().enumerate() {
-            let top = a * PANEL;
-            let frame = (MARGIN, top + MARGIN, WIDTH - MARGIN, top + PANEL - MARGIN);
-            rect(&mut img, frame, [120, 120, 120]);
-            for (k, color, name) in [(0usize, [31u8, 119, 180], "position"), (1, [255, 127, 14], "velocity")] {
-                let values: Vec<f64> = series.iter().map(|s| if k == 0 { s.0 } else { s.1 }).collect();
-                let (lo, hi) = range(&values);
-                texts.push((format!("axis {a} {name}"), format!("{lo} to {hi}")));
-                let y_of = |v: f64| frame.3 as f64 - (v - lo) / (hi - lo) * (frame.3 - frame.1) as f64;
-                if lo < 0.0 && hi > 0.0 {
-                    hline(&mut img, frame.0, frame.2, y_of(0.0) as usize, [200, 200, 200]);
-                }
-                let x_of = |t: f64| frame.0 as f64 + t / t_end * (frame.2 - frame.0) as f64;
-                let mut prev: Option<(f64, f64)> = None;
-                for (t, v) in self.time.iter().zip(&values) {
-                    let p = (x_of(*t), y_of(*v));
-                    if let Some(q) = prev {
-                        line(&mut img, q, p, color);
-                    }
-                    prev = Some(p);
-                }
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+
+    /// Writes the samples as CSV: time, then per axis position, target,
+    /// speed, load and current, then the outputs as a bit field.
+    pub fn write_csv(&self, path: &Path) -> Result<(), String> {
+        let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut w = std::io::BufWriter::new(file);
+        let mut header = "time_s".to_string();
+        for a in 0..self.axes.len() {
+            header.push_str(&format!(",position_{a},target_{a},speed_{a},load_{a},current_{a}"));
+        }
+        header.push_str(",outputs");
+        let io = |e: std::io::Error| format!("{}: {e}", path.display());
+        writeln!(w, "{header}").map_err(io)?;
+        for (i, t) in self.time.iter().enumerate() {
+            let mut line = format!("{t:.6}");
+            for s in &self.axes {
+                line.push_str(&format!(",{},{},{},{},{}", s.position[i], s.target[i], s.speed[i], s.load[i], s.current[i]));
+            }
+            line.push_str(&format!(",{}", self.outputs[i]));
+            writeln!(w, "{line}").map_err(io)?;
+        }
+        w.flush().map_err(io)
+    }
+
+    /// Draws the samples between `from` and `to` (seconds; `None`: the
+    /// whole run) into a PNG or SVG file, by the file's extension.
+    pub fn write_plot(&self, path: &Path, from: Option<f64>, to: Option<f64>) -> Result<(), String> {
+        let t0 = from.unwrap_or(0.0);
+        let t1 = to.unwrap_or_else(|| self.time.last().copied().unwrap_or(0.0));
+        if t1 <= t0 {
+            return Err(format!("the plot's window {t0} s … {t1} s is empty"));
+        }
+        let window: Vec<usize> = (0..self.time.len()).filter(|&i| (t0..=t1).contains(&self.time[i])).collect();
+        if window.is_empty() {
+            return Err(format!("no samples between {t0} s and {t1} s"));
+        }
+        let panels = self.panels(&window);
+        let height = PANEL_HEIGHT * panels.len() as u32;
+        // A font of our own: the plot looks the same on every machine.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+        let result = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("png") => draw(BitMapBackend::new(path, (WIDTH, height)).into_drawing_area(), &panels, t0, t1),
+            Some("svg") => draw(SVGBackend::new(path, (WIDTH, height)).into_drawing_area(), &panels, t0, t1),
+            _ => return Err(format!("{}: the plot is written as .png or .svg", path.display())),
+        };
+        result.map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    fn panels(&self, window: &[usize]) -> Vec<Panel> {
+        let series = |values: &[f64]| -> Vec<(f64, f64)> { decimate(window.iter().map(|&i| (self.time[i], values[i])).collect()) };
+        let changes = |values: &[f64]| window.iter().any(|&i| values[i] != values[window[0]]);
+        let mut panels = Vec::new();
+        for (a, s) in self.axes.iter().enumerate() {
+            panels.push(Panel {
+                title: format!("axis {a}: position"),
+                y_label: "µsteps".into(),
+                lines: vec![
+                    ("actual position (AP 1)".into(), BLUE, series(&s.position)),
+                    ("target position (AP 0)".into(), GREEN, series(&s.target)),
+                ],
+            });
+            panels.push(Panel {
+                title: format!("axis {a}: velocity"),
+                y_label: "internal units".into(),
+                lines: vec![("actual speed (AP 3)".into(), ORANGE, series(&s.speed))],
+            });
+            if changes(&s.load) {
+                panels.push(Panel {
+                    title: format!("axis {a}: load"),
+                    y_label: "reading".into(),
+                    lines: vec![("load value (AP 206)".into(), RED, series(&s.load))],
+                });
+            }
+            if changes(&s.current) {
+                panels.push(Panel {
+                    title: format!("axis {a}: motor current"),
+                    y_label: "0…255 = 0…100 %".into(),
+                    lines: vec![("current in effect".into(), PURPLE, series(&s.current))],
+                });
             }
         }
-        let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), WIDTH as u32, height as u32);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        for (k, v) in &texts {
-            enc.add_text_chunk(k.clone(), v.clone()).map_err(|e| e.to_string())?;
+        let changed_outputs: Vec<u32> = (0..self.output_count.min(32))
+            .filter(|&n| window.iter().any(|&i| (self.outputs[i] ^ self.outputs[window[0]]) >> n & 1 == 1))
+            .collect();
+        if !changed_outputs.is_empty() {
+            // Each output as a step trace of its own, stacked: n + level.
+            let lines = changed_outputs
+                .iter()
+                .enumerate()
+                .map(|(k, &n)| {
+                    let levels: Vec<f64> = self.outputs.iter().map(|o| k as f64 * 1.5 + (o >> n & 1) as f64).collect();
+                    (format!("OUT{n}"), PALETTE[k % PALETTE.len()], series(&levels))
+                })
+                .collect();
+            panels.push(Panel { title: "digital outputs".into(), y_label: "low / high".into(), lines });
         }
-        let mut writer = enc.write_header().map_err(|e| e.to_string())?;
-        writer.write_image_data(&img).map_err(|e| e.to_string())?;
-        for (k, v) in texts.iter().skip(1) {
-            println!("  {k}: {v}");
-        }
-        Ok(())
+        panels
     }
 }
 
-fn range(values: &[f64]) -> (f64, f64) {
-    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+/// At most [`MAX_POINTS`] points: per slice of time, the first, the
+/// minimum and the maximum (in time order) and the last sample.
+fn decimate(points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    if points.len() <= MAX_POINTS {
+        return points;
+    }
+    let per = points.len().div_ceil(MAX_POINTS / 4);
+    let mut out = Vec::with_capacity(MAX_POINTS);
+    for chunk in points.chunks(per) {
+        let lo = chunk.iter().enumerate().min_by(|a, b| a.1.1.total_cmp(&b.1.1)).map_or(0, |(i, _)| i);
+        let hi = chunk.iter().enumerate().max_by(|a, b| a.1.1.total_cmp(&b.1.1)).map_or(0, |(i, _)| i);
+        let mut keep = [0, lo.min(hi), lo.max(hi), chunk.len() - 1];
+        keep.sort_unstable();
+        let mut last = usize::MAX;
+        for i in keep {
+            if i != last {
+                out.push(chunk[i]);
+                last = i;
+            }
+        }
+    }
+    out
+}
+
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, panels: &[Panel], t0: f64, t1: f64) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    for (panel, area) in panels.iter().zip(root.split_evenly((panels.len(), 1))) {
+        let (lo, hi) = range(panel.lines.iter().flat_map(|(_, _, p)| p.iter().map(|q| q.1)));
+        let mut chart = ChartBuilder::on(&area)
+            .caption(&panel.title, ("sans-serif", 16))
+            .margin(8)
+            .margin_right(24)
+            .x_label_area_size(34)
+            .y_label_area_size(70)
+            .build_cartesian_2d(t0..t1, lo..hi)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_desc(panel.y_label.as_str())
+            .label_style(("sans-serif", 12))
+            .axis_desc_style(("sans-serif", 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .x_label_formatter(&|t| format!("{t}"))
+            .y_label_formatter(&|v| if (hi - lo) >= 10.0 { format!("{v:.0}") } else { format!("{v:.2}") })
+            .draw()
+            .map_err(e)?;
+        for (name, color, points) in &panel.lines {
+            let color = *color;
+            chart
+                .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
+                .map_err(e)?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180))
+            .label_font(("sans-serif", 12))
+            .draw()
+            .map_err(e)?;
+    }
+    root.present().map_err(e)
+}
+
+/// The y range of a panel, with a margin; a flat line gets ±1.
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     if !lo.is_finite() || !hi.is_finite() {
         return (-1.0, 1.0);
     }
-    if hi - lo < 1e-9 { (lo - 1.0, hi + 1.0) } else { (lo, hi) }
-}
-
-fn put(img: &mut [u8], x: usize, y: usize, c: [u8; 3]) {
-    if x < WIDTH {
-        let i = (y * WIDTH + x) * 3;
-        if i + 2 < img.len() {
-            img[i..i + 3].copy_from_slice(&c);
-        }
+    if hi - lo < 1e-9 {
+        return (lo - 1.0, hi + 1.0);
     }
+    let pad = (hi - lo) * 0.05;
+    (lo - pad, hi + pad)
 }
 
-fn hline(img: &mut [u8], x0: usize, x1: usize, y: usize, c: [u8; 3]) {
-    for x in x0..=x1 {
-        put(img, x, y, c);
-    }
-}
+#[cfg(test)]
+mod tests {
+    use super::decimate;
 
-fn rect(img: &mut [u8], (x0, y0, x1, y1): (usize, usize, usize, usize), c: [u8; 3]) {
-    hline(img, x0, x1, y0, c);
-    hline(img, x0, x1, y1, c);
-    for y in y0..=y1 {
-        put(img, x0, y, c);
-        put(img, x1, y, c);
-    }
-}
-
-fn line(img: &mut [u8], (x0, y0): (f64, f64), (x1, y1): (f64, f64), c: [u8; 3]) {
-    let steps = ((x1 - x0).abs().max((y1 - y0).abs()).ceil() as usize).max(1);
-    for i in 0..=steps {
-        let f = i as f64 / steps as f64;
-        let (x, y) = (x0 + (x1 - x0) * f, y0 + (y1 - y0) * f);
-        if x >= 0.0 && y >= 0.0 {
-            put(img, x as usize, y as usize, c);
-            put(img, x as usize, y as usize + 1, c);
-        }
+    #[test]
+    fn decimation_keeps_every_extreme() {
+        let points: Vec<(f64, f64)> =
+            (0..100_000).map(|i| (i as f64, ((i * 7919) % 1000) as f64 - (i == 54_321) as i32 as f64 * 5000.0)).collect();
+        let d = decimate(points.clone());
+        assert!(d.len() <= super::MAX_POINTS, "{}", d.len());
+        assert!(d.contains(&(54_321.0, -5000.0 + (54_321 * 7919 % 1000) as f64)), "the single dip survives");
+        assert!(d.windows(2).all(|w| w[0].0 < w[1].0), "in time order");
+        assert_eq!((d[0], *d.last().unwrap()), (points[0], *points.last().unwrap()));
+        assert_eq!(decimate(points[..10].to_vec()), points[..10].to_vec(), "short series stay as they are");
     }
 }

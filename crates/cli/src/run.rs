@@ -25,9 +25,26 @@ pub struct RunArgs {
     /// instruction, accumulator, X, position and speed per axis).
     #[arg(long, value_name = "FILE.csv")]
     pub trace: Option<PathBuf>,
-    /// Draw position and velocity over time per axis into a PNG file.
-    #[arg(long, value_name = "FILE.png")]
+    /// Plot the motion into a PNG or SVG file (by its extension): per
+    /// axis position and velocity, and load, current and outputs where
+    /// they change.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Write the motion sampled at a fixed step (see --sample) to a CSV
+    /// file: time, per axis position, target, speed, load, current, and
+    /// the outputs.
+    #[arg(long, value_name = "FILE.csv")]
+    pub samples: Option<PathBuf>,
+    /// The step of virtual time between two samples of the plot and the
+    /// CSV (default: the run in 2000 steps, at least 1ms).
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    pub sample: Option<u64>,
+    /// The plot starts at this virtual time (default: 0).
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    pub from: Option<u64>,
+    /// The plot ends at this virtual time (default: the end of the run).
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    pub to: Option<u64>,
     /// Stop at a label or address and enter the debugger (repeatable).
     #[arg(long = "break", value_name = "LABEL|ADDR")]
     pub breakpoints: Vec<String>,
@@ -86,7 +103,17 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         }
         None => None,
     };
-    let mut samples = args.plot.as_ref().map(|_| crate::plot::Samples::new(profile.module.axes as usize));
+    if let Some(path) = &args.plot
+        && !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png") || e.eq_ignore_ascii_case("svg"))
+    {
+        return Err(format!("{}: the plot is written as .png or .svg", path.display()));
+    }
+    if args.sample == Some(0) {
+        return Err("--sample: the step is more than 0".into());
+    }
+    let outputs = profile.ports.iter().filter(|p| p.direction == tmclsim_firmware::profile::PortDirection::Output).count() as u32;
+    let mut samples =
+        (args.plot.is_some() || args.samples.is_some()).then(|| crate::plot::Samples::new(profile.module.axes as usize, outputs));
     module.start_program();
     // The run drives a bus of one in stepped time, as every front end does.
     let mut bus = Bus::single(module);
@@ -94,7 +121,14 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let end = args.duration;
     // The run goes in slices: a plot gets 2000 samples, a trace is written
     // as it comes, the debugger takes over at breakpoints.
-    let slice = if breakpoints.is_empty() { (end / 2000).max(1_000_000) } else { 1_000_000 };
+    let slice = match args.sample {
+        Some(step) => step,
+        None if breakpoints.is_empty() => (end / 2000).max(1_000_000),
+        None => 1_000_000,
+    };
+    if let Some(s) = &mut samples {
+        s.take(bus.module(0));
+    }
     let mut debugging = args.debug;
     let stdin = std::io::stdin();
     let mut lines = stdin.lock().lines();
@@ -136,8 +170,13 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     }
     let wall = started.elapsed();
     summary(module, &program.symbols, wall);
+    if let (Some(path), Some(s)) = (&args.samples, &samples) {
+        s.write_csv(path)?;
+        println!("samples: {} ({} rows)", path.display(), s.len());
+    }
     if let (Some(path), Some(s)) = (&args.plot, &samples) {
-        s.write_png(path)?;
+        let seconds = |ns: u64| ns as f64 * 1e-9;
+        s.write_plot(path, args.from.map(seconds), args.to.map(seconds))?;
         println!("plot: {}", path.display());
     }
     Ok(ExitCode::SUCCESS)

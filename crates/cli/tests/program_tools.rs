@@ -81,6 +81,59 @@ fn run_prints_a_summary_and_writes_trace_and_plot() {
     assert!(trace.lines().any(|l| l.contains("DJNZ 42 1")));
     let image = std::fs::read(&png).unwrap();
     assert_eq!(&image[..8], &[0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1A, b'\n']);
+    // IHDR: 1200 px wide, one 230 px panel per quantity (position,
+    // velocity, load and current change in this run).
+    let (w, h) = (u32::from_be_bytes(image[16..20].try_into().unwrap()), u32::from_be_bytes(image[20..24].try_into().unwrap()));
+    assert_eq!((w, h), (1200, 4 * 230));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn run_plots_svg_with_labelled_axes_and_samples_at_a_fixed_step() {
+    let d = dir("svg");
+    let (svg, csv) = (d.join("p.svg"), d.join("s.csv"));
+    let program = example("djnz_3_7_43.tmc");
+    let o = tmclsim(&[
+        "run",
+        program.to_str().unwrap(),
+        "--for",
+        "20s",
+        "--plot",
+        svg.to_str().unwrap(),
+        "--from",
+        "5s",
+        "--to",
+        "15s",
+        "--samples",
+        csv.to_str().unwrap(),
+        "--sample",
+        "10ms",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let text_svg = std::fs::read_to_string(&svg).unwrap();
+    assert!(text_svg.starts_with("<svg"), "an SVG, not a PNG with another name");
+    for label in ["time (s)", "µsteps", "actual position (AP 1)", "target position (AP 0)", "actual speed (AP 3)", "axis 0: velocity"] {
+        assert!(text_svg.contains(label), "{label} missing");
+    }
+    // The time axis is the window: its ticks (centred under the axis) run
+    // from 5 to 15 s.
+    let ticks: Vec<f64> = text_svg
+        .split("dy=\"0.76em\" text-anchor=\"middle\"")
+        .skip(1)
+        .filter_map(|part| part.lines().nth(1).and_then(|l| l.trim().parse().ok()))
+        .collect();
+    let (lo, hi) = ticks.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+    assert_eq!((lo, hi), (5.0, 15.0), "{ticks:?}");
+    let rows: Vec<String> = std::fs::read_to_string(&csv).unwrap().lines().map(String::from).collect();
+    assert_eq!(rows[0], "time_s,position_0,target_0,speed_0,load_0,current_0,outputs");
+    assert_eq!(rows.len(), 1 + 2001, "a row every 10 ms from 0 to 20 s");
+    assert!(rows[1].starts_with("0.000000,0,0,0,"), "{}", rows[1]);
+    assert!(rows[2].starts_with("0.010000,"), "{}", rows[2]);
+    // Refusals: an unknown extension, an empty window.
+    let o = tmclsim(&["run", program.to_str().unwrap(), "--plot", d.join("p.jpg").to_str().unwrap()]);
+    assert!(!o.status.success() && text(&o).contains("p.jpg: the plot is written as .png or .svg"), "{}", text(&o));
+    let o = tmclsim(&["run", program.to_str().unwrap(), "--for", "2s", "--plot", svg.to_str().unwrap(), "--from", "3s"]);
+    assert!(!o.status.success() && text(&o).contains("the plot's window 3 s … 2 s is empty"), "{}", text(&o));
     std::fs::remove_dir_all(&d).unwrap();
 }
 
