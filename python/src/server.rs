@@ -74,11 +74,13 @@ fn pty_path(endpoint: Endpoint, module_name: &str) -> Option<PathBuf> {
 /// - ``target``: a ``Module`` or a ``Bus``; its modules move into the server
 ///   until it stops, and the ``Module`` objects reach them through it.
 /// - ``tcp``: an address (``"127.0.0.1:1141"``), True for a free port on
-///   127.0.0.1, None for no TCP.
+///   127.0.0.1, None for no TCP. An address other machines reach
+///   (``"0.0.0.0:1141"``) works with a ``UserWarning``: anyone on the
+///   network can then drive the motors.
 /// - ``pty``: a path for the symlink to a pty (the serial port a host
 ///   opens), True for one in the temporary directory, None for no pty.
 /// - ``control``: the control socket of docs/world.md (True: a free port on
-///   127.0.0.1).
+///   127.0.0.1); only on loopback (it mutes links and injects faults).
 /// - ``stepped``: virtual time moves only by ``advance`` (default: paced by
 ///   the wall clock).
 /// - ``wire_timing``: replies take as long as the bytes take at the
@@ -161,10 +163,19 @@ impl Server {
             pty: pty_path(pty, &refs[0].profile.module.name),
             control: socket_address(&control, "control")?,
             wire_timing,
+            // Warned about below, the Python way.
+            warn_exposure: false,
             ..ServerConfig::default()
         };
         shared.with_bus(|b| b.set_wire_timing(wire_timing));
         let handle = tmclsim_server::start_shared(shared.clone(), config).map_err(|e| os_error(format!("cannot serve: {e}")))?;
+        // An address other machines reach: say so (a warnings filter that
+        // turns warnings into errors stops the server again).
+        for w in tmclsim_server::exposure_warnings(std::slice::from_ref(handle.endpoints())) {
+            let message = std::ffi::CString::new(w).map_err(|e| value_error(e.to_string()))?;
+            let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+            PyErr::warn(py, &category, &message, 1)?;
+        }
         for r in refs.iter_mut() {
             r.served = true;
         }

@@ -121,6 +121,10 @@ pub struct ServeArgs {
     /// module is served (`tmclsim world`); loopback, any free port by default.
     #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:0")]
     pub control: SocketAddr,
+    /// Allow --control on an address other machines reach; clients must
+    /// then send `auth TOKEN` first (the token is printed at start).
+    #[arg(long)]
+    pub control_public: bool,
 }
 
 #[derive(Args)]

@@ -27,6 +27,7 @@ fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {
 }
 
 pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
+    check_args(&args)?;
     if let Some(path) = &args.fleet {
         return crate::fleet::serve(path, &args);
     }
@@ -63,6 +64,31 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
         }
     }
     serve((tcp, pty), vec![module], args.eeprom.clone(), eeprom_note, &args)
+}
+
+/// Refusals before anything is opened (docs/robustness.md).
+fn check_args(args: &ServeArgs) -> Result<(), String> {
+    if args.max_connections == 0 {
+        return Err("--max-connections 0 would serve no client: give 1 or more".into());
+    }
+    if !args.control.ip().is_loopback() && !args.control_public {
+        return Err(format!(
+            "--control {}: not a loopback address; the control socket changes the world, mutes links and injects faults, \
+             so it is opened to other machines only with --control-public (clients then need the token printed at start)",
+            args.control
+        ));
+    }
+    Ok(())
+}
+
+/// A fresh random token for the control socket (128 bits, hex).
+fn control_token() -> Result<String, String> {
+    use std::io::Read;
+    let mut bytes = [0u8; 16];
+    std::fs::File::open("/dev/urandom")
+        .and_then(|mut f| f.read_exact(&mut bytes))
+        .map_err(|e| format!("cannot make a control token: {e}"))?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
 }
 
 /// EtherCAT: TMCM-1310 slaves on a network interface.
@@ -136,9 +162,12 @@ fn serve(
         inter_byte_timeout: crate::millis(args.inter_byte_timeout),
         max_connections: args.max_connections,
         control: Some(args.control),
+        control_token: if args.control_public { Some(control_token()?) } else { None },
         wire_timing: args.wire_timing,
         slcan: args.slcan.clone(),
+        ..ServerConfig::default()
     };
+    let token = config.control_token.clone();
     let names: Vec<String> = modules.iter().map(|m| format!("{} (address {})", m.profile().module.name, m.address())).collect();
     let server = tmclsim_server::start_bus(modules, config).map_err(|e| format!("cannot serve: {e}"))?;
     let ep = server.endpoints().clone();
@@ -154,8 +183,12 @@ fn serve(
         println!("  slcan: {} -> {}  (CAN adapter: python-can interface \"slcan\")", link.display(), device.display());
     }
     println!("  world: {}{}", args.world, if args.wire_timing { "; wire timing on" } else { "" });
-    if let Some(addr) = ep.control {
-        println!("  control: {addr}  (tmclsim world --control {addr} help)");
+    match (ep.control, &token) {
+        (Some(addr), None) => println!("  control: {addr}  (tmclsim world --control {addr} help)"),
+        (Some(addr), Some(t)) => {
+            println!("  control: {addr}  token {t}  (send \"auth {t}\" first: tmclsim world --control {addr} auth {t} help)")
+        }
+        (None, _) => {}
     }
     if let Some(a) = ep.pytrinamic_args() {
         println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));

@@ -14,7 +14,7 @@ use crate::module::Module;
 use crate::parameter_numbers::gp;
 use tmclsim_protocol::{Instruction, Status, mnemonic};
 
-pub use crate::state::link::AsciiLine;
+pub use crate::state::link::{AsciiLine, LineState};
 
 const CR: u8 = b'\r';
 const BACKSPACE: u8 = 0x08;
@@ -33,6 +33,12 @@ impl Module {
 
     pub(crate) fn enter_ascii_mode(&mut self) {
         self.link.ascii = true;
+        self.new_ascii_session();
+    }
+
+    /// Lines typed before now are dropped at their next character.
+    pub(crate) fn new_ascii_session(&mut self) {
+        self.link.ascii_session += 1;
         self.link.ascii_line.clear();
     }
 
@@ -40,9 +46,21 @@ impl Module {
         (self.globals[0][gp::ASCII_MODE as usize] >> 4) & 3
     }
 
-    /// One character from the link in ASCII mode; what the module sends
-    /// back (echo, reply) is appended to `out`.
+    /// One character from the module's own serial port in ASCII mode; what
+    /// the module sends back (echo, reply) is appended to `out`.
     pub fn ascii_byte(&mut self, byte: u8, out: &mut Vec<u8>) {
+        let mut line = std::mem::take(&mut self.link.ascii_line);
+        self.ascii_byte_on(&mut line, byte, out);
+        self.link.ascii_line = line;
+    }
+
+    /// One character in ASCII mode from a link whose line is `line`
+    /// (docs/behaviour.md rule 83: each link types its own line).
+    pub fn ascii_byte_on(&mut self, line: &mut AsciiLine, byte: u8, out: &mut Vec<u8>) {
+        if line.session != self.link.ascii_session {
+            line.clear();
+            line.session = self.link.ascii_session;
+        }
         let addressed = |m: &Module, line: &[u8]| {
             line.first().is_some_and(|&c| {
                 c == address_char(m.address()) || (m.secondary_address() != 0 && c == address_char(m.secondary_address()))
@@ -50,7 +68,7 @@ impl Module {
         };
         match byte {
             CR => {
-                let line = self.link.ascii_line.take();
+                let line = line.take();
                 if !addressed(self, &line) {
                     return;
                 }
@@ -72,16 +90,15 @@ impl Module {
             }
             b'\n' | 0 => {}
             BACKSPACE | DELETE => {
-                let line = &self.link.ascii_line;
                 if line.len() > 1 && self.echo_mode() == 0 && addressed(self, line.bytes()) {
                     out.push(BACKSPACE);
                 }
                 if line.len() > 1 || !addressed(self, line.bytes()) {
-                    self.link.ascii_line.pop();
+                    line.pop();
                 }
             }
             _ => {
-                if self.link.ascii_line.push(byte) && self.echo_mode() == 0 && addressed(self, self.link.ascii_line.bytes()) {
+                if line.push(byte) && self.echo_mode() == 0 && addressed(self, line.bytes()) {
                     out.push(byte);
                 }
             }

@@ -164,13 +164,17 @@ impl Bus {
         self.modules.iter().any(Module::ascii_mode)
     }
 
-    /// One byte of text for the modules in ASCII mode; echoes and replies
+    /// One byte of text for the modules in ASCII mode from a link whose
+    /// lines are `lines` (docs/behaviour.md rule 83); echoes and replies
     /// are appended to `out`.
-    pub fn ascii_byte(&mut self, byte: u8, out: &mut Vec<u8>) {
+    pub fn ascii_byte(&mut self, lines: &mut crate::ascii::LineState, byte: u8, out: &mut Vec<u8>) {
         self.catch_up();
-        for m in &mut self.modules {
+        if lines.lines.len() < self.modules.len() {
+            lines.lines.resize_with(self.modules.len(), Default::default);
+        }
+        for (m, line) in self.modules.iter_mut().zip(&mut lines.lines) {
             if m.ascii_mode() {
-                m.ascii_byte(byte, out);
+                m.ascii_byte_on(line, byte, out);
             }
         }
     }

@@ -105,3 +105,30 @@ fn start_up_in_ascii_mode_with_gp67() {
     binary(&mut m, "#255 0 0 1234");
     assert!(m.ascii_mode());
 }
+
+/// docs/behaviour.md rule 83: two links type two lines; neither joins the
+/// other's characters, and a line left over from before the module last
+/// entered ASCII mode is dropped.
+#[test]
+fn each_link_types_its_own_line() {
+    use tmclsim_firmware::ascii::AsciiLine;
+    let mut m = ascii_module();
+    assert_eq!(type_text(&mut m, "ASGP 67, 0, 32\r"), "ASGP 67, 0, 32\rBA 100 32\r");
+    let (mut a, mut b) = (AsciiLine::default(), AsciiLine::default());
+    let typed = |m: &mut Module, line: &mut AsciiLine, text: &str| {
+        let mut out = Vec::new();
+        for byte in text.bytes() {
+            m.ascii_byte_on(line, byte, &mut out);
+        }
+        String::from_utf8(out).unwrap()
+    };
+    assert_eq!(typed(&mut m, &mut a, "AGAP 4"), "");
+    assert_eq!(typed(&mut m, &mut b, "ASAP 4, 0, 321\r"), "BA 100 321\r");
+    assert_eq!(typed(&mut m, &mut a, ", 0\r"), "BA 100 321\r");
+    // A partial line, then BIN from the other link and ASCII mode again.
+    assert_eq!(typed(&mut m, &mut a, "AGAP 4"), "");
+    assert_eq!(typed(&mut m, &mut b, "ABIN\r"), "BA 100 0\r");
+    assert_eq!(binary(&mut m, "#139 0 0 0").unwrap().status, 100);
+    assert_eq!(typed(&mut m, &mut a, ", 0\r"), "", "', 0' alone is addressed to nobody");
+    assert_eq!(typed(&mut m, &mut a, "AGAP 4, 0\r"), "BA 100 321\r");
+}

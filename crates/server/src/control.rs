@@ -1,38 +1,162 @@
 //! The control socket: a line protocol to change the world of a served
 //! module while it runs (docs/world.md lists the commands).
 
+use crate::ServerConfig;
 use crate::faults::LinkFaults;
 use crate::shared::SharedBus;
+use crate::slots::{Activity, Slots, accept};
 use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_firmware::world_command::{Addressed, on_off};
-use tokio::io::{AsyncBufReadExt, AsyncWriteExt, BufReader};
-use tokio::net::TcpListener;
+use tokio::io::{AsyncBufRead, AsyncBufReadExt, AsyncWriteExt, BufReader};
+use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::watch;
 
 pub use tmclsim_firmware::world_command::HELP;
 
-pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
+/// Serves the control socket: at most `config.control_max_connections`
+/// clients at once (docs/robustness.md), each line at most
+/// `config.control_max_line` bytes, and with `config.control_token` set,
+/// only clients whose first line is `auth TOKEN`.
+pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
+    let mut slots = Slots::new("control connection", config.control_max_connections, config.idle_timeout);
+    let token: Option<Arc<str>> = config.control_token.as_deref().map(Arc::from);
+    let mut failing = false;
     loop {
         tokio::select! {
-            accepted = listener.accept() => {
-                let Ok((stream, _)) = accepted else { continue };
-                let module = module.clone();
-                tokio::spawn(async move {
-                    let (r, mut w) = stream.into_split();
-                    let mut lines = BufReader::new(r).lines();
-                    while let Ok(Some(line)) = lines.next_line().await {
-                        let answer = match execute(&module, &line) {
-                            Ok(text) => format!("ok{}{text}\n", if text.is_empty() { "" } else { " " }),
-                            Err(e) => format!("error: {e}\n"),
-                        };
-                        if w.write_all(answer.as_bytes()).await.is_err() {
-                            break;
+            accepted = accept(&listener, &mut failing, "a control connection") => {
+                let Some((stream, peer)) = accepted else { continue };
+                if let Err(why) = slots.make_room() {
+                    eprintln!("tmclsim: refusing control connection from {peer}: {why}");
+                    // A fresh socket's send buffer is empty: the line fits.
+                    let _ = stream.try_write(format!("error: {why}\n").as_bytes());
+                    continue;
+                }
+                let activity = Arc::new(Activity::new());
+                let session = session(stream, module.clone(), token.clone(), config.control_max_line, activity.clone());
+                slots.spawn(peer, activity, session);
+            }
+            _ = slots.reap(), if !slots.is_empty() => {}
+            _ = stop.changed() => break,
+        }
+    }
+    slots.close_all();
+}
+
+/// One control client: a line in, an answer line out.
+async fn session(stream: TcpStream, module: Arc<SharedBus>, token: Option<Arc<str>>, max_line: usize, activity: Arc<Activity>) {
+    let (r, mut w) = stream.into_split();
+    let mut r = BufReader::new(r);
+    let mut authenticated = token.is_none();
+    let mut line = Vec::new();
+    loop {
+        let answer = match read_line(&mut r, max_line, &mut line).await {
+            Ok(Line::End) | Err(_) => return,
+            Ok(Line::TooLong { ended }) => {
+                let answer = format!("error: line longer than {max_line} bytes\n");
+                if w.write_all(answer.as_bytes()).await.is_err() {
+                    return;
+                }
+                if !ended && skip_line(&mut r).await.is_err() {
+                    return;
+                }
+                continue;
+            }
+            Ok(Line::Text) => {
+                activity.touch();
+                let text = String::from_utf8_lossy(&line);
+                let mut command: &str = &text;
+                if !authenticated {
+                    match authenticate(command, token.as_deref().unwrap_or_default()) {
+                        Ok(rest) => {
+                            authenticated = true;
+                            command = rest;
+                        }
+                        Err(e) => {
+                            let _ = w.write_all(format!("error: {e}\n").as_bytes()).await;
+                            return;
                         }
                     }
-                });
+                }
+                match execute(&module, command) {
+                    Ok(text) => format!("ok{}{text}\n", if text.is_empty() { "" } else { " " }),
+                    Err(e) => format!("error: {e}\n"),
+                }
             }
-            _ = stop.changed() => return,
+        };
+        if w.write_all(answer.as_bytes()).await.is_err() {
+            return;
+        }
+    }
+}
+
+/// `auth TOKEN [COMMAND…]`: the command after the token (may be empty),
+/// or why the client is turned away.
+fn authenticate<'a>(line: &'a str, token: &str) -> Result<&'a str, &'static str> {
+    let rest = line
+        .trim_start()
+        .strip_prefix("auth")
+        .filter(|r| r.is_empty() || r.starts_with(char::is_whitespace))
+        .ok_or("this control socket needs a token: send \"auth TOKEN\" first")?
+        .trim_start();
+    let (given, command) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+    // Compared in a time that does not depend on where they differ.
+    let same = given.len() == token.len() && given.bytes().zip(token.bytes()).fold(0u8, |acc, (a, b)| acc | (a ^ b)) == 0;
+    if same { Ok(command) } else { Err("wrong token") }
+}
+
+enum Line {
+    /// A line (without its line end) is in the buffer.
+    Text,
+    /// The line passed the limit; `ended`: its line end was read too.
+    TooLong { ended: bool },
+    /// The client closed its side.
+    End,
+}
+
+/// Reads one line into `line`, keeping at most `max` bytes in memory.
+async fn read_line(r: &mut (impl AsyncBufRead + Unpin), max: usize, line: &mut Vec<u8>) -> std::io::Result<Line> {
+    line.clear();
+    loop {
+        let available = r.fill_buf().await?;
+        if available.is_empty() {
+            return Ok(if line.is_empty() { Line::End } else { Line::Text });
+        }
+        let (taken, ended) = match available.iter().position(|&b| b == b'\n') {
+            Some(i) => (i, true),
+            None => (available.len(), false),
+        };
+        if line.len() + taken > max {
+            r.consume(taken + ended as usize);
+            return Ok(Line::TooLong { ended });
+        }
+        line.extend_from_slice(&available[..taken]);
+        r.consume(taken + ended as usize);
+        if ended {
+            if line.last() == Some(&b'\r') {
+                line.pop();
+            }
+            return Ok(Line::Text);
+        }
+    }
+}
+
+/// Reads and drops the rest of a line.
+async fn skip_line(r: &mut (impl AsyncBufRead + Unpin)) -> std::io::Result<()> {
+    loop {
+        let available = r.fill_buf().await?;
+        if available.is_empty() {
+            return Ok(());
+        }
+        match available.iter().position(|&b| b == b'\n') {
+            Some(i) => {
+                r.consume(i + 1);
+                return Ok(());
+            }
+            None => {
+                let n = available.len();
+                r.consume(n);
+            }
         }
     }
 }

@@ -15,10 +15,12 @@ mod link;
 mod pty;
 mod shared;
 mod slcan;
+mod slots;
 mod tcp;
 
 pub use faults::LinkFaults;
 pub use shared::{SharedBus, Stats};
+pub use slots::ACCEPT_BACKOFF;
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -38,10 +40,26 @@ pub struct ServerConfig {
     pub eeprom: Option<PathBuf>,
     /// A partial frame is dropped after this gap between two bytes.
     pub inter_byte_timeout: Duration,
-    /// Most TCP clients at once; more are refused with a log line.
+    /// Most TCP clients at once (at least 1); more are refused with a log
+    /// line unless the idle rule frees a slot (`idle_timeout`).
     pub max_connections: usize,
-    /// TCP address of the control socket (world and link faults).
+    /// When every slot (TCP or control) is taken, a new client takes the
+    /// slot of the connection that has gone longest without a complete
+    /// request, if that is this long or longer (docs/robustness.md).
+    pub idle_timeout: Duration,
+    /// TCP address of the control socket (world and link faults). A
+    /// non-loopback address needs `control_token`.
     pub control: Option<SocketAddr>,
+    /// Most control clients at once; more get an error line.
+    pub control_max_connections: usize,
+    /// Longest control line in bytes; a longer one is answered with an
+    /// error and dropped.
+    pub control_max_line: usize,
+    /// Control clients must send `auth TOKEN` as their first line.
+    pub control_token: Option<String>,
+    /// Print a warning on stderr for every endpoint that listens on a
+    /// non-loopback address ([`exposure_warnings`]).
+    pub warn_exposure: bool,
     /// Deliver bytes at the modules' baud rate (GP 65), as a real RS485 bus.
     pub wire_timing: bool,
     /// Path of the symlink to a pty that is a serial-line CAN adapter
@@ -57,7 +75,12 @@ impl Default for ServerConfig {
             eeprom: None,
             inter_byte_timeout: Duration::from_millis(5),
             max_connections: 64,
+            idle_timeout: Duration::from_secs(30),
             control: None,
+            control_max_connections: 16,
+            control_max_line: 4096,
+            control_token: None,
+            warn_exposure: true,
             wire_timing: false,
             slcan: None,
         }
@@ -97,6 +120,8 @@ pub struct LinkHandle {
 /// A server running on its own thread; dropping it stops it.
 pub struct ServerHandle {
     links: Vec<LinkHandle>,
+    /// The pty symlinks this server created, removed when it stops.
+    claims: Vec<pty::LinkClaim>,
     stop: watch::Sender<bool>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
@@ -132,11 +157,8 @@ impl ServerHandle {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
-        for l in &self.links {
-            for (link, _) in l.endpoints.pty.iter().chain(&l.endpoints.slcan) {
-                let _ = std::fs::remove_file(link);
-            }
-        }
+        // Each link goes only if it still points to our pty.
+        self.claims.clear();
     }
 
     /// Blocks until the server stops (it runs until stopped).
@@ -189,22 +211,79 @@ struct Opened {
 
 async fn open(config: &ServerConfig) -> std::io::Result<Opened> {
     let tcp = match config.tcp {
-        Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
+        Some(addr) => Some(listen(addr, "TCP").await?),
         None => None,
     };
     let pty = match &config.pty {
-        Some(path) => Some(pty::Pty::open(path)?),
+        Some(path) => Some(open_pty(path, "pty")?),
         None => None,
     };
     let control = match config.control {
-        Some(addr) => Some(tokio::net::TcpListener::bind(addr).await?),
+        Some(addr) => Some(listen(addr, "control").await?),
         None => None,
     };
     let slcan = match &config.slcan {
-        Some(path) => Some(pty::Pty::open(path)?),
+        Some(path) => Some(open_pty(path, "SLCAN pty")?),
         None => None,
     };
     Ok(Opened { tcp, pty, control, slcan })
+}
+
+/// Binds a listener; an error names the address.
+async fn listen(addr: SocketAddr, what: &str) -> std::io::Result<tokio::net::TcpListener> {
+    tokio::net::TcpListener::bind(addr).await.map_err(|e| std::io::Error::new(e.kind(), format!("cannot listen on {addr} ({what}): {e}")))
+}
+
+fn open_pty(path: &std::path::Path, what: &str) -> std::io::Result<pty::Pty> {
+    pty::Pty::open(path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::AddrInUse || e.kind() == std::io::ErrorKind::AlreadyExists {
+            e
+        } else {
+            std::io::Error::new(e.kind(), format!("cannot create the {what} at {}: {e}", path.display()))
+        }
+    })
+}
+
+/// What is wrong with a configuration before anything is opened.
+fn check(config: &ServerConfig) -> std::io::Result<()> {
+    let invalid = |m: String| Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, m));
+    if config.tcp.is_some() && config.max_connections == 0 {
+        return invalid("max_connections is 0: the TCP link would serve no client".into());
+    }
+    if config.control.is_some() && config.control_max_connections == 0 {
+        return invalid("control_max_connections is 0: the control socket would serve no client".into());
+    }
+    if let Some(addr) = config.control
+        && !addr.ip().is_loopback()
+        && config.control_token.as_deref().is_none_or(str::is_empty)
+    {
+        return invalid(format!(
+            "the control socket on {addr} would be open to other machines without a token (it can mute links and inject faults)"
+        ));
+    }
+    Ok(())
+}
+
+/// One warning per kind of endpoint that listens on a non-loopback
+/// address (docs/robustness.md, "Exposure: who can reach what").
+pub fn exposure_warnings(endpoints: &[Endpoints]) -> Vec<String> {
+    let public = |addrs: Vec<SocketAddr>| -> Option<String> {
+        let addrs: Vec<SocketAddr> = addrs.into_iter().filter(|a| !a.ip().is_loopback()).collect();
+        let first = addrs.first()?;
+        Some(if addrs.len() == 1 { first.to_string() } else { format!("{first} and {} more addresses", addrs.len() - 1) })
+    };
+    let mut out = Vec::new();
+    if let Some(at) = public(endpoints.iter().filter_map(|e| e.tcp).collect()) {
+        out.push(format!(
+            "TMCL on {at} is open to other machines: anyone who reaches it can drive the motors (TMCL has no authentication); listen on 127.0.0.1 to keep it local"
+        ));
+    }
+    if let Some(at) = public(endpoints.iter().filter_map(|e| e.control).collect()) {
+        out.push(format!(
+            "the control socket on {at} is open to other machines: whoever has its token can change the world, mute links and inject faults"
+        ));
+    }
+    out
 }
 
 /// Starts serving many links (a fleet) from one thread: one event loop,
@@ -223,9 +302,14 @@ pub fn start_shared(bus: Arc<SharedBus>, config: ServerConfig) -> std::io::Resul
 }
 
 fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<ServerHandle> {
+    for (_, config) in &specs {
+        check(config)?;
+    }
+    let warn = specs.iter().any(|(_, c)| c.warn_exposure);
     let shared: Vec<Arc<SharedBus>> = specs.iter().map(|(m, _)| m.clone()).collect();
     let (stop_tx, stop_rx) = watch::channel(false);
-    let (ready_tx, ready_rx) = std::sync::mpsc::channel::<std::io::Result<Vec<Endpoints>>>();
+    type Ready = std::io::Result<(Vec<Endpoints>, Vec<pty::LinkClaim>)>;
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel::<Ready>();
     let thread = std::thread::Builder::new().name("tmclsim-server".into()).spawn(move || {
         let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
             Ok(rt) => rt,
@@ -235,16 +319,21 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
             }
         };
         rt.block_on(async move {
+            // On an error, what was opened so far is dropped: listeners
+            // close, pty links and their locks are removed.
             let mut opened = Vec::with_capacity(specs.len());
             for (_, config) in &specs {
                 match open(config).await {
                     Ok(o) => opened.push(o),
                     Err(e) => {
+                        drop(opened);
                         let _ = ready_tx.send(Err(e));
                         return;
                     }
                 }
             }
+            let claims =
+                opened.iter_mut().flat_map(|o| [o.pty.as_mut(), o.slcan.as_mut()]).flatten().filter_map(|p| p.claim.take()).collect();
             let endpoints = opened
                 .iter()
                 .map(|o| Endpoints {
@@ -254,7 +343,7 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
                     slcan: o.slcan.as_ref().map(|p| (p.link.clone(), p.device.clone())),
                 })
                 .collect();
-            let _ = ready_tx.send(Ok(endpoints));
+            let _ = ready_tx.send(Ok((endpoints, claims)));
             let mut tasks = tokio::task::JoinSet::new();
             for ((module, config), o) in specs.into_iter().zip(opened) {
                 tasks.spawn(clock::run(module.clone(), stop_rx.clone()));
@@ -265,7 +354,7 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
                     tasks.spawn(pty::run(p, module.clone(), config.clone(), stop_rx.clone()));
                 }
                 if let Some(listener) = o.control {
-                    tasks.spawn(control::run(listener, module.clone(), stop_rx.clone()));
+                    tasks.spawn(control::run(listener, module.clone(), config.clone(), stop_rx.clone()));
                 }
                 if let Some(p) = o.slcan {
                     tasks.spawn(slcan::run(p, module.clone(), stop_rx.clone()));
@@ -277,7 +366,19 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
             while tasks.join_next().await.is_some() {}
         });
     })?;
-    let endpoints = ready_rx.recv().map_err(|_| std::io::Error::other("server thread ended early"))??;
+    let ready = ready_rx.recv().map_err(|_| std::io::Error::other("server thread ended early")).and_then(|r| r);
+    let (endpoints, claims) = match ready {
+        Ok(v) => v,
+        Err(e) => {
+            let _ = thread.join();
+            return Err(e);
+        }
+    };
+    if warn {
+        for w in exposure_warnings(&endpoints) {
+            eprintln!("tmclsim: warning: {w}");
+        }
+    }
     let links = endpoints.into_iter().zip(shared).map(|(endpoints, module)| LinkHandle { endpoints, module }).collect();
-    Ok(ServerHandle { links, stop: stop_tx, thread: Some(thread) })
+    Ok(ServerHandle { links, claims, stop: stop_tx, thread: Some(thread) })
 }

@@ -2,9 +2,11 @@
 //! module's answer, replies and events written back in order.
 
 use crate::shared::SharedBus;
+use crate::slots::Activity;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
+use tmclsim_firmware::ascii::LineState;
 use tmclsim_protocol::FRAME_LEN;
 use tmclsim_protocol::serial::FrameAssembler;
 use tokio::io::{AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt};
@@ -19,8 +21,17 @@ pub(crate) fn next_link_id() -> u64 {
 
 /// Serves one stream until it closes or fails. Replies are written by this
 /// task as soon as they exist; unsolicited events (138) reach it through a
-/// channel, so one task writes and frames never interleave.
-pub(crate) async fn serve<R, W>(mut reader: R, mut writer: W, module: Arc<SharedBus>, inter_byte_timeout: Duration) -> std::io::Result<()>
+/// channel, so one task writes and frames never interleave. `lines` is
+/// the link's own ASCII line state (docs/behaviour.md rule 83); `activity`
+/// learns of every complete request.
+pub(crate) async fn serve<R, W>(
+    mut reader: R,
+    mut writer: W,
+    module: Arc<SharedBus>,
+    inter_byte_timeout: Duration,
+    lines: &mut LineState,
+    activity: &Activity,
+) -> std::io::Result<()>
 where
     R: AsyncRead + Unpin,
     W: AsyncWrite + Unpin,
@@ -44,7 +55,10 @@ where
                     if module.ascii_active() {
                         // ASCII mode: text in, text out; the frame
                         // assembler starts afresh afterwards.
-                        module.ascii_byte(byte, &mut text);
+                        module.ascii_byte(lines, byte, &mut text);
+                        if byte == b'\r' {
+                            activity.touch();
+                        }
                         assembler.reset();
                         continue;
                     }
@@ -52,6 +66,7 @@ where
                         writer.write_all(&std::mem::take(&mut text)).await?;
                     }
                     let Some(frame) = assembler.push(byte, now) else { continue };
+                    activity.touch();
                     let (replies, pause) = module.handle(link, &events_tx, &frame);
                     for reply in replies {
                         let (reply, fault_delay) = module.outgoing(reply);

@@ -4,11 +4,18 @@
 //! The server keeps the slave side open itself, so the pty survives the
 //! host closing and reopening the port. The slave is put in raw mode (no
 //! echo, no line editing) as a USB/RS485 serial port behaves.
+//!
+//! A server claims the symlink's path `P` by holding an exclusive lock on
+//! `P.lock` for its whole life: a second server refuses a path a live one
+//! serves, and replaces a link whose server is gone. The link is removed
+//! when the claim ends, but only while it still points to this pty.
 
 use crate::ServerConfig;
 use crate::shared::SharedBus;
 use std::io;
+use std::io::{Read, Write};
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd, RawFd};
+use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
 use std::pin::Pin;
 use std::sync::Arc;
@@ -23,6 +30,74 @@ pub(crate) struct Pty {
     _slave: OwnedFd,
     pub link: PathBuf,
     pub device: PathBuf,
+    /// The claim on `link`; whoever holds it removes the link at the end.
+    pub claim: Option<LinkClaim>,
+}
+
+/// The exclusive lock on `P.lock` that says a live server serves `P`.
+struct PathLock {
+    path: PathBuf,
+    _file: std::fs::File,
+}
+
+impl PathLock {
+    fn take(link: &Path) -> io::Result<PathLock> {
+        let mut path = link.as_os_str().to_owned();
+        path.push(".lock");
+        let path = PathBuf::from(path);
+        loop {
+            let mut file = std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).mode(0o644).open(&path)?;
+            // SAFETY: flock on a descriptor the file owns.
+            if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } < 0 {
+                let e = io::Error::last_os_error();
+                if e.raw_os_error() != Some(libc::EWOULDBLOCK) {
+                    return Err(e);
+                }
+                let mut pid = String::new();
+                let _ = file.read_to_string(&mut pid);
+                return Err(io::Error::new(
+                    io::ErrorKind::AddrInUse,
+                    format!(
+                        "{} is served by a running tmclsim (process {}, lock {}); stop it or choose another path",
+                        link.display(),
+                        pid.trim(),
+                        path.display()
+                    ),
+                ));
+            }
+            // The previous owner may have removed the file between our open
+            // and our lock: then the lock is on a file nobody else sees.
+            let current = std::fs::metadata(&path);
+            let ours = file.metadata()?;
+            if current.is_ok_and(|c| c.ino() == ours.ino() && c.dev() == ours.dev()) {
+                file.set_len(0)?;
+                write!(file, "{}", std::process::id())?;
+                return Ok(PathLock { path, _file: file });
+            }
+        }
+    }
+}
+
+impl Drop for PathLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// A symlink this server created and serves; dropping it removes the link
+/// (if it still points to our device) and then the lock.
+pub(crate) struct LinkClaim {
+    link: PathBuf,
+    device: PathBuf,
+    _lock: PathLock,
+}
+
+impl Drop for LinkClaim {
+    fn drop(&mut self) {
+        if std::fs::read_link(&self.link).is_ok_and(|target| target == self.device) {
+            let _ = std::fs::remove_file(&self.link);
+        }
+    }
 }
 
 fn check(r: libc::c_int) -> io::Result<libc::c_int> {
@@ -30,8 +105,10 @@ fn check(r: libc::c_int) -> io::Result<libc::c_int> {
 }
 
 impl Pty {
-    /// Opens a pty and points `link` at its serial device.
+    /// Opens a pty and points `link` at its serial device: refused while
+    /// another live server serves `link`; a stale link is replaced.
     pub fn open(link: &Path) -> io::Result<Pty> {
+        let lock = PathLock::take(link)?;
         // SAFETY: plain libc calls on descriptors this function owns.
         unsafe {
             let master = check(libc::posix_openpt(libc::O_RDWR | libc::O_NOCTTY))?;
@@ -61,7 +138,8 @@ impl Pty {
                 Err(_) => {}
             }
             std::os::unix::fs::symlink(&device, link)?;
-            Ok(Pty { master, _slave: slave, link: link.to_path_buf(), device })
+            let claim = LinkClaim { link: link.to_path_buf(), device: device.clone(), _lock: lock };
+            Ok(Pty { master, _slave: slave, link: link.to_path_buf(), device, claim: Some(claim) })
         }
     }
 }
@@ -73,6 +151,8 @@ pub(crate) struct Master(Arc<AsyncFd<OwnedFd>>);
 impl Pty {
     /// The master side as a stream (the slave stays open with the pty).
     pub(crate) fn into_stream(self) -> io::Result<(Master, OwnedFd)> {
+        // The server handle took the claim out before: the link lives as
+        // long as the handle, not as this task.
         let Pty { master, _slave, .. } = self;
         // SAFETY: the AsyncFd owns the descriptor for its whole life.
         let fd = unsafe { AsyncFd::register(master) }.map_err(|e| e.into_parts().1)?;
@@ -139,8 +219,11 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, config: ServerConfig, 
             return;
         }
     };
+    // One line, as on the module's serial port (docs/behaviour.md rule 83).
+    let mut lines = Default::default();
+    let activity = crate::slots::Activity::new();
     loop {
-        let served = crate::link::serve(master.clone(), master.clone(), module.clone(), config.inter_byte_timeout);
+        let served = crate::link::serve(master.clone(), master.clone(), module.clone(), config.inter_byte_timeout, &mut lines, &activity);
         tokio::select! {
             r = served => {
                 if let Err(e) = r {

@@ -240,11 +240,11 @@ impl SharedBus {
         replies
     }
 
-    /// One byte of text for the modules in ASCII mode; echoes and replies
-    /// are appended to `out`.
-    pub(crate) fn ascii_byte(&self, byte: u8, out: &mut Vec<u8>) {
+    /// One byte of text for the modules in ASCII mode from a link whose
+    /// lines are `lines`; echoes and replies are appended to `out`.
+    pub(crate) fn ascii_byte(&self, lines: &mut tmclsim_firmware::ascii::LineState, byte: u8, out: &mut Vec<u8>) {
         let mut s = self.lock();
-        s.bus.ascii_byte(byte, out);
+        s.bus.ascii_byte(lines, byte, out);
         Self::after_change(&mut s);
         self.update_ascii(&s);
     }

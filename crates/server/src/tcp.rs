@@ -2,37 +2,37 @@
 
 use crate::ServerConfig;
 use crate::shared::SharedBus;
+use crate::slots::{Activity, Slots, accept};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use tokio::net::TcpListener;
 use tokio::sync::watch;
 
 pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
-    let open = Arc::new(AtomicUsize::new(0));
-    let mut connections = tokio::task::JoinSet::new();
+    let mut slots = Slots::new("connection", config.max_connections, config.idle_timeout);
+    let mut failing = false;
     loop {
         tokio::select! {
-            accepted = listener.accept() => {
-                let Ok((stream, peer)) = accepted else { continue };
-                if open.load(Ordering::Relaxed) >= config.max_connections {
-                    eprintln!("tmclsim: refusing connection from {peer}: {} connections open (the limit)", config.max_connections);
+            accepted = accept(&listener, &mut failing, "a TCP connection") => {
+                let Some((stream, peer)) = accepted else { continue };
+                if let Err(why) = slots.make_room() {
+                    eprintln!("tmclsim: refusing connection from {peer}: {why}");
                     drop(stream);
                     continue;
                 }
                 let _ = stream.set_nodelay(true);
-                open.fetch_add(1, Ordering::Relaxed);
                 let module = module.clone();
-                let open = open.clone();
                 let timeout = config.inter_byte_timeout;
-                connections.spawn(async move {
+                let activity = Arc::new(Activity::new());
+                let seen = activity.clone();
+                slots.spawn(peer, activity, async move {
                     let (r, w) = stream.into_split();
-                    let _ = crate::link::serve(r, w, module, timeout).await;
-                    open.fetch_sub(1, Ordering::Relaxed);
+                    let mut lines = Default::default();
+                    let _ = crate::link::serve(r, w, module, timeout, &mut lines, &seen).await;
                 });
             }
-            Some(_) = connections.join_next(), if !connections.is_empty() => {}
+            _ = slots.reap(), if !slots.is_empty() => {}
             _ = stop.changed() => break,
         }
     }
-    connections.abort_all();
+    slots.close_all();
 }

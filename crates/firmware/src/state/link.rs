@@ -1,6 +1,10 @@
 //! The host link as the module sees it: the address of the last request
 //! (events answer with it), when the host last spoke (the heartbeat), and
 //! the ASCII interface's mode and the line being typed.
+//!
+//! The mode belongs to the module; a line belongs to a link (docs/
+//! behaviour.md rule 83): the module keeps one for its own serial port, a
+//! server keeps one per connection ([`LineState`]).
 
 /// Longest ASCII line kept; the rest of a longer line is dropped.
 pub const MAX_LINE: usize = 128;
@@ -15,12 +19,22 @@ pub struct Link {
     pub heartbeat_tripped: bool,
     /// The link speaks text (ASCII mode).
     pub ascii: bool,
+    /// Counts the entries into ASCII mode: a line typed in an earlier
+    /// session is dropped (docs/behaviour.md rule 83).
+    pub ascii_session: u64,
     pub ascii_line: AsciiLine,
 }
 
 impl Default for Link {
     fn default() -> Link {
-        Link { last_address: 1, last_frame_ns: 0, heartbeat_tripped: false, ascii: false, ascii_line: AsciiLine::default() }
+        Link {
+            last_address: 1,
+            last_frame_ns: 0,
+            heartbeat_tripped: false,
+            ascii: false,
+            ascii_session: 0,
+            ascii_line: AsciiLine::default(),
+        }
     }
 }
 
@@ -33,10 +47,19 @@ impl Link {
     }
 }
 
-/// The ASCII line being typed.
+/// The ASCII line being typed on one link.
 #[derive(Clone, Debug, Default)]
 pub struct AsciiLine {
     buf: Vec<u8>,
+    /// The module's ASCII session the line was typed in.
+    pub(crate) session: u64,
+}
+
+/// The ASCII lines of one link to a bus: one per module (each module
+/// decides for itself what a backspace deletes and which lines it keeps).
+#[derive(Clone, Debug, Default)]
+pub struct LineState {
+    pub(crate) lines: Vec<AsciiLine>,
 }
 
 impl AsciiLine {
