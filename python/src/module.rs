@@ -131,9 +131,7 @@ impl Module {
             (Status::WrongType, None) => Some("the module has no such parameter".to_string()),
             (Status::WrongType, Some(p)) if write && !p.access.write => Some(format!("it is read-only (access {})", p.access)),
             (Status::WrongType, Some(p)) if !write && !p.access.read => Some(format!("it cannot be read (access {})", p.access)),
-            (Status::InvalidValue, Some(p)) if write && motor_or_bank.is_none() => {
-                Some(format!("the value must be in {}", p.range_text()))
-            }
+            (Status::InvalidValue, Some(p)) if write && motor_or_bank.is_none() => Some(format!("the value must be in {}", p.range_text())),
             (Status::InvalidValue, _) => {
                 motor_or_bank.map(|(what, n)| format!("{what} {n} does not exist on the {}", self.profile.module.name))
             }
