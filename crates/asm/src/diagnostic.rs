@@ -1,5 +1,5 @@
 //! Error messages with their place in the source, and the "did you mean"
-//! suggestions they carry.
+//! suggestions they carry (made by `tmclsim_protocol::suggest`).
 
 use std::fmt;
 
@@ -40,53 +40,7 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
     diagnostics.iter().map(|d| format!("{d}\n")).collect()
 }
 
-/// The candidate closest to `name` (case-insensitive edit distance), if it
-/// is close enough to be a likely typo.
-pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let wanted = name.to_ascii_lowercase();
-    let limit = (wanted.chars().count() / 3).max(1);
-    let mut best: Option<(usize, &str)> = None;
-    for candidate in candidates {
-        if candidate == name {
-            continue;
-        }
-        let d = edit_distance(&wanted, &candidate.to_ascii_lowercase());
-        if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
-            best = Some((d, candidate));
-        }
-    }
-    best.map(|(_, c)| c)
-}
-
-/// ` (did you mean 'Loop'?)` or nothing.
-pub fn suggestion<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> String {
-    closest(name, candidates).map_or(String::new(), |c| format!(" (did you mean '{c}'?)"))
-}
-
-/// Edit distance over characters where swapping two neighbours counts as
-/// one edit (optimal string alignment), so `Strat` is one edit from `Start`.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
-    for (i, row) in d.iter_mut().enumerate() {
-        row[0] = i;
-    }
-    for (j, cell) in d[0].iter_mut().enumerate() {
-        *cell = j;
-    }
-    for i in 1..=a.len() {
-        for j in 1..=b.len() {
-            let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut best = (d[i - 1][j] + 1).min(d[i][j - 1] + 1).min(d[i - 1][j - 1] + cost);
-            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                best = best.min(d[i - 2][j - 2] + 1);
-            }
-            d[i][j] = best;
-        }
-    }
-    d[a.len()][b.len()]
-}
+pub use tmclsim_protocol::suggest::suggestion;
 
 #[cfg(test)]
 mod tests {
@@ -97,16 +51,6 @@ mod tests {
         let d = Diagnostic::new("prog.tmc", 12, 5, "unknown label 'Lop' (did you mean 'Loop'?)");
         assert_eq!(d.to_string(), "prog.tmc:12:5: error: unknown label 'Lop' (did you mean 'Loop'?)");
         assert_eq!(Diagnostic::new("x.tmc", 0, 0, "cannot read").to_string(), "x.tmc: error: cannot read");
-    }
-
-    #[test]
-    fn suggestions() {
-        assert_eq!(closest("Lop", ["Start", "Loop"]), Some("Loop"));
-        assert_eq!(closest("loop", ["Loop"]), Some("Loop"));
-        assert_eq!(closest("MVPP", ["MVP", "MST"]), Some("MVP"));
-        assert_eq!(closest("Strat", ["Start"]), Some("Start"));
-        assert_eq!(closest("Zebra", ["Loop"]), None);
-        assert_eq!(suggestion("Zebra", ["Loop"]), "");
     }
 }
 

@@ -67,7 +67,7 @@ pub struct ServeArgs {
     pub module: String,
     /// Listen for TCP clients on this address (loopback by default). Without
     /// --tcp and --pty both are served, TCP on 127.0.0.1:1141.
-    #[arg(long, value_name = "ADDR")]
+    #[arg(long, value_name = "ADDR", value_parser = socket_address)]
     pub tcp: Option<SocketAddr>,
     /// Create a pty and a symlink to it at PATH, opened like a serial port.
     /// Without --tcp and --pty both are served, the pty at
@@ -119,8 +119,12 @@ pub struct ServeArgs {
     pub wire_timing: bool,
     /// Address of the control socket that changes the world while the
     /// module is served (`tmclsim world`); loopback, any free port by default.
-    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:0")]
+    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:0", value_parser = socket_address)]
     pub control: SocketAddr,
+    /// Also write the endpoints (tcp, pty, control, …) to FILE as TOML,
+    /// for scripts; removed when the server stops.
+    #[arg(long, value_name = "FILE")]
+    pub endpoints: Option<PathBuf>,
     /// Allow --control on an address other machines reach; clients must
     /// then send `auth TOKEN` first (the token is printed at start).
     #[arg(long)]
@@ -222,7 +226,22 @@ fn profile(name: &str) -> Result<ExitCode, String> {
 
 /// The world named on the command line: `stage`, `free` or a file.
 pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::World, String> {
+    if !matches!(name, "stage" | "free") && !name.contains('\n') && !std::path::Path::new(name).exists() {
+        return Err(format!("--world {name}: no such world file; the built-in worlds are stage (the default) and free"));
+    }
     tmclsim_firmware::World::named(name, axes)
+}
+
+/// `HOST:PORT` with a host name or an IP address (IPv4 first when a name
+/// has both).
+fn socket_address(text: &str) -> Result<SocketAddr, String> {
+    use std::net::ToSocketAddrs;
+    if let Ok(a) = text.parse() {
+        return Ok(a);
+    }
+    let all: Vec<SocketAddr> =
+        text.to_socket_addrs().map_err(|e| format!("'{text}' is not HOST:PORT ({e}); e.g. 127.0.0.1:1141 or localhost:1141"))?.collect();
+    all.iter().find(|a| a.is_ipv4()).or(all.first()).copied().ok_or_else(|| format!("'{text}' names no address"))
 }
 
 fn world(args: WorldArgs) -> Result<ExitCode, String> {
@@ -230,8 +249,16 @@ fn world(args: WorldArgs) -> Result<ExitCode, String> {
     let mut s = std::net::TcpStream::connect(&args.control).map_err(|e| format!("cannot connect to {}: {e}", args.control))?;
     s.set_read_timeout(Some(Duration::from_secs(5))).ok();
     writeln!(s, "{}", args.command.join(" ")).map_err(|e| e.to_string())?;
-    let mut line = String::new();
-    std::io::BufReader::new(s).read_line(&mut line).map_err(|e| e.to_string())?;
+    let mut line = Vec::new();
+    let not_control = || {
+        format!("{} did not answer as a control socket (a TMCL port?): give the address `tmclsim serve` prints as 'control:'", args.control)
+    };
+    match std::io::BufReader::new(s).read_until(b'\n', &mut line) {
+        Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => return Err(not_control()),
+        Err(e) => return Err(format!("{}: {e}", args.control)),
+        Ok(_) => {}
+    }
+    let Ok(line) = String::from_utf8(line) else { return Err(not_control()) };
     print!("{line}");
     Ok(if line.starts_with("ok") { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

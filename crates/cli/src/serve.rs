@@ -190,12 +190,18 @@ fn serve(
         }
         (None, _) => {}
     }
+    if let Some(path) = &args.endpoints {
+        write_endpoints(path, &ep, token.as_deref())?;
+    }
     if let Some(a) = ep.pytrinamic_args() {
         println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
     wait_for_signal();
+    if let Some(path) = &args.endpoints {
+        let _ = std::fs::remove_file(path);
+    }
     println!("tmclsim: stopping");
     server.stop();
     Ok(ExitCode::SUCCESS)
@@ -221,4 +227,26 @@ pub(crate) fn wait_for_signal() {
             _ = hup.recv() => {}
         }
     });
+}
+
+/// `--endpoints FILE`: where the server listens, as TOML, for scripts.
+fn write_endpoints(path: &std::path::Path, ep: &tmclsim_server::Endpoints, token: Option<&str>) -> Result<(), String> {
+    let quoted = |s: &str| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""));
+    let mut text = String::new();
+    if let Some(a) = ep.tcp {
+        text.push_str(&format!("tcp = {}\n", quoted(&a.to_string())));
+    }
+    if let Some((link, _)) = &ep.pty {
+        text.push_str(&format!("pty = {}\n", quoted(&link.display().to_string())));
+    }
+    if let Some((link, _)) = &ep.slcan {
+        text.push_str(&format!("slcan = {}\n", quoted(&link.display().to_string())));
+    }
+    if let Some(a) = ep.control {
+        text.push_str(&format!("control = {}\n", quoted(&a.to_string())));
+    }
+    if let Some(t) = token {
+        text.push_str(&format!("control_token = {}\n", quoted(t)));
+    }
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }

@@ -13,6 +13,7 @@ pub mod opcode;
 pub mod serial;
 pub mod slcan;
 pub mod status;
+pub mod suggest;
 
 pub use command::{CalcOp, Command, Condition, DecodeError, ErrorFlag, MoveMode, RfsAction, WaitCondition};
 pub use frame::{FRAME_LEN, Instruction, Reply, Request, checksum};

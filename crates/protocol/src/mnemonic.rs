@@ -155,7 +155,10 @@ pub fn parse_line(line: &str) -> Result<Instruction, ParseError> {
             to_i32(n[3]).ok_or_else(|| err(fields[3].0, "value out of 32-bit range".into()))?,
         ));
     }
-    let opcode = op::from_mnemonic(head).ok_or_else(|| err(c0, format!("unknown command '{head}'")))?;
+    let opcode = op::from_mnemonic(head).ok_or_else(|| {
+        let hint = crate::suggest::suggestion(head, (0..=255u8).filter_map(op::mnemonic));
+        err(c0, format!("unknown command '{head}'{hint}"))
+    })?;
     let layout = layout(opcode).expect("every mnemonic has a layout");
     let operands = &toks[1..];
     if operands.len() != layout.len() {
@@ -234,6 +237,13 @@ mod tests {
 
     fn bytes(line: &str) -> [u8; 9] {
         crate::Request::new(1, parse_line(line).unwrap()).encode()
+    }
+
+    #[test]
+    fn a_mistyped_command_gets_a_suggestion() {
+        let e = parse_line("GAPP 1, 0").unwrap_err();
+        assert_eq!((e.column, e.message.as_str()), (1, "unknown command 'GAPP' (did you mean 'GAP'?)"));
+        assert_eq!(parse_line("frobnicate 1").unwrap_err().message, "unknown command 'frobnicate'");
     }
 
     #[test]

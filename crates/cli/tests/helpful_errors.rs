@@ -1,0 +1,63 @@
+//! Mistakes users make get an answer that says what to do: typos get a
+//! suggestion, host names work where addresses do, the endpoints can be
+//! read by scripts, a wrong port is named as such.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read};
+use std::process::{Command, Stdio};
+
+fn tmclsim(args: &[&str]) -> (Option<i32>, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_tmclsim")).args(args).stdin(Stdio::null()).output().unwrap();
+    (o.status.code(), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
+}
+
+#[test]
+fn a_mistyped_command_gets_a_suggestion() {
+    let (code, text) = tmclsim(&["send", "--tcp", "127.0.0.1:9", "GAPP", "1,", "0"]);
+    assert_eq!(code, Some(2), "{text}");
+    assert!(text.contains("unknown command 'GAPP' (did you mean 'GAP'?)"), "{text}");
+}
+
+#[test]
+fn an_unknown_world_lists_the_built_in_ones() {
+    let (code, text) = tmclsim(&["serve", "--tcp", "127.0.0.1:0", "--world", "stages"]);
+    assert_eq!(code, Some(2), "{text}");
+    assert!(text.contains("--world stages: no such world file; the built-in worlds are stage (the default) and free"), "{text}");
+}
+
+#[test]
+fn host_names_serve_and_the_endpoints_file_tells_scripts_where() {
+    let file = std::env::temp_dir().join(format!("tmclsim-endpoints-{}.toml", std::process::id()));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["serve", "--tcp", "localhost:0", "--control", "localhost:0", "--endpoints", file.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut printed = String::new();
+    while !printed.contains("connect with:") {
+        assert!(out.read_line(&mut printed).unwrap() > 0, "the server ended: {printed}");
+    }
+    let endpoints: toml::Table = toml::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let tcp = endpoints["tcp"].as_str().unwrap().to_string();
+    let control = endpoints["control"].as_str().unwrap().to_string();
+    assert!(tcp.starts_with("127.0.0.1:") && control.starts_with("127.0.0.1:"), "{endpoints:?}");
+    assert!(printed.contains(&format!("tcp: {tcp}")), "the file says what the server printed: {printed}");
+    let mut s = std::net::TcpStream::connect(&tcp).unwrap();
+    assert_eq!(common::ask(&mut s, "GAP 4, 0").unwrap().status, 100);
+    // `world` pointed at the TMCL port says so.
+    let (code, text) = tmclsim(&["world", "--control", &tcp, "show"]);
+    assert_eq!(code, Some(2), "{text}");
+    assert!(text.contains("did not answer as a control socket (a TMCL port?)"), "{text}");
+    let (code, text) = tmclsim(&["world", "--control", &control, "show"]);
+    assert_eq!(code, Some(0), "{text}");
+    unsafe {
+        libc::kill(child.id() as i32, libc::SIGTERM);
+    }
+    let mut rest = String::new();
+    let _ = out.read_to_string(&mut rest);
+    child.wait().unwrap();
+    assert!(!file.exists(), "the endpoints file goes with the server");
+}
