@@ -53,7 +53,7 @@ impl Bus {
         for m in &modules {
             let m = m.bind(py).try_borrow_mut()?;
             fw.extend(m.shared.take_modules());
-            eeproms.push(m.eeprom_path.clone());
+            eeproms.push(m.eeprom_file.clone());
         }
         let shared = Arc::new(SharedBus::new(FwBus::new(fw), eeproms));
         for (i, m) in modules.iter().enumerate() {
@@ -87,7 +87,7 @@ impl Bus {
     fn send_frame(&self, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
         let frame: &[u8; FRAME_LEN] =
             frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
-        Ok(self.shared.with_bus(|b| b.handle_frame(frame)).replies.into_iter().next())
+        Ok(self.shared.frame(frame).into_iter().next())
     }
 
     /// send(address, command, type=None, motor=None, value=None) -> Reply | None

@@ -19,7 +19,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tmclsim_firmware::Bus;
-use tmclsim_firmware::eeprom::save_atomic;
+use tmclsim_firmware::eeprom::{EepromFile, resolve};
 use tmclsim_firmware::profile::Parameter;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
@@ -36,6 +36,8 @@ use tmclsim_server::SharedBus;
 /// - ``eeprom``: path of an EEPROM file (JSON). It is read when it exists
 ///   and rewritten atomically on every EEPROM write, as ``tmclsim serve
 ///   --eeprom`` does; None starts from factory defaults and keeps nothing.
+///   The file is the module's while it lives: a second module or server on
+///   it is refused (``OSError``).
 /// - ``world``: ``"stage"`` (the built-in linear stage, the default),
 ///   ``"free"`` (no switches, no end stops), the path of a TOML world file,
 ///   or the TOML text itself (a string with a line break).
@@ -52,6 +54,8 @@ pub struct Module {
     pub profile: Arc<Profile>,
     names: Names,
     pub eeprom_path: Option<PathBuf>,
+    /// The EEPROM file, held (locked) while the module lives.
+    pub eeprom_file: Option<Arc<EepromFile>>,
     /// Labels of the last program loaded (for breakpoints and `run`).
     symbols: BTreeMap<String, u32>,
 }
@@ -75,15 +79,15 @@ impl Module {
 
     /// Sends one instruction to the module's own address.
     pub fn send_instruction(&mut self, ins: Ins) -> PyResult<Option<Reply>> {
-        let (address, reply) = self.with(|m| {
-            let a = m.address();
-            (a, m.handle_frame(&Request::new(a, ins).encode()))
-        })?;
+        let address = self.address_now()?;
+        let reply = self.handle_frame(&Request::new(address, ins).encode())?;
         Ok(reply.map(|raw| Reply::new(raw, ReplyKind::of(ins, address, &raw))))
     }
 
+    /// A frame for this module; a write the EEPROM file did not take is
+    /// answered with status 5 (docs/behaviour.md rule 82).
     pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> PyResult<Option<[u8; FRAME_LEN]>> {
-        self.with(|m| m.handle_frame(frame))
+        Ok(self.shared.module_frame(self.index, frame))
     }
 
     pub fn now_ns(&mut self) -> PyResult<u64> {
@@ -243,8 +247,11 @@ impl Module {
     #[pyo3(signature = (profile="tmcm-1141", address=None, eeprom=None, world=None))]
     fn py_new(profile: &str, address: Option<u8>, eeprom: Option<PathBuf>, world: Option<&Bound<'_, PyAny>>) -> PyResult<Module> {
         let profile = Profile::built_in(profile).map_err(value_error)?;
-        let image = match &eeprom {
-            Some(path) => tmclsim_firmware::eeprom::load_for(path, &profile.module.name).map_err(value_error)?.0,
+        // The file is this module's while it lives: a second holder, in
+        // this process or another, is refused.
+        let file = eeprom.as_deref().map(EepromFile::open).transpose().map_err(os_error)?.map(Arc::new);
+        let image = match &file {
+            Some(f) => f.load_for(&profile.module.name).map_err(value_error)?.0,
             None => Eeprom::new(&profile.module.name),
         };
         let world = world_from(world, profile.module.axes as usize)?;
@@ -254,13 +261,22 @@ impl Module {
         {
             module.set_address(a);
         }
-        if let Some(path) = &eeprom
-            && (!path.exists() || address.is_some())
+        if let Some(f) = &file
+            && (!f.path().exists() || address.is_some())
         {
-            save_atomic(path, module.eeprom()).map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", path.display())))?;
+            f.save(module.eeprom()).map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", f.named().display())))?;
         }
-        let shared = Arc::new(SharedBus::new(Bus::single(module), vec![eeprom.clone()]));
-        Ok(Module { shared, index: 0, served: false, names: Names::new(&profile), profile, eeprom_path: eeprom, symbols: BTreeMap::new() })
+        let shared = Arc::new(SharedBus::new(Bus::single(module), vec![file.clone()]));
+        Ok(Module {
+            shared,
+            index: 0,
+            served: false,
+            names: Names::new(&profile),
+            profile,
+            eeprom_path: eeprom,
+            eeprom_file: file,
+            symbols: BTreeMap::new(),
+        })
     }
 
     /// The module's name, e.g. ``"TMCM-1141"``.
@@ -539,10 +555,15 @@ impl Module {
     /// --
     ///
     /// Writes the module's EEPROM image to a file (JSON, atomically); a
-    /// ``Module(eeprom=path)`` powers up from it.
+    /// ``Module(eeprom=path)`` powers up from it. A file another module
+    /// or server keeps is refused (``OSError``).
     fn eeprom_save(&mut self, path: PathBuf) -> PyResult<()> {
         let image = self.with(|m| m.eeprom().clone())?;
-        save_atomic(&path, &image).map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", path.display())))
+        let cannot = |e: std::io::Error| os_error(format!("cannot write the EEPROM file {}: {e}", path.display()));
+        match &self.eeprom_file {
+            Some(own) if resolve(&path).is_ok_and(|p| p == own.path()) => own.save(&image).map_err(cannot),
+            _ => EepromFile::open(&path).map_err(os_error)?.save(&image).map_err(cannot),
+        }
     }
 
     // ----- time ----------------------------------------------------------

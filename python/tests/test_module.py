@@ -162,6 +162,7 @@ def test_the_eeprom_file_survives_the_process(tmp_path):
     m.set_global_parameter("Serial address", None, 3)
     stored = json.loads(path.read_text())
     assert stored["axis"]["0/4"] == 1234
+    del m  # the file has one user at a time
     again = tmclsim.Module(eeprom=path)
     assert again.get_axis_parameter(4) == 1234 and again.address == 3
     with pytest.raises(ValueError, match="holds the EEPROM"):

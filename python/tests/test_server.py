@@ -190,6 +190,7 @@ def test_eeprom_file_of_a_served_module(tmp_path):
     with tmclsim.serve(module) as server, server.connect() as interface:
         interface.set_axis_parameter(4, 0, 999)
         interface.send(7, 4, 0, 0)  # STAP 4, 0
+    del module, server, interface  # the file has one user at a time
     assert tmclsim.Module(eeprom=path).get_axis_parameter(4) == 999
 
 

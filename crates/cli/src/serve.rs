@@ -2,6 +2,8 @@
 
 use crate::ServeArgs;
 use std::process::ExitCode;
+use std::sync::Arc;
+use tmclsim_firmware::eeprom::EepromFile;
 use tmclsim_firmware::{Eeprom, Module, Profile};
 use tmclsim_server::ServerConfig;
 
@@ -45,10 +47,12 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
         other => other,
     };
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
-    let (image, eeprom_note) = match &args.eeprom {
-        Some(path) => match tmclsim_firmware::eeprom::load_for(path, &profile.module.name)? {
-            (image, true) => (image, format!("restored from {}", path.display())),
-            (image, false) => (image, format!("factory defaults; changes are kept in {} (new)", path.display())),
+    // The file is this server's until it stops: a second one is refused.
+    let file = args.eeprom.as_deref().map(EepromFile::open).transpose()?.map(Arc::new);
+    let (image, eeprom_note) = match &file {
+        Some(f) => match f.load_for(&profile.module.name)? {
+            (image, true) => (image, format!("restored from {}", f.named().display())),
+            (image, false) => (image, format!("factory defaults; changes are kept in {} (new)", f.named().display())),
         },
         None => (Eeprom::new(&profile.module.name), "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
     };
@@ -57,13 +61,13 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     if let Some(a) = args.address {
         set_addresses(&mut module, a);
     }
-    if let Some(path) = &args.eeprom {
+    if let Some(f) = &file {
         // Write the file at once so a fresh one exists from the start.
-        if !path.exists() {
-            tmclsim_firmware::eeprom::save_atomic(path, module.eeprom()).map_err(|e| format!("{}: {e}", path.display()))?;
+        if !f.path().exists() {
+            f.save(module.eeprom()).map_err(|e| format!("{}: {e}", f.named().display()))?;
         }
     }
-    serve((tcp, pty), vec![module], args.eeprom.clone(), eeprom_note, &args)
+    serve((tcp, pty), vec![module], file, eeprom_note, &args)
 }
 
 /// Refusals before anything is opened (docs/robustness.md).
@@ -108,12 +112,13 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
                 .map(|f| if args.slaves == 1 { f.clone() } else { std::path::PathBuf::from(format!("{}.{}", f.display(), i + 1)) })
         })
         .collect();
+    let eeproms = eeproms.iter().map(|p| p.as_deref().map(EepromFile::open).transpose()).collect::<Result<Vec<_>, String>>()?;
     let modules = eeproms
         .iter()
-        .map(|path| {
+        .map(|file| {
             let world = crate::load_world(&args.world, 1)?;
-            let image = match path {
-                Some(p) => tmclsim_firmware::eeprom::load_for(p, &profile.module.name)?.0,
+            let image = match file {
+                Some(f) => f.load_for(&profile.module.name)?.0,
                 None => Eeprom::new(&profile.module.name),
             };
             Ok(Module::with_world(profile.clone(), image, world))
@@ -151,7 +156,7 @@ fn args_links(args: &ServeArgs) -> (Option<std::net::SocketAddr>, Option<std::pa
 fn serve(
     (tcp, pty): (Option<std::net::SocketAddr>, Option<std::path::PathBuf>),
     modules: Vec<Module>,
-    eeprom: Option<std::path::PathBuf>,
+    eeprom: Option<Arc<EepromFile>>,
     eeprom_note: String,
     args: &ServeArgs,
 ) -> Result<ExitCode, String> {

@@ -101,6 +101,13 @@ impl Module {
         &self.persistence.eeprom
     }
 
+    /// Puts back an EEPROM image that is known to be stored, after writes
+    /// that could not be (docs/behaviour.md rule 82): the RAM stays as it
+    /// is, and this is no new write.
+    pub fn restore_eeprom(&mut self, image: Eeprom) {
+        self.persistence.eeprom = image;
+    }
+
     /// Changes whenever a command wrote the EEPROM.
     pub fn eeprom_generation(&self) -> u64 {
         self.persistence.generation()

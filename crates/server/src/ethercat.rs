@@ -3,12 +3,11 @@
 //! the same interface, as from the last slave of a line.
 
 use std::io;
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tmclsim_ethercat::Segment;
-use tmclsim_firmware::eeprom::save_atomic;
+use tmclsim_firmware::eeprom::EepromFile;
 
 const ETH_P_ALL: u16 = 0x0003;
 const PACKET_OUTGOING: u8 = 4;
@@ -84,10 +83,14 @@ fn open(iface: &str) -> io::Result<(libc::c_int, libc::c_int)> {
 }
 
 /// Serves `segment` on `iface` in a background thread, in wall-clock
-/// time; module `i`'s EEPROM is saved to `eeproms[i]` on every write.
-pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<PathBuf>>) -> io::Result<EthercatHandle> {
+/// time; module `i`'s EEPROM is saved to `eeproms[i]` on every write (the
+/// files stay held until the segment stops).
+pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>) -> io::Result<EthercatHandle> {
     let (fd, index) = open(iface)?;
     segment.bus.set_stepped(false);
+    // What each file holds: a module goes back to it when a save fails
+    // (docs/behaviour.md rule 82).
+    let mut persisted: Vec<_> = segment.bus.modules().iter().map(|m| m.eeprom().clone()).collect();
     let stop = Arc::new(AtomicBool::new(false));
     let segment = Arc::new(Mutex::new(segment));
     let counters = Arc::new(Mutex::new((0u64, 0u64)));
@@ -114,10 +117,17 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<PathBuf>>) -
                 let processed = seg.process(frame);
                 // Effects: EEPROM writes are saved; events have no link.
                 for i in seg.bus.take_effects().eeprom_written {
-                    if let Some(Some(path)) = eeproms.get(i)
-                        && let Err(e) = save_atomic(path, seg.bus.module(i).eeprom())
-                    {
-                        eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
+                    let Some(Some(file)) = eeproms.get(i) else { continue };
+                    let image = seg.bus.module(i).eeprom();
+                    match file.save(image) {
+                        Ok(()) => persisted[i] = image.clone(),
+                        Err(e) => {
+                            eprintln!(
+                                "tmclsim: cannot write EEPROM file {}: {e}; the write is not kept (the module keeps the EEPROM the file holds)",
+                                file.named().display()
+                            );
+                            seg.bus.module_mut(i).restore_eeprom(persisted[i].clone());
+                        }
                     }
                 }
                 processed

@@ -27,6 +27,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_firmware::Module;
+use tmclsim_firmware::eeprom::EepromFile;
 use tokio::sync::watch;
 
 /// What to serve and where.
@@ -36,8 +37,9 @@ pub struct ServerConfig {
     pub tcp: Option<SocketAddr>,
     /// Path of the symlink to the pty's serial device.
     pub pty: Option<PathBuf>,
-    /// EEPROM file; written atomically on every EEPROM change.
-    pub eeprom: Option<PathBuf>,
+    /// EEPROM file, held (locked) by the caller; written atomically on
+    /// every EEPROM change.
+    pub eeprom: Option<Arc<EepromFile>>,
     /// A partial frame is dropped after this gap between two bytes.
     pub inter_byte_timeout: Duration,
     /// Most TCP clients at once (at least 1); more are refused with a log
@@ -177,7 +179,7 @@ impl Drop for ServerHandle {
 
 /// What one link serves and how.
 pub struct LinkSpec {
-    pub modules: Vec<(Module, Option<PathBuf>)>,
+    pub modules: Vec<(Module, Option<Arc<EepromFile>>)>,
     pub config: ServerConfig,
 }
 
@@ -197,7 +199,7 @@ pub fn start_bus(modules: Vec<Module>, config: ServerConfig) -> std::io::Result<
 }
 
 /// Starts serving modules, each with its own EEPROM file, on one link.
-pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<PathBuf>)>, config: ServerConfig) -> std::io::Result<ServerHandle> {
+pub fn start_bus_with_eeproms(modules: Vec<(Module, Option<Arc<EepromFile>>)>, config: ServerConfig) -> std::io::Result<ServerHandle> {
     start_fleet(vec![LinkSpec { modules, config }])
 }
 

@@ -4,14 +4,13 @@
 //! that receives events, link faults and counters.
 
 use crate::faults::LinkFaults;
-use std::path::PathBuf;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::can::CanFrame;
-use tmclsim_firmware::eeprom::save_atomic;
+use tmclsim_firmware::eeprom::EepromFile;
 use tmclsim_firmware::world_command::WorldCommand;
-use tmclsim_firmware::{Bus, Module};
-use tmclsim_protocol::FRAME_LEN;
+use tmclsim_firmware::{Bus, Eeprom, Module};
+use tmclsim_protocol::{FRAME_LEN, Reply, Status};
 use tokio::sync::{Notify, mpsc};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
@@ -22,8 +21,11 @@ const UNCLAIMED_EVENTS: usize = 1024;
 
 struct State {
     bus: Bus,
-    /// EEPROM file of each module.
-    eeproms: Vec<Option<PathBuf>>,
+    /// EEPROM file of each module, held (locked) while the bus has it.
+    eeproms: Vec<Option<Arc<EepromFile>>>,
+    /// The image each module's EEPROM file holds: what a module's EEPROM
+    /// goes back to when a save fails (docs/behaviour.md rule 82).
+    persisted: Vec<Eeprom>,
     sink: Option<(u64, EventSink)>,
     /// Events no link has claimed yet, by module index.
     unclaimed: Vec<(usize, [u8; FRAME_LEN])>,
@@ -67,12 +69,14 @@ pub struct SharedBus {
 
 impl SharedBus {
     /// A bus with each module's EEPROM file (`eeproms` shorter than the
-    /// bus: no file for the rest).
-    pub fn new(bus: Bus, mut eeproms: Vec<Option<PathBuf>>) -> SharedBus {
+    /// bus: no file for the rest). A module's EEPROM image is taken to be
+    /// what its file holds.
+    pub fn new(bus: Bus, mut eeproms: Vec<Option<Arc<EepromFile>>>) -> SharedBus {
         eeproms.resize(bus.len(), None);
+        let persisted = bus.modules().iter().map(|m| m.eeprom().clone()).collect();
         let shared = SharedBus {
             stats: Mutex::new(Stats::default()),
-            state: Mutex::new(State { bus, eeproms, sink: None, unclaimed: Vec::new(), scheduled: None }),
+            state: Mutex::new(State { bus, eeproms, persisted, sink: None, unclaimed: Vec::new(), scheduled: None }),
             changed: Notify::new(),
             faults: Mutex::new(LinkFaults::default()),
             ascii: std::sync::atomic::AtomicBool::new(false),
@@ -82,8 +86,8 @@ impl SharedBus {
     }
 
     /// Modules with their EEPROM files on one link, in wall-clock time.
-    pub fn wall(modules: Vec<(Module, Option<PathBuf>)>, wire_timing: bool) -> SharedBus {
-        let (modules, eeproms): (Vec<Module>, Vec<Option<PathBuf>>) = modules.into_iter().unzip();
+    pub fn wall(modules: Vec<(Module, Option<Arc<EepromFile>>)>, wire_timing: bool) -> SharedBus {
+        let (modules, eeproms): (Vec<Module>, Vec<Option<Arc<EepromFile>>>) = modules.into_iter().unzip();
         let mut bus = Bus::new(modules);
         bus.set_wire_timing(wire_timing);
         bus.set_stepped(false);
@@ -176,14 +180,22 @@ impl SharedBus {
     /// Runs `f` on the bus, brought up to the clock's now; then carries out
     /// what changed (EEPROM files, events) and wakes the clock task.
     pub fn with_bus<R>(&self, f: impl FnOnce(&mut Bus) -> R) -> R {
+        self.with_bus_saved(f).0
+    }
+
+    /// As [`SharedBus::with_bus`], and says whether an EEPROM write that
+    /// `f` made could not be saved to its file: the module's EEPROM is then
+    /// back to what the file holds (docs/behaviour.md rule 82).
+    pub fn with_bus_saved<R>(&self, f: impl FnOnce(&mut Bus) -> R) -> (R, bool) {
         let mut s = self.lock();
-        s.bus.catch_up();
+        let before = Self::generations(&mut s, Bus::catch_up);
         let r = f(&mut s.bus);
-        Self::after_change(&mut s);
+        let written = Self::written_since(&s, before);
+        let failed = Self::after_change(&mut s);
         self.update_ascii(&s);
         drop(s);
         self.changed.notify_one();
-        r
+        (r, written.iter().any(|i| failed.contains(i)))
     }
 
     /// Runs `f` on module `index` (in bus order), brought up to now.
@@ -209,6 +221,7 @@ impl SharedBus {
         s.bus.catch_up();
         Self::after_change(&mut s);
         s.eeproms.clear();
+        s.persisted.clear();
         std::mem::replace(&mut s.bus, Bus::new(Vec::new())).into_modules()
     }
 
@@ -226,8 +239,24 @@ impl SharedBus {
     pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
         self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
-        let answer = s.bus.handle_frame(frame);
-        self.after_request(s, link, sink, !answer.replies.is_empty());
+        let before = Self::generations(&mut s, |bus| {
+            // The addressed modules first catch up on their own, so that
+            // what their programs store is not taken for the request's.
+            let now = bus.now_ns();
+            for i in 0..bus.len() {
+                if bus.module(i).answers_to(frame[0]) {
+                    bus.module_mut(i).advance_to(now);
+                }
+            }
+        });
+        let mut answer = s.bus.handle_frame(frame);
+        let written = Self::written_since(&s, before);
+        let failed = self.after_request(s, link, sink, !answer.replies.is_empty());
+        if written.iter().any(|i| failed.contains(i)) {
+            for r in &mut answer.replies {
+                *r = Self::not_stored(*r, frame[1]);
+            }
+        }
         (answer.replies, Duration::from_nanos(answer.delay_ns))
     }
 
@@ -235,9 +264,64 @@ impl SharedBus {
     pub(crate) fn handle_can(&self, link: u64, sink: &EventSink, frame: &CanFrame) -> Vec<CanFrame> {
         self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
-        let replies = s.bus.handle_can(frame);
-        self.after_request(s, link, sink, true);
+        let before = Self::generations(&mut s, Bus::catch_up);
+        let mut replies = s.bus.handle_can(frame);
+        let written = Self::written_since(&s, before);
+        let failed = self.after_request(s, link, sink, true);
+        if written.iter().any(|i| failed.contains(i)) {
+            // `[module address][status][opcode][value]`: a 9-byte reply
+            // without host byte and checksum.
+            for r in replies.iter_mut().filter(|r| r.len == 7) {
+                let mut nine = [0u8; FRAME_LEN];
+                nine[1..8].copy_from_slice(&r.data[..7]);
+                nine[8] = tmclsim_protocol::frame::checksum(&nine[..8]);
+                r.data[..7].copy_from_slice(&Self::not_stored(nine, frame.data[0])[1..8]);
+            }
+        }
         replies
+    }
+
+    /// Puts one frame on the bus from in process and returns the replies
+    /// as a link would carry them: a write the EEPROM file did not take is
+    /// answered with status 5 (docs/behaviour.md rule 82).
+    pub fn frame(&self, frame: &[u8; FRAME_LEN]) -> Vec<[u8; FRAME_LEN]> {
+        let (answer, unsaved) = self.with_bus_saved(|bus| bus.handle_frame(frame));
+        answer.replies.into_iter().map(|r| if unsaved { Self::not_stored(r, frame[1]) } else { r }).collect()
+    }
+
+    /// Sends one frame to module `index` (in bus order) alone, from in
+    /// process; its reply as in [`SharedBus::frame`].
+    pub fn module_frame(&self, index: usize, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
+        let (reply, unsaved) = self.with_bus_saved(|bus| bus.module_mut(index).handle_frame(frame));
+        reply.map(|r| if unsaved { Self::not_stored(r, frame[1]) } else { r })
+    }
+
+    /// Before a request: `prepare` runs on the bus, then the EEPROM
+    /// generation of every module is noted (`None`: no module has an
+    /// EEPROM file, nothing to note).
+    fn generations(s: &mut State, prepare: impl FnOnce(&mut Bus)) -> Option<Vec<u64>> {
+        prepare(&mut s.bus);
+        s.eeproms.iter().any(Option::is_some).then(|| s.bus.modules().iter().map(Module::eeprom_generation).collect())
+    }
+
+    /// After a request: the modules whose EEPROM it wrote.
+    fn written_since(s: &State, before: Option<Vec<u64>>) -> Vec<usize> {
+        let Some(before) = before else { return Vec::new() };
+        s.bus.modules().iter().zip(before).enumerate().filter(|(_, (m, g))| m.eeprom_generation() != *g).map(|(i, _)| i).collect()
+    }
+
+    /// A reply that said the request was carried out (100, or 101 for a
+    /// downloaded word) says instead that the EEPROM did not take it: 5
+    /// (docs/behaviour.md rule 82). Other replies, and frames that are no
+    /// reply to `opcode`, stay as they are.
+    fn not_stored(frame: [u8; FRAME_LEN], opcode: u8) -> [u8; FRAME_LEN] {
+        match Reply::decode(&frame) {
+            Some(mut r) if r.opcode == opcode && matches!(r.status(), Some(Status::Ok | Status::Loaded)) => {
+                r.status = Status::EepromLocked.code();
+                r.encode()
+            }
+            _ => frame,
+        }
     }
 
     /// One byte of text for the modules in ASCII mode from a link whose
@@ -253,19 +337,21 @@ impl SharedBus {
     /// (if it got an answer or events are waiting), effects are carried
     /// out, and the clock task is woken if something is due sooner than it
     /// sleeps for.
-    fn after_request(&self, mut s: std::sync::MutexGuard<'_, State>, link: u64, sink: &EventSink, answered: bool) {
+    /// Returns the modules whose EEPROM file could not be saved.
+    fn after_request(&self, mut s: std::sync::MutexGuard<'_, State>, link: u64, sink: &EventSink, answered: bool) -> Vec<usize> {
         self.update_ascii(&s);
         let has_events = s.bus.modules().iter().any(Module::has_events);
         if (answered || has_events) && s.sink.as_ref().is_none_or(|(id, _)| *id != link) {
             s.sink = Some((link, sink.clone()));
         }
-        Self::after_change(&mut s);
+        let failed = Self::after_change(&mut s);
         let due = s.bus.next_deadline();
         let wake = due.is_some_and(|d| s.scheduled.is_none_or(|sch| d < sch));
         drop(s);
         if wake {
             self.changed.notify_one();
         }
+        failed
     }
 
     /// A 138 event (9-byte form) as the CAN frame of the module it is from.
@@ -291,7 +377,11 @@ impl SharedBus {
         self.changed.notified().await
     }
 
-    fn after_change(s: &mut State) {
+    /// Carries out what changed: events go to the link that spoke last,
+    /// written EEPROMs to their files. A module whose file cannot be saved
+    /// goes back to the image its file holds, and says so on stderr
+    /// (docs/behaviour.md rule 82); those modules are returned.
+    fn after_change(s: &mut State) -> Vec<usize> {
         let effects = s.bus.take_effects();
         for (index, event) in effects.events {
             match &s.sink {
@@ -302,12 +392,84 @@ impl SharedBus {
                 None => {}
             }
         }
+        let mut failed = Vec::new();
         for index in effects.eeprom_written {
-            if let Some(path) = &s.eeproms[index]
-                && let Err(e) = save_atomic(path, s.bus.module(index).eeprom())
-            {
-                eprintln!("tmclsim: cannot write EEPROM file {}: {e}", path.display());
+            let Some(file) = &s.eeproms[index] else { continue };
+            let image = s.bus.module(index).eeprom();
+            match file.save(image) {
+                Ok(()) => s.persisted[index] = image.clone(),
+                Err(e) => {
+                    eprintln!(
+                        "tmclsim: cannot write EEPROM file {}: {e}; the write is not kept (status 5 to the command that made it; the module keeps the EEPROM the file holds)",
+                        file.named().display()
+                    );
+                    let persisted = s.persisted[index].clone();
+                    s.bus.module_mut(index).restore_eeprom(persisted);
+                    failed.push(index);
+                }
             }
         }
+        failed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tmclsim_protocol::{Instruction, Request, opcode};
+
+    fn frame(op: u8, kind: u8, value: i32) -> [u8; FRAME_LEN] {
+        Request::new(1, Instruction::new(op, kind, 0, value)).encode()
+    }
+
+    /// Sends a frame in process: the reply's status and opcode.
+    fn ask(bus: &SharedBus, op: u8, kind: u8, value: i32) -> (u8, u8) {
+        let raw = bus.module_frame(0, &frame(op, kind, value)).expect("a reply");
+        let r = Reply::decode(&raw).expect("a valid checksum");
+        (r.status, r.opcode)
+    }
+
+    #[test]
+    fn writes_the_file_does_not_take_are_answered_with_status_5_on_every_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = dir.path().join("store");
+        std::fs::create_dir(&store).unwrap();
+        let path = store.join("m.eeprom");
+        let file = Arc::new(EepromFile::open(&path).unwrap());
+        let bus = SharedBus::new(Bus::single(Module::built_in("tmcm-1141").unwrap()), vec![Some(file)]);
+        assert_eq!(ask(&bus, opcode::SAP, 4, 1000), (100, opcode::SAP));
+        assert_eq!(ask(&bus, opcode::STAP, 4, 0), (100, opcode::STAP));
+
+        // No file can be created where the directory was.
+        let away = dir.path().join("away");
+        std::fs::rename(&store, &away).unwrap();
+        std::fs::write(&store, "").unwrap();
+        assert_eq!(ask(&bus, opcode::SAP, 4, 2000), (100, opcode::SAP), "a write of RAM only is unaffected");
+        assert_eq!(ask(&bus, opcode::STAP, 4, 0), (5, opcode::STAP));
+        assert_eq!(bus.with(|m| m.eeprom().axis(0, 4)), Some(1000), "the EEPROM is what the file holds");
+        // A downloaded word: 5 instead of 101.
+        assert_eq!(ask(&bus, opcode::ENTER_DOWNLOAD, 0, 0), (100, opcode::ENTER_DOWNLOAD));
+        assert_eq!(ask(&bus, opcode::SAP, 4, 5), (5, opcode::SAP));
+        assert_eq!(ask(&bus, opcode::EXIT_DOWNLOAD, 0, 0), (5, opcode::EXIT_DOWNLOAD));
+        assert!(bus.with(|m| m.eeprom().program.is_empty()));
+        // A link's frame and a CAN frame.
+        let (sink, _events) = mpsc::unbounded_channel();
+        let (replies, _) = bus.handle(1, &sink, &frame(opcode::STAP, 4, 0));
+        let r = Reply::decode(&replies[0]).expect("a valid checksum");
+        assert_eq!((r.status, r.opcode), (5, opcode::STAP));
+        let can = CanFrame::new(1, &[opcode::STAP, 4, 0, 0, 0, 0, 0]);
+        let replies = bus.handle_can(1, &sink, &can);
+        assert_eq!(replies[0].bytes()[1..3], [5, opcode::STAP]);
+        let can = CanFrame::new(1, &[opcode::GAP, 4, 0, 0, 0, 0, 0]);
+        assert_eq!(bus.handle_can(1, &sink, &can)[0].bytes()[1..3], [100, opcode::GAP], "reads are unaffected");
+
+        // Repaired: the next write stores the file's image and itself.
+        std::fs::remove_file(&store).unwrap();
+        std::fs::rename(&away, &store).unwrap();
+        assert_eq!(ask(&bus, opcode::SAP, 5, 300), (100, opcode::SAP));
+        assert_eq!(ask(&bus, opcode::STAP, 5, 0), (100, opcode::STAP));
+        let image = Eeprom::load(&path).unwrap().unwrap();
+        assert_eq!((image.axis(0, 4), image.axis(0, 5)), (Some(1000), Some(300)));
+        assert!(image.program.is_empty());
     }
 }
