@@ -1,8 +1,9 @@
 //! `Bus`: several modules on one link, as on an RS485 bus — a firmware
 //! `Bus` shared with the modules' objects (and a server, when served).
 
-use crate::errors::value_error;
-use crate::module::{Module, seconds_to_ns, served_error};
+use crate::advance::seconds_to_ns;
+use crate::errors::{guard, value_error};
+use crate::module::{Module, served_error};
 use crate::types::{Reply, ReplyKind, command_from};
 use pyo3::prelude::*;
 use std::borrow::Cow;
@@ -73,7 +74,7 @@ impl Bus {
     ///
     /// The module that answers to ``address`` now (GP 66).
     fn module(&self, py: Python<'_>, address: u8) -> PyResult<Py<Module>> {
-        match self.shared.with_bus(|b| b.index_of(address)) {
+        match guard(py, || self.shared.with_bus(|b| b.index_of(address)))? {
             Some(i) => Ok(self.modules[i].clone_ref(py)),
             None => Err(value_error(format!("no module on the bus answers to address {address}"))),
         }
@@ -84,10 +85,10 @@ impl Bus {
     ///
     /// Puts nine bytes on the bus: every module sees them, the addressed
     /// one answers (None: nobody answered).
-    fn send_frame(&self, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
+    fn send_frame(&self, py: Python<'_>, frame: Cow<'_, [u8]>) -> PyResult<Option<[u8; FRAME_LEN]>> {
         let frame: &[u8; FRAME_LEN] =
             frame.as_ref().try_into().map_err(|_| value_error(format!("a frame is {FRAME_LEN} bytes, not {}", frame.len())))?;
-        Ok(self.shared.frame(frame).into_iter().next())
+        Ok(guard(py, || self.shared.frame(frame))?.into_iter().next())
     }
 
     /// send(address, command, type=None, motor=None, value=None) -> Reply | None
@@ -106,7 +107,7 @@ impl Bus {
     ) -> PyResult<Option<Reply>> {
         let ins = command_from(command, r#type, motor, value)?;
         let frame = Request::new(address, ins).encode();
-        let reply = self.send_frame(Cow::Borrowed(&frame))?;
+        let reply = self.send_frame(command.py(), Cow::Borrowed(&frame))?;
         Ok(reply.map(|raw| Reply::new(raw, ReplyKind::of(ins, address, &raw))))
     }
 

@@ -43,3 +43,27 @@ pub fn value_error(message: impl Into<String>) -> PyErr {
 pub fn os_error(message: impl Into<String>) -> PyErr {
     PyOSError::new_err(message.into())
 }
+
+/// Runs `f`, turning a panic inside it into `Err` with the panic's
+/// message, so that no panic reaches Python (where it would be a
+/// `PanicException`, which `except Exception` does not catch). Needs no
+/// GIL; [`internal_error`] makes the exception.
+pub fn catch<R>(f: impl FnOnce() -> R) -> Result<R, String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).map_err(|payload| {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic without a message".to_string())
+    })
+}
+
+/// `InternalError(message)`: the simulator failed inside.
+pub fn internal_error(py: Python<'_>, message: String) -> PyErr {
+    python_error(py, "InternalError", (format!("internal error in the simulator: {message}"),))
+}
+
+/// [`catch`] with the GIL held: a panic becomes `InternalError`.
+pub fn guard<R>(py: Python<'_>, f: impl FnOnce() -> R) -> PyResult<R> {
+    catch(f).map_err(|message| internal_error(py, message))
+}

@@ -9,11 +9,13 @@
 //! - `types.rs`: `Reply`, `Instruction`, `Registers`;
 //! - `world.rs`: the control protocol of docs/world.md on any module;
 //! - `names.rs`: parameters by name;
-//! - `errors.rs`: raising the package's Python exceptions.
+//! - `advance.rs`: moving virtual time on (checked durations, Ctrl-C);
+//! - `errors.rs`: raising the package's Python exceptions, panics caught.
 //!
 //! The pure-Python part (`tmclsim/__init__.py`) subclasses `Module` and
 //! `Server` to add the world convenience methods and PyTrinamic helpers.
 
+mod advance;
 mod asm;
 mod bus;
 mod errors;
@@ -40,6 +42,7 @@ fn _tmclsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(profiles, m)?)?;
     m.add_function(wrap_pyfunction!(module::_time_core, m)?)?;
     m.add_function(wrap_pyfunction!(status_text, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_inside_guard, m)?)?;
     Ok(())
 }
 
@@ -63,4 +66,14 @@ fn status_text(status: u8) -> String {
         Some(s) => s.describe().to_string(),
         None => format!("status {status}"),
     }
+}
+
+/// _panic_inside_guard() -> None
+/// --
+///
+/// For the package's tests: panics inside the guard that every call into
+/// the simulator runs in, which raises ``tmclsim.InternalError``.
+#[pyfunction]
+fn _panic_inside_guard(py: Python<'_>) -> PyResult<()> {
+    errors::guard(py, || panic!("a panic on purpose"))
 }

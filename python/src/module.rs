@@ -6,8 +6,9 @@
 //! `advance` calls) and follows the wall clock while a `Server` serves it
 //! in real time; the bus writes the EEPROM file.
 
+use crate::advance::advance_in_slices;
 use crate::asm::{Program, program_from};
-use crate::errors::{os_error, tmcl_error, value_error};
+use crate::errors::{catch, guard, internal_error, os_error, tmcl_error, value_error};
 use crate::names::{Names, snake_case};
 use crate::types::{Registers, Reply, ReplyKind, command_from};
 use crate::world;
@@ -63,8 +64,10 @@ pub struct Module {
 impl Module {
     /// Runs `f` on the module, brought up to the bus's now; the bus then
     /// carries out what changed (EEPROM file, events).
+    /// A panic inside becomes `InternalError`, never a `PanicException`.
     pub fn with<R>(&mut self, f: impl FnOnce(&mut FwModule) -> R) -> PyResult<R> {
-        Ok(self.shared.with_module(self.index, f))
+        let (shared, index) = (&self.shared, self.index);
+        catch(|| shared.with_module(index, f)).map_err(|m| Python::attach(|py| internal_error(py, m)))
     }
 
     pub fn is_served(&self) -> bool {
@@ -105,9 +108,7 @@ impl Module {
                 "the module is served in real time: set server.stepped = True to move virtual time by hand",
             ));
         }
-        let shared = self.shared.clone();
-        py.detach(|| shared.advance(ns));
-        Ok(())
+        advance_in_slices(py, &self.shared.clone(), ns)
     }
 
     fn axis_number(&self, param: &Bound<'_, PyAny>) -> PyResult<u8> {
@@ -182,13 +183,6 @@ fn byte(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<u8> {
         return Err(pyo3::exceptions::PyTypeError::new_err(format!("a {what} is an int or a name, not {}", obj.get_type().name()?)));
     }
     obj.extract::<u8>().map_err(|_| value_error(format!("a {what} is 0…255, not {obj}")))
-}
-
-pub fn seconds_to_ns(seconds: f64) -> PyResult<u64> {
-    if !(seconds >= 0.0 && seconds.is_finite()) {
-        return Err(value_error(format!("time moves forward only: {seconds} s")));
-    }
-    Ok((seconds * 1e9).round() as u64)
 }
 
 /// The world a module is made with.
@@ -576,7 +570,7 @@ impl Module {
     /// needs stepped time (``server.stepped = True``) and moves every
     /// module of the link.
     fn advance(&mut self, py: Python<'_>, seconds: f64) -> PyResult<()> {
-        let ns = seconds_to_ns(seconds)?;
+        let ns = crate::advance::seconds_to_ns(seconds)?;
         self.advance_ns(py, ns)
     }
 
@@ -661,19 +655,22 @@ impl Module {
     /// in-process module (stop its server first).
     #[pyo3(signature = (timeout=10.0))]
     fn step(&mut self, py: Python<'_>, timeout: f64) -> PyResult<bool> {
-        let limit = seconds_to_ns(timeout)?;
+        let limit = crate::advance::seconds_to_ns(timeout)?;
         if !self.shared.is_stepped() {
             return Err(PyRuntimeError::new_err(
                 "the module is served in real time: step needs stepped time (stop the server or set server.stepped = True)",
             ));
         }
         let (shared, index) = (self.shared.clone(), self.index);
-        Ok(py.detach(|| {
-            shared.with_module(index, |m| {
-                let end = m.now_ns().saturating_add(limit);
-                m.step_instruction(end, 10_000_000)
+        py.detach(|| {
+            catch(|| {
+                shared.with_module(index, |m| {
+                    let end = m.now_ns().saturating_add(limit);
+                    m.step_instruction(end, 10_000_000)
+                })
             })
-        }))
+        })
+        .map_err(|m| internal_error(py, m))
     }
 
     /// Breakpoints: addresses (or labels of the program loaded last)
@@ -785,8 +782,9 @@ impl Module {
     /// Returns what the control socket prints after ``ok``; raises
     /// ``ValueError`` with its error. ``link …`` commands need a served
     /// module.
-    fn world(&mut self, line: &str) -> PyResult<String> {
-        world::run(&self.shared, self.index, line, self.served).map_err(value_error)
+    fn world(&mut self, py: Python<'_>, line: &str) -> PyResult<String> {
+        let (shared, index, served) = (&self.shared, self.index, self.served);
+        guard(py, || world::run(shared, index, line, served))?.map_err(value_error)
     }
 
     fn __repr__(&mut self) -> String {
@@ -823,20 +821,22 @@ impl Module {
 #[pyfunction]
 pub fn _time_core(module: &Bound<'_, Module>, operation: &str, calls: u32) -> PyResult<f64> {
     let this = module.try_borrow_mut()?;
-    this.shared.with_module(this.index, |m| {
-        let frame = Request::new(m.address(), Ins::new(opcode::GAP, 4, 0, 0)).encode();
-        let started = std::time::Instant::now();
-        let mut sink = 0i64;
-        for n in 0..calls {
-            sink += match operation {
-                "send_frame" => std::hint::black_box(m.handle_frame(std::hint::black_box(&frame))).map_or(0, |r| r[7] as i64),
-                "get_axis_parameter" => m.get_axis_parameter(std::hint::black_box(4), 0).unwrap_or(0) as i64,
-                "set_axis_parameter" => m.set_axis_parameter(4, 0, std::hint::black_box(1000 + (n % 2) as i32)).map_or(0, |_| 1),
-                "get_global_parameter" => m.get_global_parameter(std::hint::black_box(66), 0).unwrap_or(0) as i64,
-                other => return Err(value_error(format!("unknown operation '{other}'"))),
-            };
-        }
-        std::hint::black_box(sink);
-        Ok(started.elapsed().as_secs_f64() / calls.max(1) as f64)
-    })
+    guard(module.py(), || {
+        this.shared.with_module(this.index, |m| {
+            let frame = Request::new(m.address(), Ins::new(opcode::GAP, 4, 0, 0)).encode();
+            let started = std::time::Instant::now();
+            let mut sink = 0i64;
+            for n in 0..calls {
+                sink += match operation {
+                    "send_frame" => std::hint::black_box(m.handle_frame(std::hint::black_box(&frame))).map_or(0, |r| r[7] as i64),
+                    "get_axis_parameter" => m.get_axis_parameter(std::hint::black_box(4), 0).unwrap_or(0) as i64,
+                    "set_axis_parameter" => m.set_axis_parameter(4, 0, std::hint::black_box(1000 + (n % 2) as i32)).map_or(0, |_| 1),
+                    "get_global_parameter" => m.get_global_parameter(std::hint::black_box(66), 0).unwrap_or(0) as i64,
+                    other => return Err(value_error(format!("unknown operation '{other}'"))),
+                };
+            }
+            std::hint::black_box(sink);
+            Ok(started.elapsed().as_secs_f64() / calls.max(1) as f64)
+        })
+    })?
 }

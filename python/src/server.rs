@@ -5,9 +5,10 @@
 //! the wall clock; when it stops (also when garbage collected) the clock is
 //! stepped again.
 
+use crate::advance::{advance_in_slices, seconds_to_ns};
 use crate::bus::Bus;
-use crate::errors::{os_error, value_error};
-use crate::module::{Module, seconds_to_ns, served_error};
+use crate::errors::{guard, os_error, value_error};
+use crate::module::{Module, served_error};
 use crate::world;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
@@ -266,8 +267,7 @@ impl Server {
             return Err(PyRuntimeError::new_err("advance needs stepped time: set stepped = True first"));
         }
         let ns = seconds_to_ns(seconds)?;
-        py.detach(|| shared.advance(ns));
-        Ok(())
+        advance_in_slices(py, &shared, ns)
     }
 
     /// Virtual time of the served modules, in seconds.
@@ -284,12 +284,12 @@ impl Server {
     /// does: inputs, switches, loads, faults, ``link …`` faults, ``show``.
     /// Returns what the socket prints after ``ok``; raises ``ValueError``.
     #[pyo3(signature = (line, module=0))]
-    fn world(&self, line: &str, module: usize) -> PyResult<String> {
+    fn world(&self, py: Python<'_>, line: &str, module: usize) -> PyResult<String> {
         let shared = self.live()?;
         if module >= self.modules.len() {
             return Err(value_error(format!("module {module}: the server has {}", self.modules.len())));
         }
-        world::run(shared, module, line, true).map_err(value_error)
+        guard(py, || world::run(shared, module, line, true))?.map_err(value_error)
     }
 
     /// link_faults(drop=None, corrupt=None, delay_ms=None, mute=None, clear=False) -> dict

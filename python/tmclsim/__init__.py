@@ -37,13 +37,14 @@ from ._tmclsim import (
     profiles,
     status_text,
 )
-from .errors import AssemblyError, Diagnostic, TmclError
+from .errors import AssemblyError, Diagnostic, InternalError, TmclError
 
 __all__ = [
     "AssemblyError",
     "Bus",
     "Diagnostic",
     "Instruction",
+    "InternalError",
     "Module",
     "Program",
     "Registers",

@@ -1,7 +1,8 @@
 """The exceptions of tmclsim.
 
 ``TmclError`` carries the TMCL status code a module answered with;
-``AssemblyError`` carries the assembler's diagnostics.
+``AssemblyError`` carries the assembler's diagnostics; ``InternalError``
+reports a failure inside the simulator itself.
 """
 
 from typing import List, NamedTuple
@@ -60,3 +61,10 @@ class AssemblyError(Exception):
 
     def __str__(self) -> str:
         return "\n".join(str(d) for d in self.diagnostics)
+
+
+class InternalError(RuntimeError):
+    """The simulator failed inside (a bug in tmclsim, not in the caller's
+    program): the call did not complete and the module may be left in an
+    inconsistent state. The message is the internal one; please report it.
+    """

@@ -163,6 +163,14 @@ struct ProfileArgs {
 }
 
 fn main() -> ExitCode {
+    // A panic on any thread ends the process with status 101 after the
+    // usual message: a server whose link or clock task died would go on
+    // listening and serve nothing.
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        report(info);
+        std::process::exit(101);
+    }));
     let cli = Cli::parse();
     if !matches!(cli.command, Command::Serve(_) | Command::Bench(_) | Command::FleetBench(_)) {
         // A command whose output goes to a reader that stops early

@@ -74,9 +74,15 @@ pub fn parse_duration(text: &str) -> Result<u64, String> {
     };
     let v: f64 = number.trim().parse().map_err(|_| format!("'{text}' is not a duration (use e.g. 500ms, 10s, 5m, 1h)"))?;
     if !(v >= 0.0 && v.is_finite()) {
-        return Err(format!("'{text}' is not a duration"));
+        return Err(format!("'{text}' is not a duration: a finite time forward"));
     }
-    Ok((v * scale) as u64)
+    // Refused, not capped: 2^64 ns is the end of virtual time
+    // (docs/behaviour.md rule 84).
+    let ns = v * scale;
+    if ns >= u64::MAX as f64 {
+        return Err(format!("'{text}' is too long: virtual time ends after {:.0} s (about 584 years)", u64::MAX as f64 * 1e-9));
+    }
+    Ok(ns as u64)
 }
 
 pub fn run(args: RunArgs) -> Result<ExitCode, String> {
@@ -149,7 +155,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
             }
             continue;
         }
-        let next = (bus.now_ns() + slice).min(end);
+        let next = bus.now_ns().saturating_add(slice).min(end);
         bus.advance_to(next);
         if let Some(w) = &mut trace {
             write_trace(w, bus.module_mut(0))?;
@@ -319,4 +325,22 @@ fn step_one(m: &mut Module, end: u64) {
     m.set_breakpoints(&[]);
     m.step_instruction(end, 10_000_000);
     m.set_breakpoints(&bps);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_duration;
+
+    #[test]
+    fn durations_out_of_range_are_refused_not_capped() {
+        assert_eq!(parse_duration("1.5s"), Ok(1_500_000_000));
+        assert_eq!(parse_duration("500ms"), Ok(500_000_000));
+        assert_eq!(parse_duration("1e10"), Ok(10_000_000_000_000_000_000));
+        for long in ["18446744074s", "1e12", "1e300h"] {
+            assert!(parse_duration(long).unwrap_err().contains("is too long"), "{long}");
+        }
+        for bad in ["-1s", "nan", "inf", "-inf"] {
+            assert!(parse_duration(bad).unwrap_err().contains("is not a duration"), "{bad}");
+        }
+    }
 }

@@ -53,6 +53,8 @@ fn two_modules_at_one_address_are_refused() {
 #[test]
 fn endless_input_files_are_refused_unread() {
     refused(&["serve", "--fleet", "/dev/zero"], "/dev/zero: larger than 1 MiB, the limit for a fleet file");
+    refused(&["serve", "--tcp", "127.0.0.1:0", "--world", "/dev/zero"], "/dev/zero: larger than 1 MiB, the limit for a world file");
+    refused(&["run", "/dev/zero"], "cannot read the file: larger than 2 MiB, the limit for a source file");
     refused(&["disasm", "/dev/zero"], "/dev/zero: larger than 1 MiB, the limit for a program binary");
     refused(&["asm", "/dev/zero"], "cannot read the file: larger than 2 MiB, the limit for a source file");
     let bin = fleet_file("p.bin", "");

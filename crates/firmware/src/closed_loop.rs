@@ -186,10 +186,10 @@ impl Module {
             }
             axis.closed_loop.sync_offset = axis.mech_offset;
         }
-        if let Some((lo, hi)) = self.world.axes[m].travel {
+        if self.world.axes[m].travel.is_some() {
             let axis = &mut self.axes[m];
             let mech = axis.motion.x * sign + axis.mech_offset;
-            axis.mech_offset += mech.clamp(lo, hi) - mech;
+            axis.mech_offset += self.world.axes[m].within_travel(mech) - mech;
         }
         if dt > 0.0 {
             self.axes[m].closed_loop.rotor_velocity = (self.mechanical_position(m) - before) * sign / dt;

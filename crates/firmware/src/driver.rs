@@ -201,10 +201,9 @@ impl Module {
         if slips {
             axis.mech_offset -= moved * sign;
         }
-        if let Some((lo, hi)) = self.world.axes[m].travel {
+        if self.world.axes[m].travel.is_some() {
             let mech = axis.motion.x * sign + axis.mech_offset;
-            let clamped = mech.clamp(lo, hi);
-            axis.mech_offset += clamped - mech;
+            axis.mech_offset += self.world.axes[m].within_travel(mech) - mech;
         }
         // Encoder deviation (AP 212): the motor stops when the position
         // counter and the encoder drift apart further than allowed.

@@ -33,6 +33,7 @@ mod time;
 pub mod world;
 pub mod world_command;
 pub mod world_file;
+pub mod world_rules;
 
 pub use bus::Bus;
 pub use clock::Clock;

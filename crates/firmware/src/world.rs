@@ -92,6 +92,18 @@ impl AxisWorld {
         self.loads.iter().filter(|l| l.applies(mech, t_s)).map(|l| l.torque).sum()
     }
 
+    /// `mech` held within the end stops (unchanged without them). Unlike
+    /// `f64::clamp` this never panics: values that bypassed the rule set
+    /// (docs/behaviour.md rule 84) through `world_mut` give a wrong
+    /// position, not a dead module (an inverted range holds at its upper
+    /// end; a NaN end is no end).
+    pub fn within_travel(&self, mech: f64) -> f64 {
+        match self.travel {
+            Some((lo, hi)) => mech.max(lo).min(hi),
+            None => mech,
+        }
+    }
+
     /// Mechanical positions where a switch changes state.
     pub fn thresholds(&self) -> impl Iterator<Item = f64> + '_ {
         let home = self.home_switch.map(|(a, b)| [a, b]);

@@ -6,6 +6,8 @@
 
 use crate::module::Module;
 use crate::world::Load;
+use crate::world_rules::{ANALOG, SUPPLY, TEMPERATURE, check, check_input, check_load, check_span, check_stop, check_travel};
+use tmclsim_profile::Profile;
 
 pub const HELP: &str = "commands: [@ADDRESS] input N 0|1 | analog N VALUE | supply VOLTS | temperature CELSIUS | \
 switch AXIS left|right|home press|release|auto | place AXIS left|right POSITION [WIDTH] | place AXIS home FROM TO | \
@@ -137,8 +139,12 @@ impl WorldCommand {
         Ok(match cmd {
             "input" => {
                 let number = num(w.next(), "input number")?;
-                let level: u8 = num(w.next(), "level")?;
-                WorldCommand::Input { number, high: level != 0 }
+                let high = match w.next() {
+                    Some("1") => true,
+                    Some("0") => false,
+                    other => return Err(format!("expected level 0 or 1, found {}", other.unwrap_or("nothing"))),
+                };
+                WorldCommand::Input { number, high }
             }
             "analog" => {
                 let number = num(w.next(), "input number")?;
@@ -209,20 +215,18 @@ impl WorldCommand {
         }
     }
 
-    /// Applies the command to a module; `Ok` carries what to print after
-    /// `ok` (only `show` prints something).
+    /// Applies the command to a module, after checking its values
+    /// ([`WorldCommand::validate`], docs/behaviour.md rule 84): a refused
+    /// command changes nothing. `Ok` carries what to print after `ok`
+    /// (only `show` prints something).
     pub fn apply(&self, m: &mut Module) -> Result<String, String> {
+        self.validate(m.profile())?;
         let axes = m.profile().module.axes as usize;
-        if let Some(a) = self.axis()
-            && a >= axes
-        {
-            return Err(format!("axis {a} does not exist (the module has {axes})"));
-        }
         let world = m.world_mut();
         match *self {
             WorldCommand::Input { number, high } => world.set_digital(number, high),
             WorldCommand::Analog { number, value } => world.set_analog(number, value),
-            WorldCommand::Supply { volts } => world.supply_decivolts = (volts * 10.0).round().clamp(0.0, 1000.0) as u16,
+            WorldCommand::Supply { volts } => world.supply_decivolts = (volts * 10.0).round() as u16,
             WorldCommand::Temperature { celsius } => world.temperature = celsius,
             WorldCommand::Switch { axis, which, pressed } => {
                 let wa = &mut world.axes[axis];
@@ -276,6 +280,37 @@ impl WorldCommand {
             }
         }
         Ok(String::new())
+    }
+}
+
+impl WorldCommand {
+    /// Checks the command's values against the rule set and the module's
+    /// profile (its axes and inputs); `apply` does this first.
+    pub fn validate(&self, profile: &Profile) -> Result<(), String> {
+        let axes = profile.module.axes as usize;
+        if let Some(a) = self.axis()
+            && a >= axes
+        {
+            return Err(format!("axis {a} does not exist (the module has {axes})"));
+        }
+        let on_axis = |axis: usize, r: Result<(), String>| r.map_err(|e| format!("axis {axis}: {e}"));
+        match *self {
+            WorldCommand::Input { number, .. } => check_input(profile, 0, number),
+            WorldCommand::Analog { number, value } => {
+                check_input(profile, 1, number)?;
+                check("analog value", value as f64, ANALOG).map(drop)
+            }
+            WorldCommand::Supply { volts } => check("supply", volts, SUPPLY).map(drop),
+            WorldCommand::Temperature { celsius } => check("temperature", celsius, TEMPERATURE).map(drop),
+            WorldCommand::PlaceStop { axis, which, position, width } => {
+                let name = if which == SwitchKind::Left { "left" } else { "right" };
+                on_axis(axis, check_stop(name, position, width))
+            }
+            WorldCommand::PlaceHome { axis, from, to } => on_axis(axis, check_span("home switch", from, to)),
+            WorldCommand::Travel { axis, from, to } => on_axis(axis, check_travel(from, to)),
+            WorldCommand::Load { axis, torque, from, to } => on_axis(axis, check_load(&Load { torque, from, to, ..Load::default() })),
+            WorldCommand::Switch { .. } | WorldCommand::Fault { .. } | WorldCommand::Show { .. } => Ok(()),
+        }
     }
 }
 

@@ -1,6 +1,7 @@
 //! The world description file (TOML), see `docs/world.md`.
 
 use crate::world::{AxisWorld, Load, World};
+use crate::world_rules::{ANALOG, WORLD_ANALOG_INPUTS, WORLD_DIGITAL_INPUTS, check};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -95,41 +96,40 @@ impl World {
             return Err(format!("the world describes {} axes, the module has {axes}", f.axis.len()));
         }
         if let Some(v) = f.supply {
-            if !(0.0..=100.0).contains(&v) {
-                return Err(format!("supply = {v} V is out of range"));
-            }
+            crate::world_rules::check("supply", v, crate::world_rules::SUPPLY)?;
             w.supply_decivolts = (v * 10.0).round() as u16;
         }
         if let Some(t) = f.temperature {
             w.temperature = t;
         }
+        if f.inputs.len() > WORLD_DIGITAL_INPUTS {
+            return Err(format!("inputs lists {} levels: the world has {WORLD_DIGITAL_INPUTS} digital inputs", f.inputs.len()));
+        }
         for (n, level) in f.inputs.iter().enumerate() {
+            if *level > 1 {
+                return Err(format!("inputs[{n}] = {level}: a level is 0 or 1"));
+            }
             w.set_digital(n as u8, *level != 0);
         }
+        if f.analog.len() > WORLD_ANALOG_INPUTS {
+            return Err(format!("analog lists {} values: the world has {WORLD_ANALOG_INPUTS} analog inputs", f.analog.len()));
+        }
         for (n, v) in f.analog.iter().enumerate() {
-            if *v > 4095 {
-                return Err(format!("analog[{n}] = {v} is above 4095"));
-            }
+            check(&format!("analog[{n}]"), *v as f64, ANALOG)?;
             w.set_analog(n as u8, *v);
         }
         for (a, af) in f.axis.into_iter().enumerate() {
             let axis: &mut AxisWorld = &mut w.axes[a];
             if let Some([lo, hi]) = af.travel {
-                if lo >= hi {
-                    return Err(format!("axis {a}: travel [{lo}, {hi}] is empty"));
-                }
                 axis.travel = Some((lo, hi));
             }
             if let Some(s) = af.start {
                 axis.start = s;
             }
             if let Some(e) = af.encoder {
-                axis.encoder_counts = (e > 0.0).then_some(e);
+                axis.encoder_counts = (e != 0.0).then_some(e);
             }
             if let Some(f) = af.fullsteps {
-                if f <= 0.0 {
-                    return Err(format!("axis {a}: fullsteps = {f} must be positive"));
-                }
                 axis.fullsteps_per_rev = f;
             }
             if af.no_left_switch {
@@ -150,23 +150,19 @@ impl World {
                 axis.right_width = s.width;
             }
             if let Some(h) = af.home_switch {
-                if h.from > h.to {
-                    return Err(format!("axis {a}: home switch from {} to {} is empty", h.from, h.to));
-                }
                 axis.home_switch = Some((h.from, h.to));
             }
             for l in af.load {
-                if l.torque < 0.0 {
-                    return Err(format!("axis {a}: a load of {} % is negative", l.torque));
-                }
                 axis.loads.push(Load { torque: l.torque, from: l.from, to: l.to, after: l.after, until: l.until });
             }
         }
+        // Every value by the one rule set (docs/behaviour.md rule 84).
+        w.validate()?;
         Ok(w)
     }
 
     pub fn load_file(path: &std::path::Path, axes: usize) -> Result<World, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = crate::files::read_text_limited(path, crate::files::MAX_CONFIG_BYTES, "a world file")?;
         World::from_toml(&text, axes).map_err(|e| format!("{}: {e}", path.display()))
     }
 }
