@@ -274,7 +274,10 @@ fn a_failed_start_names_the_address_and_leaves_no_link() {
     let at = taken.local_addr().unwrap().to_string();
     let (ok, err) = refused(&["--tcp", &at, "--pty", link.to_str().unwrap()]);
     assert_eq!(ok, Some(false));
-    assert!(err.contains(&format!("cannot listen on {at} (TCP): ")) && err.contains("in use"), "{err}");
+    assert!(
+        err.contains(&format!("cannot listen on {at} (TCP): ")) && err.contains("in use") && err.contains("choose another port"),
+        "{err}"
+    );
     assert!(!exists(&link));
     // The control socket is bound after the pty exists.
     let (ok, err) = refused(&["--tcp", "127.0.0.1:0", "--pty", link.to_str().unwrap(), "--control", &at]);

@@ -231,9 +231,17 @@ async fn open(config: &ServerConfig) -> std::io::Result<Opened> {
     Ok(Opened { tcp, pty, control, slcan })
 }
 
-/// Binds a listener; an error names the address.
+/// Binds a listener; an error names the address and what to do.
 async fn listen(addr: SocketAddr, what: &str) -> std::io::Result<tokio::net::TcpListener> {
-    tokio::net::TcpListener::bind(addr).await.map_err(|e| std::io::Error::new(e.kind(), format!("cannot listen on {addr} ({what}): {e}")))
+    tokio::net::TcpListener::bind(addr).await.map_err(|e| {
+        let hint = match e.kind() {
+            std::io::ErrorKind::AddrInUse => " (another program listens there: stop it, or choose another port; port 0 takes a free one)",
+            std::io::ErrorKind::AddrNotAvailable => " (no interface of this machine has that address)",
+            std::io::ErrorKind::PermissionDenied => " (ports below 1024 need privileges: choose a port above 1023)",
+            _ => "",
+        };
+        std::io::Error::new(e.kind(), format!("cannot listen on {addr} ({what}): {e}{hint}"))
+    })
 }
 
 fn open_pty(path: &std::path::Path, what: &str) -> std::io::Result<pty::Pty> {
