@@ -371,7 +371,22 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
                 }
             }
             let mut stop = stop_rx.clone();
-            let _ = stop.wait_for(|s| *s).await;
+            // The server stops when asked, or when one of its tasks panics:
+            // then every link closes rather than a listener staying open
+            // in front of a task that is gone.
+            let failed = async {
+                loop {
+                    match tasks.join_next().await {
+                        Some(Err(e)) if e.is_panic() => return e,
+                        Some(_) => {}
+                        None => std::future::pending::<()>().await,
+                    }
+                }
+            };
+            tokio::select! {
+                _ = stop.wait_for(|s| *s) => {}
+                e = failed => eprintln!("tmclsim: a server task failed ({e}); every link of this server is closed"),
+            }
             tasks.abort_all();
             while tasks.join_next().await.is_some() {}
         });

@@ -103,6 +103,12 @@ impl Slots {
             }
             Some(Err(e)) => {
                 self.open.remove(&e.id());
+                if e.is_panic() {
+                    // A connection that panicked takes its listener down
+                    // with it, and the listener the server (lib.rs):
+                    // nothing keeps listening with a broken module behind.
+                    std::panic::resume_unwind(e.into_panic());
+                }
             }
             None => std::future::pending().await,
         }
