@@ -90,8 +90,15 @@ impl Server {
         Duration::from_millis((f[0] + f[1]) * 1000 / hz)
     }
 
+    /// How many log lines contain `what`; waits up to 2 s for the first
+    /// one (the log arrives through a pipe, after the client's answer).
     fn log_has(&self, what: &str) -> usize {
-        self.log.lock().unwrap().iter().filter(|l| l.contains(what)).count()
+        let count = || self.log.lock().unwrap().iter().filter(|l| l.contains(what)).count();
+        let until = std::time::Instant::now() + Duration::from_secs(2);
+        while count() == 0 && std::time::Instant::now() < until {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        count()
     }
 
     fn check(&self) {
