@@ -32,6 +32,9 @@ pub struct Module {
     pub(crate) globals: Globals,
     pub(crate) io: Io,
     pub(crate) world: World,
+    /// The world the module was created in (`reset` of the world control
+    /// goes back to it).
+    pub(crate) initial_world: World,
     /// The EEPROM image and whether it was written.
     pub(crate) persistence: Persistence,
     pub(crate) registers: Registers,
@@ -63,6 +66,7 @@ impl Module {
         let template = World::free(1).axes[0].clone();
         world.axes.resize(profile.module.axes as usize, template);
         let mut m = Module {
+            initial_world: world.clone(),
             world,
             axes: Vec::new(),
             globals: Globals::default(),
@@ -95,6 +99,26 @@ impl Module {
 
     pub fn world_mut(&mut self) -> &mut World {
         &mut self.world
+    }
+
+    /// The world goes back to the one the module was created in, and each
+    /// carriage to that world's start position; the module's own state
+    /// (position counters, parameters, program) stays as it is.
+    pub fn reset_world(&mut self) {
+        self.world = self.initial_world.clone();
+        for m in 0..self.axes.len() {
+            let start = self.world.axes[m].start;
+            self.place_carriage(m, start);
+        }
+    }
+
+    /// Puts the carriage of an axis at a position of the world (its
+    /// mechanical position) without moving the motor: the position counter
+    /// keeps its value, as when a carriage is pushed by hand.
+    pub fn place_carriage(&mut self, axis: usize, position: f64) {
+        let sign = self.shaft_sign();
+        let a = &mut self.axes[axis];
+        a.mech_offset = position - a.motion.x * sign;
     }
 
     pub fn eeprom(&self) -> &Eeprom {

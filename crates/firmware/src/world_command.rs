@@ -6,12 +6,12 @@
 
 use crate::module::Module;
 use crate::world::Load;
-use crate::world_rules::{ANALOG, SUPPLY, TEMPERATURE, check, check_input, check_load, check_span, check_stop, check_travel};
+use crate::world_rules::{ANALOG, POSITION, SUPPLY, TEMPERATURE, check, check_input, check_load, check_span, check_stop, check_travel};
 use tmclsim_profile::Profile;
 
 pub const HELP: &str = "commands: [@ADDRESS] input N 0|1 | analog N VALUE | supply VOLTS | temperature CELSIUS | \
 switch AXIS left|right|home press|release|auto | place AXIS left|right POSITION [WIDTH] | place AXIS home FROM TO | \
-travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \
+place AXIS carriage POSITION | reset | travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \
 link drop N | link corrupt N | link delay MS | link mute on|off | link clear | show [AXIS] | help";
 
 /// One of the three switches of an axis.
@@ -34,6 +34,13 @@ pub enum CoilFault {
 /// A change of the world (or a look at it).
 #[derive(Clone, Debug, PartialEq)]
 pub enum WorldCommand {
+    /// The world the module was served in again, carriages at its start.
+    Reset,
+    /// Puts the carriage of an axis at a position (the motor does not move).
+    PlaceCarriage {
+        axis: usize,
+        position: f64,
+    },
     /// Drives a digital input high or low.
     Input {
         number: u8,
@@ -167,8 +174,13 @@ impl WorldCommand {
                 };
                 WorldCommand::Switch { axis, which, pressed }
             }
+            "reset" => WorldCommand::Reset,
             "place" => {
                 let axis = num(w.next(), "axis")?;
+                if w.clone().next() == Some("carriage") {
+                    w.next();
+                    return Ok(WorldCommand::PlaceCarriage { axis, position: num(w.next(), "position")? });
+                }
                 let which = switch_kind(w.next())?;
                 let position = num(w.next(), "position")?;
                 let rest = optional(w.next())?;
@@ -205,6 +217,7 @@ impl WorldCommand {
     pub fn axis(&self) -> Option<usize> {
         match *self {
             WorldCommand::Switch { axis, .. }
+            | WorldCommand::PlaceCarriage { axis, .. }
             | WorldCommand::PlaceStop { axis, .. }
             | WorldCommand::PlaceHome { axis, .. }
             | WorldCommand::Travel { axis, .. }
@@ -222,8 +235,20 @@ impl WorldCommand {
     pub fn apply(&self, m: &mut Module) -> Result<String, String> {
         self.validate(m.profile())?;
         let axes = m.profile().module.axes as usize;
+        match *self {
+            WorldCommand::Reset => {
+                m.reset_world();
+                return Ok(String::new());
+            }
+            WorldCommand::PlaceCarriage { axis, position } => {
+                m.place_carriage(axis, position);
+                return Ok(String::new());
+            }
+            _ => {}
+        }
         let world = m.world_mut();
         match *self {
+            WorldCommand::Reset | WorldCommand::PlaceCarriage { .. } => {}
             WorldCommand::Input { number, high } => world.set_digital(number, high),
             WorldCommand::Analog { number, value } => world.set_analog(number, value),
             WorldCommand::Supply { volts } => world.supply_decivolts = (volts * 10.0).round() as u16,
@@ -309,7 +334,8 @@ impl WorldCommand {
             WorldCommand::PlaceHome { axis, from, to } => on_axis(axis, check_span("home switch", from, to)),
             WorldCommand::Travel { axis, from, to } => on_axis(axis, check_travel(from, to)),
             WorldCommand::Load { axis, torque, from, to } => on_axis(axis, check_load(&Load { torque, from, to, ..Load::default() })),
-            WorldCommand::Switch { .. } | WorldCommand::Fault { .. } | WorldCommand::Show { .. } => Ok(()),
+            WorldCommand::PlaceCarriage { axis, position } => on_axis(axis, check("carriage position", position, POSITION).map(drop)),
+            WorldCommand::Switch { .. } | WorldCommand::Fault { .. } | WorldCommand::Show { .. } | WorldCommand::Reset => Ok(()),
         }
     }
 }

@@ -154,3 +154,31 @@ fn the_built_in_worlds_follow_the_rules() {
     assert_eq!(World::stage(3).validate(), Ok(()));
     assert_eq!(World::free(3).validate(), Ok(()));
 }
+
+#[test]
+fn reset_and_carriage_placement_bring_a_run_back_without_a_restart() {
+    let mut m = Module::built_in("tmcm-1141").unwrap();
+    *m.world_mut() = World::stage(1);
+    let mut bus = Bus::single(Module::with_world(m.profile().clone(), m.eeprom().clone(), World::stage(1)));
+    let start = World::stage(1).axes[0].start;
+    // A run changes the world and drives the carriage onto the right end stop.
+    say(&mut bus, "temperature 90").unwrap();
+    say(&mut bus, "load 0 30").unwrap();
+    send(bus.module_mut(0), "ROR 0, 2047");
+    bus.advance(600_000 * MS);
+    assert!(bus.module(0).switches(0).1, "the carriage stands on the right switch");
+    // Placing the carriage moves it, not the motor: the counter keeps its value.
+    send(bus.module_mut(0), "MST 0");
+    let counter = bus.module(0).actual_position(0);
+    say(&mut bus, "place 0 carriage 1000").unwrap();
+    assert_eq!(bus.module(0).mechanical_position(0), 1000.0);
+    assert_eq!(bus.module(0).actual_position(0), counter);
+    assert!(!bus.module(0).switches(0).1, "off the switch");
+    assert!(say(&mut bus, "place 0 carriage nan").unwrap_err().contains("carriage position"));
+    assert!(say(&mut bus, "place 1 carriage 0").unwrap_err().contains("axis 1 does not exist"));
+    // Reset: the world the module was served in, the carriage at its start.
+    say(&mut bus, "reset").unwrap();
+    let m = bus.module(0);
+    assert_eq!(m.world(), &World::stage(1));
+    assert_eq!(m.mechanical_position(0), start);
+}
