@@ -174,6 +174,7 @@ fn serve(
     };
     let token = config.control_token.clone();
     let names: Vec<String> = modules.iter().map(|m| format!("{} (address {})", m.profile().module.name, m.address())).collect();
+    let addresses: Vec<(u8, String)> = modules.iter().map(|m| (m.address(), m.profile().module.name.clone())).collect();
     let server = tmclsim_server::start_bus(modules, config).map_err(|e| format!("cannot serve: {e}"))?;
     let ep = server.endpoints().clone();
     println!("tmclsim: virtual {} is serving", names.join(", "));
@@ -197,6 +198,19 @@ fn serve(
     }
     if let Some(path) = &args.endpoints {
         write_endpoints(path, &ep, token.as_deref())?;
+    }
+    if let Some((link, _)) = &ep.slcan {
+        let (first, _) = &addresses[0];
+        println!(
+            "  over CAN: pytrinamic ConnectionManager(\"--interface slcan_tmcl --port {} --data-rate 1000000 --module-id {first}\")",
+            link.display()
+        );
+    }
+    if addresses.len() > 1 {
+        let (a, _) = &addresses[1];
+        println!(
+            "  a bus: each module answers its own address; PyTrinamic reaches module {a} with --module-id {a} in the ConnectionManager arguments, or module_id={a} in its module class"
+        );
     }
     if let Some(a) = ep.pytrinamic_args() {
         println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));

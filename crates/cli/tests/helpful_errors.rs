@@ -61,3 +61,26 @@ fn host_names_serve_and_the_endpoints_file_tells_scripts_where() {
     child.wait().unwrap();
     assert!(!file.exists(), "the endpoints file goes with the server");
 }
+
+#[test]
+fn bus_and_can_hints_say_how_to_reach_each_module() {
+    let slcan = std::env::temp_dir().join(format!("tmclsim-hint-slcan-{}", std::process::id()));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["serve", "--tcp", "127.0.0.1:0", "--bus", "tmcm-1141@1,tmcm-1141@2", "--slcan", slcan.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut printed = String::new();
+    while !printed.contains("connect with:") {
+        assert!(out.read_line(&mut printed).unwrap() > 0, "the server ended: {printed}");
+    }
+    unsafe {
+        libc::kill(child.id() as i32, libc::SIGTERM);
+    }
+    let _ = out.read_to_string(&mut String::new());
+    child.wait().unwrap();
+    assert!(printed.contains("PyTrinamic reaches module 2 with --module-id 2"), "{printed}");
+    assert!(printed.contains(&format!("--interface slcan_tmcl --port {} --data-rate 1000000 --module-id 1", slcan.display())), "{printed}");
+}
