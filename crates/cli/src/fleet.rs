@@ -156,6 +156,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
             inter_byte_timeout: crate::millis(args.inter_byte_timeout),
             max_connections: args.max_connections,
             wire_timing: l.wire_timing,
+            log_frames: args.log_frames,
             ..ServerConfig::default()
         };
         specs.push(LinkSpec { modules, config });

@@ -125,6 +125,10 @@ pub struct ServeArgs {
     /// for scripts; removed when the server stops.
     #[arg(long, value_name = "FILE")]
     pub endpoints: Option<PathBuf>,
+    /// Print every frame in and out on stderr, decoded (command or status
+    /// and value), with the time since start and the link it came on.
+    #[arg(long, short = 'v')]
+    pub log_frames: bool,
     /// Allow --control on an address other machines reach; clients must
     /// then send `auth TOKEN` first (the token is printed at start).
     #[arg(long)]

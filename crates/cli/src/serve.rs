@@ -170,6 +170,7 @@ fn serve(
         control_token: if args.control_public { Some(control_token()?) } else { None },
         wire_timing: args.wire_timing,
         slcan: args.slcan.clone(),
+        log_frames: args.log_frames,
         ..ServerConfig::default()
     };
     let token = config.control_token.clone();

@@ -84,3 +84,23 @@ fn bus_and_can_hints_say_how_to_reach_each_module() {
     assert!(printed.contains("PyTrinamic reaches module 2 with --module-id 2"), "{printed}");
     assert!(printed.contains(&format!("--interface slcan_tmcl --port {} --data-rate 1000000 --module-id 1", slcan.display())), "{printed}");
 }
+
+#[test]
+fn log_frames_shows_the_traffic_decoded() {
+    let (mut child, tcp) = common::serve(&["--log-frames"], Stdio::piped());
+    let mut s = std::net::TcpStream::connect(&tcp).unwrap();
+    assert_eq!(common::ask(&mut s, "SAP 4, 0, 1234").unwrap().status, 100);
+    assert_eq!(common::ask(&mut s, "GAP 4, 0").unwrap().value, 1234);
+    drop(s);
+    unsafe {
+        libc::kill(child.id() as i32, libc::SIGTERM);
+    }
+    let mut log = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut log).unwrap();
+    child.wait().unwrap();
+    let lines: Vec<&str> = log.lines().filter(|l| l.contains(" tcp 127.0.0.1:")).collect();
+    assert_eq!(lines.len(), 4, "{log}");
+    assert!(lines[0].ends_with("→ 01 05 04 00 00 00 04 D2 E0  to 1: SAP 4, 0, 1234"), "{}", lines[0]);
+    assert!(lines[3].contains("← 02 01 64 06 00 00 04 D2") && lines[3].ends_with("from 1: status 100 (ok), value 1234"), "{}", lines[3]);
+    assert!(lines[0].starts_with("tmclsim: ") && lines[0].contains(" s tcp 127.0.0.1:"), "a time and the link: {}", lines[0]);
+}

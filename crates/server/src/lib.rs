@@ -11,6 +11,7 @@ mod clock;
 pub mod control;
 pub mod ethercat;
 mod faults;
+mod frame_log;
 mod link;
 mod pty;
 mod shared;
@@ -67,6 +68,9 @@ pub struct ServerConfig {
     /// Path of the symlink to a pty that is a serial-line CAN adapter
     /// (SLCAN) with the modules on its CAN bus.
     pub slcan: Option<PathBuf>,
+    /// Print every frame in and out on stderr, decoded, with the time and
+    /// the link it came on.
+    pub log_frames: bool,
 }
 
 impl Default for ServerConfig {
@@ -85,6 +89,7 @@ impl Default for ServerConfig {
             warn_exposure: true,
             wire_timing: false,
             slcan: None,
+            log_frames: false,
         }
     }
 }

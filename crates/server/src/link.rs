@@ -19,6 +19,20 @@ pub(crate) fn next_link_id() -> u64 {
     NEXT_LINK.fetch_add(1, Ordering::Relaxed)
 }
 
+/// How a link is served: from the server's configuration, and the link's
+/// name for the frame log.
+pub(crate) struct Options {
+    pub inter_byte_timeout: Duration,
+    pub log_frames: bool,
+    pub name: String,
+}
+
+impl Options {
+    pub fn of(config: &crate::ServerConfig, name: String) -> Options {
+        Options { inter_byte_timeout: config.inter_byte_timeout, log_frames: config.log_frames, name }
+    }
+}
+
 /// Serves one stream until it closes or fails. Replies are written by this
 /// task as soon as they exist; unsolicited events (138) reach it through a
 /// channel, so one task writes and frames never interleave. `lines` is
@@ -28,7 +42,7 @@ pub(crate) async fn serve<R, W>(
     mut reader: R,
     mut writer: W,
     module: Arc<SharedBus>,
-    inter_byte_timeout: Duration,
+    options: &Options,
     lines: &mut LineState,
     activity: &Activity,
 ) -> std::io::Result<()>
@@ -39,7 +53,12 @@ where
     let link = next_link_id();
     let (events_tx, mut events) = mpsc::unbounded_channel::<[u8; FRAME_LEN]>();
     let start = Instant::now();
-    let mut assembler = FrameAssembler::new(inter_byte_timeout.as_nanos() as u64);
+    let mut assembler = FrameAssembler::new(options.inter_byte_timeout.as_nanos() as u64);
+    let log = |direction: crate::frame_log::Direction, frame: &[u8; FRAME_LEN]| {
+        if options.log_frames {
+            crate::frame_log::print(&options.name, link, direction, frame);
+        }
+    };
     let mut buf = [0u8; 512];
     loop {
         tokio::select! {
@@ -67,6 +86,7 @@ where
                     }
                     let Some(frame) = assembler.push(byte, now) else { continue };
                     activity.touch();
+                    log(crate::frame_log::Direction::In, &frame);
                     let (replies, pause) = module.handle(link, &events_tx, &frame);
                     for reply in replies {
                         let (reply, fault_delay) = module.outgoing(reply);
@@ -75,6 +95,7 @@ where
                             tokio::time::sleep(delay).await;
                         }
                         if let Some(reply) = reply {
+                            log(crate::frame_log::Direction::Out, &reply);
                             writer.write_all(&reply).await?;
                         }
                     }
@@ -86,6 +107,7 @@ where
             }
             Some(event) = events.recv() => {
                 if let (Some(event), _) = module.outgoing(event) {
+                    log(crate::frame_log::Direction::Out, &event);
                     writer.write_all(&event).await?;
                     writer.flush().await?;
                 }

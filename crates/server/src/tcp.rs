@@ -21,13 +21,13 @@ pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: S
                 }
                 let _ = stream.set_nodelay(true);
                 let module = module.clone();
-                let timeout = config.inter_byte_timeout;
+                let options = crate::link::Options::of(&config, format!("tcp {peer}"));
                 let activity = Arc::new(Activity::new());
                 let seen = activity.clone();
                 slots.spawn(peer, activity, async move {
                     let (r, w) = stream.into_split();
                     let mut lines = Default::default();
-                    let _ = crate::link::serve(r, w, module, timeout, &mut lines, &seen).await;
+                    let _ = crate::link::serve(r, w, module, &options, &mut lines, &seen).await;
                 });
             }
             _ = slots.reap(), if !slots.is_empty() => {}
