@@ -105,7 +105,14 @@ impl Loader<'_> {
             Ok(f) => f,
             Err(message) => match built_in(wanted) {
                 Some(f) => f,
-                None => return self.reporter.error(loc, column, message),
+                None => {
+                    let shipped: Vec<&str> = crate::include::BUILT_IN.iter().map(|(n, _)| *n).collect();
+                    let hint = format!(
+                        "; the include files shipped with tmclsim are {} (their names: crates/asm/README.md)",
+                        shipped.join(" and ")
+                    );
+                    return self.reporter.error(loc, column, format!("{message}{hint}"));
+                }
             },
         };
         if let Some(start) = self.stack.iter().position(|(key, _)| *key == found.key) {

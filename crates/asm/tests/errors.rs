@@ -149,7 +149,10 @@ fn include_cycle() {
 fn include_not_found() {
     let e = assemble("STOP\n#include nothere.inc\n", "prog.tmc", &MemoryResolver::new(), None).unwrap_err();
     assert_eq!(e.len(), 1);
-    assert_eq!(e[0].to_string(), "prog.tmc:2:10: error: cannot find include file 'nothere.inc'");
+    assert_eq!(
+        e[0].to_string(),
+        "prog.tmc:2:10: error: cannot find include file 'nothere.inc'; the include files shipped with tmclsim are Interrupts.inc and Parameters.inc (their names: crates/asm/README.md)"
+    );
     assert_eq!(one("#include", false), "prog.tmc:1:9: error: #include needs a file name");
 }
 
