@@ -7,9 +7,10 @@ mod common;
 use std::io::{BufRead, BufReader, Read};
 use std::process::{Command, Stdio};
 
+/// Exit status and everything printed.
 fn tmclsim(args: &[&str]) -> (Option<i32>, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_tmclsim")).args(args).stdin(Stdio::null()).output().unwrap();
-    (o.status.code(), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
+    let o = common::tmclsim(args);
+    (o.status.code(), common::text(&o))
 }
 
 #[test]

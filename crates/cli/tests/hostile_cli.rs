@@ -3,11 +3,11 @@
 //! server that starts wrong (docs/robustness.md).
 
 use std::io::Read;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 
-fn tmclsim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tmclsim")).args(args).stdin(Stdio::null()).output().unwrap()
-}
+mod common;
+
+use common::tmclsim;
 
 /// Asserts a refusal: exit status 2, no panic, and `expected` in stderr.
 fn refused(args: &[&str], expected: &str) {

@@ -2,12 +2,10 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use common::{text, tmclsim};
 
-fn tmclsim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tmclsim")).args(args).output().unwrap()
-}
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("tmclsim-cli-{name}-{}", std::process::id()));
@@ -17,10 +15,6 @@ fn dir(name: &str) -> PathBuf {
 
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../asm/tests/programs").join(name)
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 #[test]

@@ -52,3 +52,13 @@ pub fn ask(s: &mut TcpStream, line: &str) -> Option<Reply> {
     s.read_exact(&mut buf).ok()?;
     Reply::decode(&buf)
 }
+
+/// Runs `tmclsim ARGS` to the end with standard input closed.
+pub fn tmclsim(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tmclsim")).args(args).stdin(Stdio::null()).output().unwrap()
+}
+
+/// Standard output and standard error of a finished command, together.
+pub fn text(o: &std::process::Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
