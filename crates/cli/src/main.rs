@@ -11,6 +11,7 @@ mod bench;
 mod client;
 mod fleet;
 mod plot;
+mod progress;
 mod run;
 mod send;
 mod serve;

@@ -138,7 +138,13 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let mut debugging = args.debug;
     let stdin = std::io::stdin();
     let mut lines = stdin.lock().lines();
+    // A bar for long runs; none while a debugger may talk on the terminal.
+    let mut progress = (breakpoints.is_empty() && !args.debug)
+        .then(|| crate::progress::Progress::new(end / 1_000_000, "{bar:40} {pos}/{len} ms of virtual time"));
     while bus.now_ns() < end {
+        if let Some(p) = &mut progress {
+            p.set(bus.now_ns() / 1_000_000);
+        }
         // A breakpoint stops the program (step mode); after `continue` the
         // program runs on past the breakpoint it stood on.
         let at_breakpoint = bus.module(0).program().hit_breakpoint.is_some() && bus.module(0).program().mode != RunMode::Run;
@@ -168,6 +174,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
             // Stopped for good: the rest is motion only.
             bus.advance_to(end);
         }
+    }
+    if let Some(p) = progress {
+        p.finish();
     }
     let module = bus.module_mut(0);
     if let Some(mut w) = trace {

@@ -45,7 +45,9 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
     };
     ok(c.request(Instruction::new(opcode::STOP_APPLICATION, 0, 0, 0))?, "stop")?;
     ok(c.request(Instruction::new(opcode::ENTER_DOWNLOAD, 0, 0, 0))?, "enter download mode")?;
+    let mut progress = crate::progress::Progress::new(2 * words.len() as u64, "{bar:40} {pos}/{len} words sent and read back");
     for (a, w) in words.iter().enumerate() {
+        progress.set(a as u64);
         let r = c.request(*w)?;
         if r.status != Status::Loaded.code() {
             let _ = c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
@@ -55,6 +57,7 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
     ok(c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0))?, "exit download mode")?;
     // Verify by reading every word back.
     for (a, w) in words.iter().enumerate() {
+        progress.set((words.len() + a) as u64);
         let raw = c.exchange(Instruction::new(opcode::READ_MEMORY, 0, 0, a as i32))?;
         if raw[1] == args.link.address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
             return Err(format!("read-back of word {a}: status {} (code protection?)", raw[2]));
@@ -69,6 +72,7 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
             ));
         }
     }
+    progress.finish();
     println!("uploaded and verified {} instructions", words.len());
     if args.autostart {
         ok(c.request(Instruction::new(opcode::SGP, 77, 0, 1))?, "autostart (GP 77)")?;

@@ -197,3 +197,17 @@ fn upload_over_tcp_and_pty_verifies_and_runs() {
     server.wait().unwrap();
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+#[test]
+fn a_long_run_is_quiet_when_stderr_is_no_terminal() {
+    let d = dir("quiet");
+    let source = d.join("poll.tmc");
+    std::fs::write(&source, "Loop:\n  MVP ABS, 0, 512000\nWait:\n  GAP 8, 0\n  JC ZE, Wait\n  MVP ABS, 0, 0\n  JA Loop\n").unwrap();
+    let started = std::time::Instant::now();
+    let o = tmclsim(&["run", source.to_str().unwrap(), "--for", "3m"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(started.elapsed().as_secs_f64() > 1.0, "long enough for a bar on a terminal");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.is_empty(), "no progress bar in a pipe: {stderr}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
