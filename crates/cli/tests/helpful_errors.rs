@@ -4,9 +4,6 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read};
-use std::process::{Command, Stdio};
-
 /// Exit status and everything printed.
 fn tmclsim(args: &[&str]) -> (Option<i32>, String) {
     let o = common::tmclsim(args);
@@ -30,17 +27,8 @@ fn an_unknown_world_lists_the_built_in_ones() {
 #[test]
 fn host_names_serve_and_the_endpoints_file_tells_scripts_where() {
     let file = std::env::temp_dir().join(format!("tmclsim-endpoints-{}.toml", std::process::id()));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .args(["serve", "--tcp", "localhost:0", "--control", "localhost:0", "--endpoints", file.to_str().unwrap()])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut printed = String::new();
-    while !printed.contains("connect with:") {
-        assert!(out.read_line(&mut printed).unwrap() > 0, "the server ended: {printed}");
-    }
+    let server = common::Server::start(&["--tcp", "localhost:0", "--control", "localhost:0", "--endpoints", file.to_str().unwrap()]);
+    let printed = server.banner.join("\n");
     let endpoints: toml::Table = toml::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
     let tcp = endpoints["tcp"].as_str().unwrap().to_string();
     let control = endpoints["control"].as_str().unwrap().to_string();
@@ -54,51 +42,28 @@ fn host_names_serve_and_the_endpoints_file_tells_scripts_where() {
     assert!(text.contains("did not answer as a control socket (a TMCL port?)"), "{text}");
     let (code, text) = tmclsim(&["world", "--control", &control, "show"]);
     assert_eq!(code, Some(0), "{text}");
-    unsafe {
-        libc::kill(child.id() as i32, libc::SIGTERM);
-    }
-    let mut rest = String::new();
-    let _ = out.read_to_string(&mut rest);
-    child.wait().unwrap();
+    server.stop();
     assert!(!file.exists(), "the endpoints file goes with the server");
 }
 
 #[test]
 fn bus_and_can_hints_say_how_to_reach_each_module() {
     let slcan = std::env::temp_dir().join(format!("tmclsim-hint-slcan-{}", std::process::id()));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .args(["serve", "--tcp", "127.0.0.1:0", "--bus", "tmcm-1141@1,tmcm-1141@2", "--slcan", slcan.to_str().unwrap()])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut printed = String::new();
-    while !printed.contains("connect with:") {
-        assert!(out.read_line(&mut printed).unwrap() > 0, "the server ended: {printed}");
-    }
-    unsafe {
-        libc::kill(child.id() as i32, libc::SIGTERM);
-    }
-    let _ = out.read_to_string(&mut String::new());
-    child.wait().unwrap();
+    let server = common::Server::start(&["--tcp", "127.0.0.1:0", "--bus", "tmcm-1141@1,tmcm-1141@2", "--slcan", slcan.to_str().unwrap()]);
+    let printed = server.banner.join("\n");
+    server.stop();
     assert!(printed.contains("PyTrinamic reaches module 2 with --module-id 2"), "{printed}");
     assert!(printed.contains(&format!("--interface slcan_tmcl --port {} --data-rate 1000000 --module-id 1", slcan.display())), "{printed}");
 }
 
 #[test]
 fn log_frames_shows_the_traffic_decoded() {
-    let (mut child, tcp) = common::serve(&["--log-frames"], Stdio::piped());
-    let mut s = std::net::TcpStream::connect(&tcp).unwrap();
+    let server = common::Server::start(&["--tcp", "127.0.0.1:0", "--log-frames"]);
+    let mut s = server.connect();
     assert_eq!(common::ask(&mut s, "SAP 4, 0, 1234").unwrap().status, 100);
     assert_eq!(common::ask(&mut s, "GAP 4, 0").unwrap().value, 1234);
-    drop(s);
-    unsafe {
-        libc::kill(child.id() as i32, libc::SIGTERM);
-    }
-    let mut log = String::new();
-    child.stderr.take().unwrap().read_to_string(&mut log).unwrap();
-    child.wait().unwrap();
+    server.logged(&["← 02 01 64 06"]).expect("the reply to GAP logged");
+    let log = server.log.lock().unwrap().join("\n");
     let lines: Vec<&str> = log.lines().filter(|l| l.contains(" tcp 127.0.0.1:")).collect();
     assert_eq!(lines.len(), 4, "{log}");
     assert!(lines[0].ends_with("→ 01 05 04 00 00 00 04 D2 E0  to 1: SAP 4, 0, 1234"), "{}", lines[0]);

@@ -4,55 +4,15 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
+use common::Server;
+use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::process::{Child, Stdio};
-use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tmclsim_protocol::Reply;
 
-struct Server {
-    child: Child,
-    addr: String,
-    log: Arc<Mutex<Vec<String>>>,
-}
-
-impl Server {
-    fn start(extra: &[&str]) -> Server {
-        let (mut child, addr) = common::serve(extra, Stdio::piped());
-        let log = Arc::new(Mutex::new(Vec::new()));
-        let (l, err) = (log.clone(), child.stderr.take().unwrap());
-        std::thread::spawn(move || {
-            for line in BufReader::new(err).lines().map_while(Result::ok) {
-                l.lock().unwrap().push(line);
-            }
-        });
-        Server { child, addr, log }
-    }
-
-    fn rss_kib(&self) -> u64 {
-        let s = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).unwrap();
-        s.lines().find(|l| l.starts_with("VmRSS:")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap()
-    }
-
-    fn check(&self) {
-        let mut s = TcpStream::connect(&self.addr).unwrap();
-        s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-        for (line, expect) in [("SAP 4, 0, 1234", 1234), ("GAP 4, 0", 1234), ("GGP 66, 0", 1)] {
-            s.write_all(&common::frame(line)).unwrap();
-            let mut b = [0u8; 9];
-            s.read_exact(&mut b).unwrap();
-            let r = Reply::decode(&b).unwrap();
-            assert_eq!((r.status, r.value), (100, expect), "{line}");
-        }
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// A server with TCP on a free loopback port and `extra` arguments.
+fn start(extra: &[&str]) -> Server {
+    Server::start(&[&["--tcp", "127.0.0.1:0"][..], extra].concat())
 }
 
 /// xorshift64: the same "random" bytes every run. Every ninth byte (counted
@@ -86,10 +46,10 @@ fn noise(seed: &mut u64, offset: u64, buf: &mut [u8], sum: &mut u8) -> u64 {
 #[test]
 fn a_hundred_megabytes_of_random_bytes() {
     // No partial frame is ever dropped on a pause: the stream stays aligned.
-    let server = Server::start(&["--inter-byte-timeout", "600000"]);
+    let server = start(&["--inter-byte-timeout", "600000"]);
     server.check();
     let before = server.rss_kib();
-    let mut s = TcpStream::connect(&server.addr).unwrap();
+    let mut s = TcpStream::connect(server.tcp()).unwrap();
     // Every frame addressed to the module is answered with a checksum error
     // (status 1); the replies are drained and counted while the noise goes
     // out.
@@ -133,10 +93,10 @@ fn a_hundred_megabytes_of_random_bytes() {
 
 #[test]
 fn thousands_of_connects_and_disconnects() {
-    let server = Server::start(&[]);
+    let server = start(&[]);
     let before = server.rss_kib();
     for i in 0..3000 {
-        let mut s = TcpStream::connect(&server.addr).unwrap();
+        let mut s = TcpStream::connect(server.tcp()).unwrap();
         if i % 3 == 0 {
             // Leave a partial frame behind.
             let _ = s.write_all(&[1, 6, 4]);
@@ -151,11 +111,11 @@ fn thousands_of_connects_and_disconnects() {
 
 #[test]
 fn idle_connections_up_to_the_limit() {
-    let server = Server::start(&["--max-connections", "20"]);
-    let idle: Vec<TcpStream> = (0..20).map(|_| TcpStream::connect(&server.addr).unwrap()).collect();
+    let server = start(&["--max-connections", "20"]);
+    let idle: Vec<TcpStream> = (0..20).map(|_| TcpStream::connect(server.tcp()).unwrap()).collect();
     std::thread::sleep(Duration::from_millis(100));
     // The 21st is refused: accepted and closed at once, with a log line.
-    let mut extra = TcpStream::connect(&server.addr).unwrap();
+    let mut extra = TcpStream::connect(server.tcp()).unwrap();
     extra.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
     let mut b = [0u8; 1];
     assert_eq!(extra.read(&mut b).unwrap_or(0), 0, "closed by the server");
@@ -172,10 +132,10 @@ fn idle_connections_up_to_the_limit() {
 
 #[test]
 fn half_open_and_half_closed_connections() {
-    let server = Server::start(&["--max-connections", "8"]);
+    let server = start(&["--max-connections", "8"]);
     // A host that sends its last command and closes its sending half still
     // gets the reply.
-    let mut s = TcpStream::connect(&server.addr).unwrap();
+    let mut s = TcpStream::connect(server.tcp()).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     s.write_all(&common::frame("GAP 4, 0")).unwrap();
     s.shutdown(std::net::Shutdown::Write).unwrap();
@@ -187,7 +147,7 @@ fn half_open_and_half_closed_connections() {
     // server's side) hold no more than their own slot; others are served.
     let stuck: Vec<TcpStream> = (0..7)
         .map(|_| {
-            let mut s = TcpStream::connect(&server.addr).unwrap();
+            let mut s = TcpStream::connect(server.tcp()).unwrap();
             s.write_all(&[1, 6, 4, 0]).unwrap();
             s
         })

@@ -4,61 +4,16 @@
 
 mod common;
 
-use common::ask;
-use std::io::{BufRead, BufReader, Read};
-use std::net::TcpStream;
+use common::{Server, ask};
+use std::io::Read;
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::{Arc, Mutex};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::Eeprom;
 
-/// A served module whose stderr is collected; stopped when dropped.
-struct Server {
-    child: Child,
-    addr: String,
-    log: Arc<Mutex<Vec<String>>>,
-}
-
-impl Server {
-    fn start(eeprom: &Path) -> Server {
-        let (mut child, addr) = common::serve(&["--eeprom", eeprom.to_str().unwrap()], Stdio::piped());
-        let log = Arc::new(Mutex::new(Vec::new()));
-        let (l, err) = (log.clone(), child.stderr.take().unwrap());
-        std::thread::spawn(move || {
-            for line in BufReader::new(err).lines().map_while(Result::ok) {
-                l.lock().unwrap().push(line);
-            }
-        });
-        Server { child, addr, log }
-    }
-
-    fn connect(&self) -> TcpStream {
-        let s = TcpStream::connect(&self.addr).unwrap();
-        s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-        s
-    }
-
-    /// Waits up to 5 s for a stderr line containing every piece.
-    fn logged(&self, pieces: &[&str]) -> Option<String> {
-        let deadline = Instant::now() + Duration::from_secs(5);
-        loop {
-            if let Some(l) = self.log.lock().unwrap().iter().find(|l| pieces.iter().all(|p| l.contains(p))) {
-                return Some(l.clone());
-            }
-            if Instant::now() > deadline {
-                return None;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// A served module keeping its EEPROM in `eeprom`, its stderr collected.
+fn start(eeprom: &Path) -> Server {
+    Server::start(&["--tcp", "127.0.0.1:0", "--eeprom", eeprom.to_str().unwrap()])
 }
 
 /// Runs `tmclsim serve` on `eeprom` expecting it to give up: its exit
@@ -91,7 +46,7 @@ fn refused(eeprom: &Path) -> (Option<i32>, String) {
 fn a_second_server_on_the_same_file_is_refused_naming_it() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.eeprom");
-    let first = Server::start(&path);
+    let first = start(&path);
     let mut s = first.connect();
     assert_eq!(ask(&mut s, "SAP 4, 0, 1500").unwrap().status, 100);
     assert_eq!(ask(&mut s, "STAP 4, 0").unwrap().status, 100);
@@ -116,7 +71,7 @@ fn a_second_server_on_the_same_file_is_refused_naming_it() {
     drop(first);
 
     // Once it is gone the file is free again, and through the link too.
-    let next = Server::start(&link);
+    let next = start(&link);
     let mut s = next.connect();
     assert_eq!(ask(&mut s, "GAP 4, 0").unwrap().value, 1500);
     assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
@@ -128,7 +83,7 @@ fn a_write_the_file_cannot_take_is_answered_with_status_5_and_serving_goes_on() 
     let store = dir.path().join("store");
     std::fs::create_dir(&store).unwrap();
     let path = store.join("m.eeprom");
-    let server = Server::start(&path);
+    let server = start(&path);
     let mut s = server.connect();
     assert_eq!(ask(&mut s, "SAP 4, 0, 1000").unwrap().status, 100);
     assert_eq!(ask(&mut s, "STAP 4, 0").unwrap().status, 100);

@@ -5,121 +5,28 @@
 
 mod common;
 
+use common::{Server, serve_command};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::{Arc, Mutex};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-struct Server {
-    child: Child,
-    /// What it printed up to "connect with:".
-    banner: Vec<String>,
-    log: Arc<Mutex<Vec<String>>>,
-}
-
-fn command(args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_tmclsim"));
-    c.arg("serve").args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
-    c
-}
-
-impl Server {
-    fn start(args: &[&str]) -> Server {
-        Server::spawn(command(args))
-    }
-
-    fn spawn(mut c: Command) -> Server {
-        let mut child = c.spawn().unwrap();
-        let log = Arc::new(Mutex::new(Vec::new()));
-        let (l, err) = (log.clone(), child.stderr.take().unwrap());
-        std::thread::spawn(move || {
-            for line in BufReader::new(err).lines().map_while(Result::ok) {
-                l.lock().unwrap().push(line);
-            }
-        });
-        let mut out = BufReader::new(child.stdout.take().unwrap());
-        let mut banner = Vec::new();
-        loop {
-            let mut line = String::new();
-            if out.read_line(&mut line).unwrap() == 0 {
-                let _ = child.wait();
-                panic!("the server ended before serving: {:?} {:?}", banner, log.lock().unwrap());
-            }
-            let done = line.starts_with("connect with:");
-            banner.push(line.trim().to_string());
-            if done {
-                break;
-            }
-        }
-        std::thread::spawn(move || {
-            let _ = out.read_to_end(&mut vec![]);
-        });
-        Server { child, banner, log }
-    }
-
-    /// The value printed after `KEY: ` (first word).
-    fn printed(&self, key: &str) -> String {
-        let prefix = format!("{key}: ");
-        let line = self.banner.iter().find_map(|l| l.strip_prefix(&prefix)).unwrap_or_else(|| panic!("no {key} in {:?}", self.banner));
-        line.split_whitespace().next().unwrap().to_string()
-    }
-
-    fn tcp(&self) -> String {
-        self.printed("tcp")
-    }
-
-    fn control(&self) -> String {
-        self.printed("control")
-    }
-
-    fn rss_kib(&self) -> u64 {
-        let s = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).unwrap();
-        s.lines().find(|l| l.starts_with("VmRSS:")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap()
-    }
-
-    /// CPU time (user + system) used so far.
-    fn cpu(&self) -> Duration {
-        let s = std::fs::read_to_string(format!("/proc/{}/stat", self.child.id())).unwrap();
-        let after = &s[s.rfind(')').unwrap() + 2..];
-        let f: Vec<u64> = after.split_whitespace().skip(11).take(2).map(|x| x.parse().unwrap()).collect();
-        // SAFETY: sysconf has no preconditions.
-        let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) } as u64;
-        Duration::from_millis((f[0] + f[1]) * 1000 / hz)
-    }
-
-    /// How many log lines contain `what`; waits up to 2 s for the first
-    /// one (the log arrives through a pipe, after the client's answer).
-    fn log_has(&self, what: &str) -> usize {
-        let count = || self.log.lock().unwrap().iter().filter(|l| l.contains(what)).count();
-        let until = std::time::Instant::now() + Duration::from_secs(2);
-        while count() == 0 && std::time::Instant::now() < until {
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        count()
-    }
-
-    fn check(&self) {
-        let mut s = TcpStream::connect(self.tcp()).unwrap();
-        s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-        let r = common::ask(&mut s, "GGP 66, 0").expect("a reply");
-        assert_eq!((r.status, r.value), (100, 1));
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// CPU time (user + system) a server used so far.
+fn cpu_time(server: &Server) -> Duration {
+    let s = std::fs::read_to_string(format!("/proc/{}/stat", server.child.id())).unwrap();
+    let after = &s[s.rfind(')').unwrap() + 2..];
+    let f: Vec<u64> = after.split_whitespace().skip(11).take(2).map(|x| x.parse().unwrap()).collect();
+    // SAFETY: sysconf has no preconditions.
+    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) } as u64;
+    Duration::from_millis((f[0] + f[1]) * 1000 / hz)
 }
 
 /// Runs a serve that should refuse to start: its exit success and stderr.
 /// A serve still running after 10 s is killed (`None`).
 fn refused(args: &[&str]) -> (Option<bool>, String) {
-    let mut child = command(args).stdout(Stdio::null()).spawn().unwrap();
+    let mut child = serve_command(args).stdout(Stdio::null()).spawn().unwrap();
     let mut err = child.stderr.take().unwrap();
     let reader = std::thread::spawn(move || {
         let mut s = String::new();
@@ -341,7 +248,7 @@ fn a_tcp_link_open_to_other_machines_is_warned_about() {
 
 #[test]
 fn out_of_file_descriptors_the_accept_loop_backs_off() {
-    let mut c = command(&["--tcp", "127.0.0.1:0", "--max-connections", "1000"]);
+    let mut c = serve_command(&["--tcp", "127.0.0.1:0", "--max-connections", "1000"]);
     // SAFETY: setrlimit is async-signal-safe; nothing else runs in the hook.
     unsafe {
         c.pre_exec(|| {
@@ -358,9 +265,9 @@ fn out_of_file_descriptors_the_accept_loop_backs_off() {
     // listen queue while every accept fails.
     let clients: Vec<TcpStream> = (0..60).map(|_| TcpStream::connect(server.tcp()).unwrap()).collect();
     std::thread::sleep(Duration::from_millis(300));
-    let (cpu, wall) = (server.cpu(), Instant::now());
+    let (cpu, wall) = (cpu_time(&server), Instant::now());
     std::thread::sleep(Duration::from_secs(1));
-    let used = server.cpu() - cpu;
+    let used = cpu_time(&server) - cpu;
     assert!(used < wall.elapsed() / 5, "the server waits instead of spinning: {used:?} of CPU in {:?}", wall.elapsed());
     assert_eq!(server.log_has("cannot accept a TCP connection on"), 1, "logged once: {:?}", server.log.lock().unwrap());
     drop(clients);

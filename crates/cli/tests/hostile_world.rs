@@ -5,70 +5,16 @@
 
 mod common;
 
+use common::{Server, serve_command};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Stdio;
+use std::time::Duration;
 use tmclsim_protocol::Reply;
 
-/// A `tmclsim serve` process with its TCP and control endpoints; dropped,
-/// it is killed and reaped.
-struct Server {
-    child: Child,
-    tcp: String,
-    control: String,
-}
-
-impl Server {
-    fn start(extra: &[&str], stderr: Stdio) -> Server {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-            .args(["serve", "--tcp", "127.0.0.1:0", "--control", "127.0.0.1:0"])
-            .args(extra)
-            .stdout(Stdio::piped())
-            .stderr(stderr)
-            .spawn()
-            .unwrap();
-        let mut out = BufReader::new(child.stdout.take().unwrap());
-        let (mut tcp, mut control) = (None, None);
-        loop {
-            let mut line = String::new();
-            assert!(out.read_line(&mut line).unwrap() > 0, "the server ended before serving");
-            let line = line.trim();
-            if let Some(a) = line.strip_prefix("tcp: ") {
-                tcp = Some(a.to_string());
-            }
-            if let Some(a) = line.strip_prefix("control: ") {
-                control = a.split_whitespace().next().map(str::to_string);
-            }
-            if line.starts_with("connect with:") {
-                break;
-            }
-        }
-        std::thread::spawn(move || {
-            let mut sink = vec![];
-            let _ = out.read_to_end(&mut sink);
-        });
-        Server { child, tcp: tcp.expect("a tcp endpoint"), control: control.expect("a control endpoint") }
-    }
-
-    /// Waits up to `limit` for the process to end; its exit code.
-    fn exit_code_within(&mut self, limit: Duration) -> Option<i32> {
-        let started = Instant::now();
-        while started.elapsed() < limit {
-            if let Some(status) = self.child.try_wait().unwrap() {
-                return status.code();
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        None
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// A server with TCP and control on free loopback ports.
+fn args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    [&["--tcp", "127.0.0.1:0", "--control", "127.0.0.1:0"][..], extra].concat()
 }
 
 fn ask(s: &mut TcpStream, line: &str) -> Reply {
@@ -80,8 +26,10 @@ fn ask(s: &mut TcpStream, line: &str) -> Reply {
 
 #[test]
 fn values_out_of_range_are_refused_and_the_module_keeps_serving() {
-    let server = Server::start(&[], Stdio::null());
-    let control = TcpStream::connect(&server.control).unwrap();
+    let mut command = serve_command(&args(&[]));
+    command.stderr(Stdio::null());
+    let server = Server::spawn(command);
+    let control = TcpStream::connect(server.control()).unwrap();
     control.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     let mut answers = BufReader::new(control.try_clone().unwrap());
     let mut say = |line: &str| -> String {
@@ -109,7 +57,7 @@ fn values_out_of_range_are_refused_and_the_module_keeps_serving() {
         assert!(answer.starts_with(expected), "{line}: {answer}");
     }
     // The module moves, in the world it had (the stage's end stops).
-    let mut link = TcpStream::connect(&server.tcp).unwrap();
+    let mut link = TcpStream::connect(server.tcp()).unwrap();
     link.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     assert_eq!(ask(&mut link, "ROR 0, 500").status, 100);
     std::thread::sleep(Duration::from_millis(300));
@@ -131,12 +79,13 @@ fn a_panic_ends_the_server_process() {
     // A panic is provoked without a bug: with stderr closed, the server's
     // log line for a refused connection (more than --max-connections)
     // cannot be written, and printing to stderr panics.
-    let mut server = Server::start(&["--max-connections", "1"], Stdio::piped());
-    drop(server.child.stderr.take());
-    let mut first = TcpStream::connect(&server.tcp).unwrap();
+    let mut child = serve_command(&args(&["--max-connections", "1"])).spawn().unwrap();
+    drop(child.stderr.take());
+    let mut server = Server::of(child);
+    let mut first = TcpStream::connect(server.tcp()).unwrap();
     first.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     assert_eq!(ask(&mut first, "GAP 4, 0").status, 100);
-    let _second = TcpStream::connect(&server.tcp).unwrap();
+    let _second = TcpStream::connect(server.tcp()).unwrap();
     // Without the panic hook the process would go on listening with its
     // TCP task gone; with it, it ends with the status of a panic.
     assert_eq!(server.exit_code_within(Duration::from_secs(10)), Some(101));

@@ -5,37 +5,183 @@
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
 
-/// Starts `tmclsim serve` with `args` (plus `--tcp 127.0.0.1:0`) and waits
-/// until it serves; returns the process and its TCP endpoint. Its stdout
-/// keeps being drained so it never blocks.
-pub fn serve(args: &[&str], stderr: Stdio) -> (Child, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .args(["serve", "--tcp", "127.0.0.1:0"])
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(stderr)
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut tcp = None;
+/// `tmclsim serve ARGS` with standard output and error piped.
+pub fn serve_command(args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tmclsim"));
+    c.arg("serve").args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
+    c
+}
+
+/// Reads what a starting server prints up to its `connect with:` line
+/// (`None` when it ends first), then keeps draining its standard output
+/// so that it never blocks.
+fn read_banner(child: &mut Child) -> Option<Vec<String>> {
+    let mut out = BufReader::new(child.stdout.take().expect("stdout piped"));
+    let mut banner = Vec::new();
     loop {
         let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "the server ended before serving");
-        if let Some(a) = line.trim().strip_prefix("tcp: ") {
-            tcp = Some(a.to_string());
+        if out.read_line(&mut line).unwrap() == 0 {
+            return None;
         }
-        if line.starts_with("connect with:") {
+        let done = line.starts_with("connect with:");
+        banner.push(line.trim().to_string());
+        if done {
             break;
         }
     }
     std::thread::spawn(move || {
-        let mut sink = vec![];
-        let _ = out.read_to_end(&mut sink);
+        let _ = out.read_to_end(&mut vec![]);
     });
-    (child, tcp.expect("the server printed its tcp endpoint"))
+    Some(banner)
+}
+
+/// The value a server printed after `KEY: ` (its first word).
+fn printed(banner: &[String], key: &str) -> String {
+    let prefix = format!("{key}: ");
+    let line = banner.iter().find_map(|l| l.strip_prefix(&prefix)).unwrap_or_else(|| panic!("no {key} in {banner:?}"));
+    line.split_whitespace().next().unwrap().to_string()
+}
+
+/// Starts `tmclsim serve` with `args` (plus `--tcp 127.0.0.1:0`) and waits
+/// until it serves; returns the process and its TCP endpoint.
+pub fn serve(args: &[&str], stderr: Stdio) -> (Child, String) {
+    let mut child = serve_command(&[&["--tcp", "127.0.0.1:0"][..], args].concat()).stderr(stderr).spawn().unwrap();
+    let banner = read_banner(&mut child).expect("the server ended before serving");
+    (child, printed(&banner, "tcp"))
+}
+
+/// A `tmclsim serve` process of a test: what it printed up to `connect
+/// with:` and its standard error, line by line as it comes. Dropped, it is
+/// killed and reaped.
+pub struct Server {
+    pub child: Child,
+    pub banner: Vec<String>,
+    pub log: Arc<Mutex<Vec<String>>>,
+}
+
+impl Server {
+    /// `tmclsim serve ARGS`, once it serves.
+    pub fn start(args: &[&str]) -> Server {
+        Server::spawn(serve_command(args))
+    }
+
+    pub fn spawn(mut command: Command) -> Server {
+        Server::of(command.spawn().unwrap())
+    }
+
+    /// A started server process (its standard output piped; its standard
+    /// error, if piped, becomes the log).
+    pub fn of(mut child: Child) -> Server {
+        let log = Arc::new(Mutex::new(Vec::new()));
+        if let Some(err) = child.stderr.take() {
+            let l = log.clone();
+            std::thread::spawn(move || {
+                for line in BufReader::new(err).lines().map_while(Result::ok) {
+                    l.lock().unwrap().push(line);
+                }
+            });
+        }
+        let Some(banner) = read_banner(&mut child) else {
+            let _ = child.wait();
+            std::thread::sleep(Duration::from_millis(100));
+            panic!("the server ended before serving: {:?}", log.lock().unwrap());
+        };
+        Server { child, banner, log }
+    }
+
+    /// The value printed after `KEY: ` (first word).
+    pub fn printed(&self, key: &str) -> String {
+        printed(&self.banner, key)
+    }
+
+    pub fn tcp(&self) -> String {
+        self.printed("tcp")
+    }
+
+    pub fn control(&self) -> String {
+        self.printed("control")
+    }
+
+    /// A connection to the TCP endpoint, with a 5 s read timeout.
+    pub fn connect(&self) -> TcpStream {
+        let s = TcpStream::connect(self.tcp()).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        s
+    }
+
+    /// The module still answers correctly: SAP, GAP and GGP over a new
+    /// connection.
+    pub fn check(&self) {
+        let mut s = self.connect();
+        for (line, expect) in [("SAP 4, 0, 1234", 1234), ("GAP 4, 0", 1234), ("GGP 66, 0", 1)] {
+            let r = ask(&mut s, line).unwrap_or_else(|| panic!("{line}: no reply"));
+            assert_eq!((r.status, r.value), (100, expect), "{line}");
+        }
+    }
+
+    /// Resident memory in KiB.
+    pub fn rss_kib(&self) -> u64 {
+        let s = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).unwrap();
+        s.lines().find(|l| l.starts_with("VmRSS:")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap()
+    }
+
+    /// The first log line holding every piece, waiting up to 5 s for it
+    /// (the log arrives through a pipe, after a client's answer).
+    pub fn logged(&self, pieces: &[&str]) -> Option<String> {
+        let deadline = Instant::now() + Duration::from_secs(5);
+        loop {
+            if let Some(l) = self.log.lock().unwrap().iter().find(|l| pieces.iter().all(|p| l.contains(p))) {
+                return Some(l.clone());
+            }
+            if Instant::now() > deadline {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// How many log lines contain `what`, waiting up to 2 s for the first.
+    pub fn log_has(&self, what: &str) -> usize {
+        let count = || self.log.lock().unwrap().iter().filter(|l| l.contains(what)).count();
+        let until = Instant::now() + Duration::from_secs(2);
+        while count() == 0 && Instant::now() < until {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        count()
+    }
+
+    /// Waits up to `limit` for the process to end; its exit code.
+    pub fn exit_code_within(&mut self, limit: Duration) -> Option<i32> {
+        let started = Instant::now();
+        while started.elapsed() < limit {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                return status.code();
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        None
+    }
+
+    /// Stops the server as Ctrl-C would (SIGTERM) and waits for it.
+    pub fn stop(mut self) {
+        // SAFETY: signalling the child this test started.
+        unsafe {
+            libc::kill(self.child.id() as i32, libc::SIGTERM);
+        }
+        let _ = self.child.wait();
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
 }
 
 /// The request frame of a command (mnemonic or `#op type motor value`) to
