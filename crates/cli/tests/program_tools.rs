@@ -131,18 +131,23 @@ fn run_plots_svg_with_labelled_axes_and_samples_at_a_fixed_step() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
-#[test]
-fn continue_at_a_breakpoint_runs_to_the_next_hit() {
+/// Runs the manual's DJNZ loop with a breakpoint at Loop, typing `input`
+/// into the debugger; what it printed.
+fn debug_djnz_loop(input: &[u8]) -> String {
+    use std::io::Write;
     let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
         .args(["run", example("djnz_3_7_43.tmc").to_str().unwrap(), "--for", "60s", "--break", "Loop"])
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
-    use std::io::Write;
-    child.stdin.as_mut().unwrap().write_all(b"c\nc\nc\nq\n").unwrap();
-    let out = child.wait_with_output().unwrap();
-    let t = String::from_utf8_lossy(&out.stdout);
+    child.stdin.as_mut().unwrap().write_all(input).unwrap();
+    String::from_utf8_lossy(&child.wait_with_output().unwrap().stdout).into_owned()
+}
+
+#[test]
+fn continue_at_a_breakpoint_runs_to_the_next_hit() {
+    let t = debug_djnz_loop(b"c\nc\nc\nq\n");
     // Each pass of the loop (a move and a 5 s WAIT) hits Loop once more.
     let times: Vec<f64> =
         t.split("[").skip(1).filter(|p| p.contains("] 1: MVP REL")).map(|p| p.split(" s]").next().unwrap().parse().unwrap()).collect();
@@ -153,16 +158,7 @@ fn continue_at_a_breakpoint_runs_to_the_next_hit() {
 
 #[test]
 fn run_with_breakpoint_and_scripted_debugger() {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .args(["run", example("djnz_3_7_43.tmc").to_str().unwrap(), "--for", "60s", "--break", "Loop"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write;
-    child.stdin.as_mut().unwrap().write_all(b"i\ns\ns\ni\nq\n").unwrap();
-    let out = child.wait_with_output().unwrap();
-    let t = String::from_utf8_lossy(&out.stdout);
+    let t = debug_djnz_loop(b"i\ns\ns\ni\nq\n");
     assert!(t.contains("breakpoint at 1"), "{t}");
     assert!(t.contains("1: MVP REL, 0, 51200"), "{t}");
     assert!(t.contains("user variables 42=100"), "{t}");
