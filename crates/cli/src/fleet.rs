@@ -144,7 +144,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
                     pr
                 }
             };
-            let world = crate::load_world(&l.world, profile.module.axes as usize)?;
+            let world = tmclsim_firmware::World::named(&l.world, profile.module.axes as usize)?;
             let mut m = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), world);
             m.set_address(*a);
             modules.push((m, None));

@@ -80,6 +80,9 @@ impl World {
             "stage" => Ok(World::stage(axes)),
             "free" => Ok(World::free(axes)),
             text if text.contains('\n') => World::from_toml(text, axes),
+            path if !std::path::Path::new(path).exists() => {
+                Err(format!("{path}: no such world file; the built-in worlds are stage (the default) and free"))
+            }
             path => World::load_file(std::path::Path::new(path), axes),
         }
     }
