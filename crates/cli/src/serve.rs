@@ -251,22 +251,16 @@ pub(crate) fn wait_for_signal() {
 
 /// `--endpoints FILE`: where the server listens, as TOML, for scripts.
 fn write_endpoints(path: &std::path::Path, ep: &tmclsim_server::Endpoints, token: Option<&str>) -> Result<(), String> {
-    let quoted = |s: &str| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""));
-    let mut text = String::new();
-    if let Some(a) = ep.tcp {
-        text.push_str(&format!("tcp = {}\n", quoted(&a.to_string())));
-    }
-    if let Some((link, _)) = &ep.pty {
-        text.push_str(&format!("pty = {}\n", quoted(&link.display().to_string())));
-    }
-    if let Some((link, _)) = &ep.slcan {
-        text.push_str(&format!("slcan = {}\n", quoted(&link.display().to_string())));
-    }
-    if let Some(a) = ep.control {
-        text.push_str(&format!("control = {}\n", quoted(&a.to_string())));
-    }
-    if let Some(t) = token {
-        text.push_str(&format!("control_token = {}\n", quoted(t)));
-    }
-    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+    let mut table = toml::Table::new();
+    let mut put = |key: &str, value: Option<String>| {
+        if let Some(v) = value {
+            table.insert(key.into(), v.into());
+        }
+    };
+    put("tcp", ep.tcp.map(|a| a.to_string()));
+    put("pty", ep.pty.as_ref().map(|(link, _)| link.display().to_string()));
+    put("slcan", ep.slcan.as_ref().map(|(link, _)| link.display().to_string()));
+    put("control", ep.control.map(|a| a.to_string()));
+    put("control_token", token.map(str::to_string));
+    std::fs::write(path, table.to_string()).map_err(|e| format!("{}: {e}", path.display()))
 }
