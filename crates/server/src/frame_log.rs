@@ -16,8 +16,9 @@ pub(crate) enum Direction {
     Out,
 }
 
-/// The server's start, for timestamps.
-fn started() -> Instant {
+/// The server's start, for timestamps (taken when the first server that
+/// logs frames starts).
+pub(crate) fn started() -> Instant {
     static START: OnceLock<Instant> = OnceLock::new();
     *START.get_or_init(Instant::now)
 }

@@ -320,6 +320,9 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
     for (_, config) in &specs {
         check(config)?;
     }
+    if specs.iter().any(|(_, c)| c.log_frames) {
+        frame_log::started();
+    }
     let warn = specs.iter().any(|(_, c)| c.warn_exposure);
     let shared: Vec<Arc<SharedBus>> = specs.iter().map(|(m, _)| m.clone()).collect();
     let (stop_tx, stop_rx) = watch::channel(false);
