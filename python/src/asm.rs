@@ -76,7 +76,7 @@ impl Program {
             Some(seq) => instructions_from(seq)?,
             None => Vec::new(),
         };
-        Ok(Program { inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new() } })
+        Ok(Program { inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new(), ..Default::default() } })
     }
 
     /// from_binary(data: bytes, symbols=None) -> Program
@@ -88,7 +88,7 @@ impl Program {
     #[pyo3(signature = (data, symbols=None))]
     fn from_binary(data: Vec<u8>, symbols: Option<&Bound<'_, PyAny>>) -> PyResult<Program> {
         let instructions = AsmProgram::from_binary(&data).map_err(|e| value_error(format!("binary image: {e}")))?;
-        Ok(Program { inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new() } })
+        Ok(Program { inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new(), ..Default::default() } })
     }
 
     /// The instructions, one per program memory word.
@@ -107,6 +107,13 @@ impl Program {
     #[getter]
     fn constants(&self) -> BTreeMap<String, i64> {
         self.inner.constants.clone()
+    }
+
+    /// The source of every instruction, same index as `instructions`:
+    /// (file, line, column, text); empty for a program not assembled here.
+    #[getter]
+    fn source_map(&self) -> Vec<(String, u32, u32, String)> {
+        self.inner.source_map.iter().map(|s| (s.file.clone(), s.line, s.column, s.text.clone())).collect()
     }
 
     /// to_binary() -> bytes

@@ -190,6 +190,9 @@ def test_includes(tmp_path):
     program = tmclsim.assemble_file(main, include_path=[tmp_path / "lib"])
     assert program.instructions == [Instruction.parse("SAP 4, 0, 2000")]
     assert program.constants["FAST"] == 2000
+    # The source map names the line each instruction comes from.
+    assert program.source_map == [(str(main), 2, 5, "SAP 4, 0, FAST")]
+    assert tmclsim.Program.from_binary(program.to_binary()).source_map == []
 
 
 def test_instructions():

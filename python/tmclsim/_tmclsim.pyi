@@ -118,6 +118,9 @@ class Program:
         """Labels: name → address."""
     @property
     def constants(self) -> Dict[str, int]: ...
+    @property
+    def source_map(self) -> List[Tuple[str, int, int, str]]:
+        """(file, line, column, text) of every instruction; empty when not assembled from source."""
     def to_binary(self) -> bytes:
         """The binary image: 8 bytes per instruction."""
     def symbol_file(self) -> str:

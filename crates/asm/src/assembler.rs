@@ -16,6 +16,7 @@ use crate::include::{IncludeResolver, built_in};
 use crate::lexer::strip_comments;
 use crate::limits::{MAX_LINE_BYTES, MAX_STATEMENTS, MAX_TOTAL_SOURCE_BYTES};
 use crate::parser::{Body, parse_line};
+use crate::source_map::SourceLine;
 
 /// How deeply includes may nest (a cycle is reported before this).
 const MAX_INCLUDE_DEPTH: usize = 64;
@@ -25,6 +26,8 @@ struct Statement {
     loc: Loc,
     labels: Vec<(String, usize)>,
     body: Body,
+    /// The line without its comment, for the source map.
+    text: String,
 }
 
 /// Reads a file and, recursively, the files it includes.
@@ -88,7 +91,7 @@ impl Loader<'_> {
                 self.full = true;
                 break;
             }
-            self.statements.push(Statement { loc, labels: parsed.labels, body: parsed.body });
+            self.statements.push(Statement { loc, labels: parsed.labels, body: parsed.body, text: line.trim().to_string() });
             if let Some((wanted, column)) = include {
                 self.include(name, &wanted, loc, column);
             }
@@ -182,6 +185,7 @@ pub fn assemble(
     // Pass 2: values of constants, then the instructions.
     evaluator.evaluate_constants(&mut reporter);
     let mut instructions = Vec::new();
+    let mut source_map = Vec::new();
     for st in &statements {
         let word = match &st.body {
             Body::Instruction { mnemonic, column, operands, end_column } => {
@@ -219,12 +223,18 @@ pub fn assemble(
             }
         }
         instructions.push(word);
+        source_map.push(SourceLine {
+            file: reporter.files.get(st.loc.file).cloned().unwrap_or_default(),
+            line: st.loc.line as u32,
+            column: first_column(&st.body) as u32,
+            text: st.text.clone(),
+        });
     }
 
     if !reporter.is_empty() {
         return Err(reporter.finish());
     }
-    Ok(Program { instructions, symbols: evaluator.label_addresses(), constants: evaluator.constant_values() })
+    Ok(Program { instructions, symbols: evaluator.label_addresses(), constants: evaluator.constant_values(), source_map })
 }
 
 fn first_column(body: &Body) -> usize {

@@ -19,6 +19,7 @@
 //! - `check.rs`: checks against a module profile;
 //! - `assembler.rs`: the passes that tie these together;
 //! - `binary.rs`, `symbol_file.rs`: output formats;
+//! - `source_map.rs`: the source line of every instruction;
 //! - `disasm.rs`: the disassembler;
 //! - `diagnostic.rs`: error messages with file, line and column;
 //! - `limits.rs`: how much source is read and how many errors reported.
@@ -35,6 +36,7 @@ pub mod include;
 mod lexer;
 pub mod limits;
 mod parser;
+pub mod source_map;
 pub mod symbol_file;
 
 use std::collections::BTreeMap;
@@ -43,6 +45,7 @@ use std::path::Path;
 pub use assembler::assemble;
 pub use diagnostic::{Diagnostic, render};
 pub use disasm::disassemble;
+pub use source_map::{LinePlace, SourceLine};
 pub use include::{FileResolver, IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
 pub use tmclsim_profile::Profile;
 pub use tmclsim_protocol::Instruction;
@@ -56,6 +59,9 @@ pub struct Program {
     pub symbols: BTreeMap<String, u32>,
     /// Constant → value (those of included files too).
     pub constants: BTreeMap<String, i64>,
+    /// The source of every instruction, same index as `instructions`;
+    /// empty for a program read from a binary.
+    pub source_map: Vec<SourceLine>,
 }
 
 impl Program {
@@ -69,9 +75,15 @@ impl Program {
         binary::decode(bytes)
     }
 
-    /// The symbol file: `label address` per line, sorted by address.
+    /// The symbol file: `label address` per line, sorted by address, then
+    /// the source map.
     pub fn symbol_file(&self) -> String {
-        symbol_file::write(&self.symbols)
+        symbol_file::write(&self.symbols, &self.source_map)
+    }
+
+    /// The source line of the instruction at `address`, if known.
+    pub fn source_of(&self, address: u32) -> Option<&SourceLine> {
+        self.source_map.get(address as usize)
     }
 
     /// Reads a symbol file written by [`Program::symbol_file`].

@@ -44,7 +44,15 @@ fn first_steps_program_binary_checked_by_hand() {
     // JA Loop, Loop = 8: 16+08 = 1E.
     assert_eq!(words[12], [0x16, 0x00, 0x00, 0x00, 0x00, 0x00, 0x08, 0x1E]);
     assert_eq!(program.symbols["Loop"], 8);
-    assert_eq!(program.symbol_file(), "Loop 8\n");
+    // The label, then the source map: "Loop:" stands alone on line 11, so
+    // address 8 is the MVP of line 12; the text loses its comment.
+    let symbols = program.symbol_file();
+    assert!(symbols.starts_with("Loop 8\n// source map"), "{symbols}");
+    let name = common::programs_dir().join("first_steps_2_4.tmc").display().to_string();
+    assert!(symbols.contains(&format!("\n@0\t{name}\t2\t1\tROL 0, 1000\n")), "{symbols}");
+    assert!(symbols.contains(&format!("\n@8\t{name}\t12\t1\tMVP ABS, 0, 512000\n")), "{symbols}");
+    assert_eq!(program.source_map.len(), program.instructions.len());
+    assert_eq!(program.source_of(12).map(|s| (s.line, s.text.as_str())), Some((16, "JA Loop")));
 }
 
 #[test]

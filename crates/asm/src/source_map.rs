@@ -1,0 +1,107 @@
+//! The source map: for every instruction of a program, the file, line and
+//! column it was assembled from and the text of that line. Debuggers show
+//! source lines with it and take breakpoints as `file:line`.
+
+use std::collections::BTreeMap;
+
+/// Where one instruction comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SourceLine {
+    /// The file as the assembler named it (the path given, or the name in
+    /// `#include`).
+    pub file: String,
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column of the mnemonic (characters).
+    pub column: u32,
+    /// The line as written, without its comment and surrounding blanks.
+    pub text: String,
+}
+
+/// A place asked for by a debugger: `file:line`, or `line` alone for the
+/// program's main file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LinePlace {
+    pub file: Option<String>,
+    pub line: u32,
+}
+
+impl LinePlace {
+    /// Reads `12`, `prog.tmc:12` or `dir/prog.tmc:12`; anything else is
+    /// not a line place.
+    pub fn parse(text: &str) -> Option<LinePlace> {
+        let (file, line) = match text.rsplit_once(':') {
+            Some((file, line)) if !file.is_empty() => (Some(file.to_string()), line),
+            Some(_) => return None,
+            None => (None, text),
+        };
+        let line: u32 = line.parse().ok().filter(|l| *l > 0)?;
+        Some(LinePlace { file, line })
+    }
+}
+
+/// The first instruction assembled from `place` or, when that line holds
+/// none, from the next line of the same file that does (as debuggers put a
+/// breakpoint on a comment or blank line). `None` when the file holds no
+/// instruction at or after that line, or no file of the map matches.
+///
+/// A file matches when it is the name in the map, or when the map's name
+/// ends with `/` + the name given. Without a file, the file of the first
+/// instruction (the main file) is meant.
+pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, String> {
+    let file = match &place.file {
+        Some(f) => {
+            let names: BTreeMap<&str, ()> = map.iter().map(|s| (s.file.as_str(), ())).collect();
+            let matching: Vec<&str> = names.keys().copied().filter(|n| *n == f || n.ends_with(&format!("/{f}"))).collect();
+            match matching.as_slice() {
+                [one] => one.to_string(),
+                [] => {
+                    let all: Vec<&str> = names.keys().copied().collect();
+                    return Err(format!("no instruction comes from a file '{f}' (the program's files: {})", all.join(", ")));
+                }
+                many => return Err(format!("'{f}' names several files: {}", many.join(", "))),
+            }
+        }
+        None => match map.first() {
+            Some(s) => s.file.clone(),
+            None => return Err("the program has no source map (it was not assembled from source)".into()),
+        },
+    };
+    map.iter()
+        .enumerate()
+        .filter(|(_, s)| s.file == file && s.line >= place.line)
+        .min_by_key(|(a, s)| (s.line, *a))
+        .map(|(a, _)| a as u32)
+        .ok_or_else(|| format!("{file}: no instruction at or after line {}", place.line))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(file: &str, line: u32) -> SourceLine {
+        SourceLine { file: file.into(), line, column: 1, text: String::new() }
+    }
+
+    #[test]
+    fn places_parse() {
+        assert_eq!(LinePlace::parse("12"), Some(LinePlace { file: None, line: 12 }));
+        assert_eq!(LinePlace::parse("a/b.tmc:3"), Some(LinePlace { file: Some("a/b.tmc".into()), line: 3 }));
+        for bad in ["", "0", ":3", "x.tmc:", "x.tmc:-1", "Loop"] {
+            assert_eq!(LinePlace::parse(bad), None, "{bad}");
+        }
+    }
+
+    #[test]
+    fn a_line_without_instruction_means_the_next_one() {
+        let map = [line("dir/main.tmc", 2), line("dir/main.tmc", 5), line("lib.tmc", 1), line("dir/main.tmc", 9)];
+        let at = |f: Option<&str>, l| address_of(&map, &LinePlace { file: f.map(str::to_string), line: l });
+        assert_eq!(at(None, 1), Ok(0));
+        assert_eq!(at(None, 3), Ok(1));
+        assert_eq!(at(Some("main.tmc"), 6), Ok(3));
+        assert_eq!(at(Some("lib.tmc"), 1), Ok(2));
+        assert!(at(None, 10).unwrap_err().contains("no instruction at or after line 10"));
+        assert!(at(Some("other.tmc"), 1).unwrap_err().contains("the program's files: dir/main.tmc, lib.tmc"));
+        assert!(address_of(&[], &LinePlace { file: None, line: 1 }).unwrap_err().contains("no source map"));
+    }
+}
