@@ -45,8 +45,8 @@ use std::path::Path;
 pub use assembler::assemble;
 pub use diagnostic::{Diagnostic, render};
 pub use disasm::disassemble;
-pub use source_map::{LinePlace, SourceLine};
 pub use include::{FileResolver, IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
+pub use source_map::{LinePlace, SourceLine};
 pub use tmclsim_profile::Profile;
 pub use tmclsim_protocol::Instruction;
 

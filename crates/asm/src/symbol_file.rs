@@ -12,11 +12,12 @@
 //! and `//` comments.
 //!
 //! A program assembled from source adds its source map after the labels,
-//! one line per instruction, fields separated by tabs:
+//! one line per instruction, its five fields separated by tabs (shown
+//! here as `→`):
 //!
 //! ```text
 //! // source map: @address, file, line, column, source text
-//! @0	shuttle.tmc	7	7	Loop: MVP ABS, 0, 51200
+//! @0→shuttle.tmc→7→7→Loop: MVP ABS, 0, 51200
 //! ```
 
 use std::collections::BTreeMap;

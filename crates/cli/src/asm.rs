@@ -16,7 +16,8 @@ pub struct AsmArgs {
     /// Check the program against this module's profile.
     #[arg(long, default_value = "tmcm-1141")]
     pub module: String,
-    /// Print a listing (address, bytes, source) instead of writing files.
+    /// Print a listing instead of writing files: address, bytes, source
+    /// line number and source text.
     #[arg(long)]
     pub list: bool,
 }
@@ -54,7 +55,15 @@ pub fn asm(args: AsmArgs) -> Result<ExitCode, String> {
                 println!("{label}:");
             }
             let b = ins.to_bytes();
-            println!("{a:5}  {}  {}", crate::client::hex(&b), tmclsim_protocol::mnemonic::format(*ins));
+            // The source line beside the bytes: its number, with the file
+            // named when it is an included one.
+            let main = program.source_map.first().map(|s| s.file.as_str());
+            let source = match program.source_of(a as u32) {
+                Some(s) if Some(s.file.as_str()) == main => format!("{:>5}  {}", s.line, s.text),
+                Some(s) => format!("{:>5}  {}  ({}:{})", s.line, s.text, s.file, s.line),
+                None => format!("       {}", tmclsim_protocol::mnemonic::format(*ins)),
+            };
+            println!("{a:5}  {}  {source}", crate::client::hex(&b));
         }
         return Ok(ExitCode::SUCCESS);
     }

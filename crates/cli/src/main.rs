@@ -9,6 +9,7 @@ use std::time::Duration;
 mod asm;
 mod bench;
 mod client;
+mod debugger;
 mod fleet;
 mod plot;
 mod progress;

@@ -2,7 +2,7 @@
 //! a trace, a plot, breakpoints and an interactive debugger.
 
 use crate::asm::assemble;
-use std::collections::BTreeMap;
+use crate::debugger::{Debug, Debugger};
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -45,8 +45,9 @@ pub struct RunArgs {
     /// The plot ends at this virtual time (default: the end of the run).
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
     pub to: Option<u64>,
-    /// Stop at a label or address and enter the debugger (repeatable).
-    #[arg(long = "break", value_name = "LABEL|ADDR")]
+    /// Stop at a label, an address or FILE:LINE and enter the debugger
+    /// (repeatable).
+    #[arg(long = "break", value_name = "LABEL|ADDR|FILE:LINE")]
     pub breakpoints: Vec<String>,
     /// Start in the interactive debugger (step, continue, inspect).
     #[arg(long)]
@@ -92,7 +93,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     module.load_program(&program.instructions).map_err(|s| format!("the program does not fit the module: {s}"))?;
     let mut breakpoints = Vec::new();
     for b in &args.breakpoints {
-        breakpoints.push(resolve(b, &program.symbols)?);
+        breakpoints.push(crate::debugger::resolve(b, &program).map_err(|e| format!("--break {e}"))?);
     }
     module.set_breakpoints(&breakpoints);
     let mut trace = match &args.trace {
@@ -136,6 +137,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         s.take(bus.module(0));
     }
     let mut debugging = args.debug;
+    let mut debugger = Debugger::default();
     let stdin = std::io::stdin();
     let mut lines = stdin.lock().lines();
     // A bar for long runs; none while a debugger may talk on the terminal.
@@ -149,10 +151,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         // program runs on past the breakpoint it stood on.
         let at_breakpoint = bus.module(0).program().hit_breakpoint.is_some() && bus.module(0).program().mode != RunMode::Run;
         if debugging || at_breakpoint {
-            if let Some(pc) = bus.module(0).program().hit_breakpoint {
-                println!("breakpoint at {pc}");
-            }
-            let answer = debugger(bus.module_mut(0), &program, &mut lines, end)?;
+            let answer = debugger.session(bus.module_mut(0), &program, &mut lines, end)?;
             // Steps moved the module; the bus follows.
             bus.advance_to(bus.module(0).now_ns());
             match answer {
@@ -184,7 +183,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         w.flush().map_err(|e| e.to_string())?;
     }
     let wall = started.elapsed();
-    summary(module, &program.symbols, wall);
+    summary(module, &program, wall);
     if let (Some(path), Some(s)) = (&args.samples, &samples) {
         s.write_csv(path)?;
         println!("samples: {} ({} rows)", path.display(), s.len());
@@ -195,15 +194,6 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         println!("plot: {}", path.display());
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn resolve(at: &str, symbols: &BTreeMap<String, u32>) -> Result<u16, String> {
-    if let Some(a) = symbols.get(at) {
-        return Ok(*a as u16);
-    }
-    mnemonic::parse_number(at)
-        .and_then(|n| u16::try_from(n).ok())
-        .ok_or_else(|| format!("'{at}' is neither a label of the program nor an address"))
 }
 
 fn write_trace(w: &mut impl Write, module: &mut Module) -> Result<(), String> {
@@ -225,7 +215,7 @@ fn write_trace(w: &mut impl Write, module: &mut Module) -> Result<(), String> {
     Ok(())
 }
 
-fn summary(m: &Module, symbols: &BTreeMap<String, u32>, wall: std::time::Duration) {
+fn summary(m: &Module, program: &tmclsim_asm::Program, wall: std::time::Duration) {
     let p = m.program();
     let t = m.now_ns() as f64 * 1e-9;
     println!(
@@ -235,12 +225,12 @@ fn summary(m: &Module, symbols: &BTreeMap<String, u32>, wall: std::time::Duratio
         t / wall.as_secs_f64().max(1e-9),
         p.executed
     );
-    let label = symbols.iter().find(|(_, a)| **a == p.pc as u32).map(|(l, _)| format!(" ({l})")).unwrap_or_default();
-    println!("program: {:?} at {}{label}{}", p.mode, p.pc, if p.wait.is_some() { ", waiting" } else { "" });
+    let at = crate::debugger::place(program, p.pc);
+    println!("program: {:?} at {at}{}", p.mode, if p.wait.is_some() { ", waiting" } else { "" });
     inspect(m);
 }
 
-fn inspect(m: &Module) {
+pub fn inspect(m: &Module) {
     let r = m.registers();
     let p = m.program();
     println!("  accumulator {}  X {}  compare {:?}  error flags {:#04x}", r.accumulator, r.x, r.compare, r.errors);
@@ -265,75 +255,6 @@ fn inspect(m: &Module) {
     if !vars.is_empty() {
         println!("  user variables {}", vars.join(" "));
     }
-}
-
-enum Debug {
-    Continue,
-    Quit,
-}
-
-/// The interactive debugger: one command per line.
-fn debugger(
-    m: &mut Module,
-    program: &tmclsim_asm::Program,
-    lines: &mut impl Iterator<Item = std::io::Result<String>>,
-    end: u64,
-) -> Result<Debug, String> {
-    m.pause_program();
-    println!("debugger: s[tep] [N], c[ontinue], i[nspect], l[ist], b[reak] LABEL|ADDR, d[elete] LABEL|ADDR, q[uit]");
-    loop {
-        let pc = m.program().pc;
-        let here = program.instructions.get(pc as usize).map_or("(end of program)".into(), |i| mnemonic::format(*i));
-        let waiting = if m.program().wait.is_some() { " (waiting)" } else { "" };
-        print!("[{:.3} s] {pc}: {here}{waiting} > ", m.now_ns() as f64 * 1e-9);
-        std::io::stdout().flush().ok();
-        let Some(line) = lines.next() else { return Ok(Debug::Quit) };
-        let line = line.map_err(|e| e.to_string())?;
-        let mut words = line.split_whitespace();
-        match words.next().unwrap_or("") {
-            "s" | "step" => {
-                let n: u64 = words.next().and_then(|w| w.parse().ok()).unwrap_or(1);
-                for _ in 0..n {
-                    step_one(m, end);
-                }
-            }
-            "c" | "continue" => {
-                m.start_program();
-                return Ok(Debug::Continue);
-            }
-            "i" | "inspect" => inspect(m),
-            "l" | "list" => {
-                let from = pc.saturating_sub(3) as usize;
-                for a in from..(from + 8).min(program.instructions.len()) {
-                    let mark = if a == pc as usize { "=>" } else { "  " };
-                    println!("{mark} {a:5}  {}", mnemonic::format(program.instructions[a]));
-                }
-            }
-            cmd @ ("b" | "break" | "d" | "delete") => match words.next().map(|w| resolve(w, &program.symbols)) {
-                Some(Ok(a)) => {
-                    let mut bps = m.program().breakpoints.clone();
-                    bps.retain(|b| *b != a);
-                    if cmd.starts_with('b') {
-                        bps.push(a);
-                    }
-                    m.set_breakpoints(&bps);
-                    println!("breakpoints: {bps:?}");
-                }
-                Some(Err(e)) => println!("{e}"),
-                None => println!("breakpoints: {:?}", m.program().breakpoints),
-            },
-            "q" | "quit" => return Ok(Debug::Quit),
-            "" => {}
-            other => println!("unknown command '{other}'"),
-        }
-    }
-}
-
-fn step_one(m: &mut Module, end: u64) {
-    let bps = m.program().breakpoints.clone();
-    m.set_breakpoints(&[]);
-    m.step_instruction(end, 10_000_000);
-    m.set_breakpoints(&bps);
 }
 
 #[cfg(test)]

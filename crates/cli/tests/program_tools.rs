@@ -134,9 +134,16 @@ fn run_plots_svg_with_labelled_axes_and_samples_at_a_fixed_step() {
 /// Runs the manual's DJNZ loop with a breakpoint at Loop, typing `input`
 /// into the debugger; what it printed.
 fn debug_djnz_loop(input: &[u8]) -> String {
+    debug(&example("djnz_3_7_43.tmc"), &["--break", "Loop"], input)
+}
+
+/// Runs a program for 60 s with more `run` options, typing `input` into
+/// the debugger; what it printed.
+fn debug(program: &Path, options: &[&str], input: &[u8]) -> String {
     use std::io::Write;
     let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .args(["run", example("djnz_3_7_43.tmc").to_str().unwrap(), "--for", "60s", "--break", "Loop"])
+        .args(["run", program.to_str().unwrap(), "--for", "60s"])
+        .args(options)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .spawn()
@@ -149,18 +156,80 @@ fn debug_djnz_loop(input: &[u8]) -> String {
 fn continue_at_a_breakpoint_runs_to_the_next_hit() {
     let t = debug_djnz_loop(b"c\nc\nc\nq\n");
     // Each pass of the loop (a move and a 5 s WAIT) hits Loop once more.
-    let times: Vec<f64> =
-        t.split("[").skip(1).filter(|p| p.contains("] 1: MVP REL")).map(|p| p.split(" s]").next().unwrap().parse().unwrap()).collect();
+    let times: Vec<f64> = t
+        .split("\n[")
+        .skip(1)
+        .filter(|p| p.contains("djnz_3_7_43.tmc:6 (1, Loop)  MVP REL, 0, 51200 >"))
+        .map(|p| p.split(" s]").next().unwrap().parse().unwrap())
+        .collect();
     assert_eq!(times.len(), 4, "{t}");
     assert!(times.windows(2).all(|w| w[1] - w[0] > 5.0), "every continue runs one pass of the loop: {times:?}");
-    assert_eq!(t.matches("breakpoint at 1").count(), 4, "{t}");
+    let hits = t.split("breakpoint at ").skip(1).filter(|p| p.split('\n').next().unwrap().ends_with("djnz_3_7_43.tmc:6 (1, Loop)"));
+    assert_eq!(hits.count(), 4, "{t}");
+}
+
+#[test]
+fn the_debugger_speaks_in_source_lines_and_names() {
+    let djnz = example("djnz_3_7_43.tmc");
+    // A breakpoint on line 8 (WAIT TICKS); line 5 holds only the label
+    // Loop, so a breakpoint there stands on the MVP of line 6.
+    let t = debug(&djnz, &["--break", "djnz_3_7_43.tmc:8", "--break", "djnz_3_7_43.tmc:5"], b"b\nq\n");
+    assert!(t.contains("breakpoint at ") && t.contains("djnz_3_7_43.tmc:6 (1, Loop)  MVP REL, 0, 51200\n"), "{t}");
+    assert!(t.contains("djnz_3_7_43.tmc:8 (3)  WAIT TICKS, 0, 500\n"), "{t}");
+    // Watches report changes at every stop; prints name the parameter and
+    // its unit; advance runs virtual time and stops at a breakpoint.
+    let input = b"w var 42\nw AP actual position\np AP 4\np GP 0 2\np acc\nc\nd Loop\nadvance 2s\nq\n";
+    let t = debug(&djnz, &["--break", "Loop"], input);
+    assert!(t.contains("watch 1: user variable 42 = 100"), "{t}");
+    assert!(t.contains("watch 2: AP 1 (Actual position) motor 0 = 0 µsteps"), "{t}");
+    assert!(t.contains("AP 4 (Maximum positioning speed) motor 0 = "), "{t}");
+    assert!(t.contains("GP 0 (") && t.contains(") bank 2 = 0"), "{t}");
+    assert!(t.contains("> accumulator = 0"), "{t}");
+    assert!(t.contains("watch 1: user variable 42 100 → 99"), "{t}");
+    assert!(t.contains("watch 2: AP 1 (Actual position) motor 0 0 µsteps → 51200 µsteps"), "{t}");
+    let stops: Vec<f64> = t.split("\n[").skip(1).map(|p| p.split(" s]").next().unwrap().parse().unwrap()).collect();
+    let (&last, rest) = stops.split_last().unwrap();
+    assert!((last - rest.last().unwrap() - 2.0).abs() < 0.0015, "advance 2s: {stops:?}\n{t}");
+    // Nonsense gets an answer, not a step.
+    let t = debug(&djnz, &["--break", "Loop"], b"s -1\ns 0\ns x\nstp\np AP actul position\nb Lop\nb 99\nu 3\nh\nq\n");
+    for answer in [
+        "step takes a count of 1 or more instructions, not '-1'",
+        "step takes a count of 1 or more instructions, not '0'",
+        "step takes a count of 1 or more instructions, not 'x'",
+        "unknown command 'stp' (did you mean 'step'?)",
+        "no axis parameter 'actul position' (did you mean 'Actual position'?)",
+        "'Lop' is neither a label of the program, an address nor FILE:LINE (did you mean 'Loop'?)",
+        "address 99 is outside the program (0…4)",
+        "no watch 3",
+        "a[dvance] TIME",
+    ] {
+        assert!(t.contains(answer), "{answer}\n{t}");
+    }
+    assert_eq!(t.matches("djnz_3_7_43.tmc:6 (1, Loop)  MVP REL, 0, 51200 >").count(), 10, "nothing moved: {t}");
+    // next runs a whole subroutine: CALL at line 7, then line 8.
+    let call = example("call_3_7_44.tmc");
+    let t = debug(&call, &["--break", "call_3_7_44.tmc:7"], b"n\np stack\nq\n");
+    assert!(t.contains("call_3_7_44.tmc:7 (3)  CALL LT, RunLeft >"), "{t}");
+    assert!(t.contains("call_3_7_44.tmc:8 (4)  CALL ZE, MotorStop > stack = []"), "{t}");
+    // A line without instructions at the end of the file is refused.
+    let o = tmclsim(&["run", djnz.to_str().unwrap(), "--break", "djnz_3_7_43.tmc:40"]);
+    assert!(!o.status.success() && text(&o).contains("no instruction at or after line 40"), "{}", text(&o));
+}
+
+#[test]
+fn asm_list_shows_the_source_beside_the_bytes() {
+    let o = tmclsim(&["asm", "--list", example("djnz_3_7_43.tmc").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("Loop:\n    1  04 01 00 00 00 C8 00      6  MVP REL, 0, 51200\n"), "{t}");
+    assert!(t.contains("    4  31 2A 00 00 00 00 01      9  DJNZ 42, Loop\n"), "{t}");
 }
 
 #[test]
 fn run_with_breakpoint_and_scripted_debugger() {
     let t = debug_djnz_loop(b"i\ns\ns\ni\nq\n");
-    assert!(t.contains("breakpoint at 1"), "{t}");
-    assert!(t.contains("1: MVP REL, 0, 51200"), "{t}");
+    assert!(t.contains("breakpoint at ") && t.contains("djnz_3_7_43.tmc:6 (1, Loop)\n"), "{t}");
+    assert!(t.contains("djnz_3_7_43.tmc:7 (2)  WAIT POS, 0, 0 >"), "{t}");
     assert!(t.contains("user variables 42=100"), "{t}");
 }
 
