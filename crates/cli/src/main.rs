@@ -9,6 +9,7 @@ use std::time::Duration;
 mod asm;
 mod bench;
 mod client;
+mod console;
 mod debugger;
 mod fleet;
 mod plot;
@@ -31,6 +32,8 @@ enum Command {
     Serve(ServeArgs),
     /// Send one command to a TMCL module (real or virtual) and print the reply.
     Send(SendArgs),
+    /// An interactive direct-mode console to any TMCL module: names, history, completion; scripts from stdin.
+    Console(console::ConsoleArgs),
     /// List a module profile: its features, then every parameter with access, range and default.
     Profile(ProfileArgs),
     /// Measure commands per second in-process and round trips over TCP and the pty.
@@ -191,6 +194,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Serve(a) => serve::run(a),
         Command::Send(a) => send::run(a),
+        Command::Console(a) => console::run(a),
         Command::Profile(a) => profile(&a.module),
         Command::Bench(a) => bench::run(a),
         Command::Asm(a) => asm::asm(a),
