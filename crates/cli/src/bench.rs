@@ -11,14 +11,49 @@ use tmclsim_protocol::mnemonic::parse_line;
 /// The command mix every measurement uses.
 const MIX: &[&str] = &["GAP 1, 0", "SAP 4, 0, 1500", "GGP 66, 0", "GIO 0, 0", "MVP ABS, 0, 5000", "GAP 8, 0"];
 
+/// Prints a table row above the stage bar (see `STAGES`).
+macro_rules! row {
+    ($($t:tt)*) => {
+        STAGES.with(|s| match &*s.borrow() {
+            Some(stages) => stages.println(&format!($($t)*)),
+            None => println!($($t)*),
+        })
+    };
+}
+
+thread_local! {
+    /// The benchmark's stages on the terminal, while it runs.
+    static STAGES: std::cell::RefCell<Option<crate::progress::Stages>> = const { std::cell::RefCell::new(None) };
+}
+
+/// The next stage of the benchmark begins.
+fn stage(what: &str) {
+    STAGES.with(|s| {
+        if let Some(stages) = &*s.borrow() {
+            stages.start(what)
+        }
+    });
+}
+
 pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
     let frames: Vec<[u8; 9]> = MIX.iter().map(|l| Request::new(1, parse_line(l).unwrap()).encode()).collect();
-    println!("tmclsim bench: command mix {MIX:?}, {} cores", std::thread::available_parallelism().map_or(1, |n| n.get()));
-    println!();
-    println!("| measurement | commands | result |");
-    println!("|---|---:|---|");
+    row!("tmclsim bench: command mix {MIX:?}, {} cores\n", std::thread::available_parallelism().map_or(1, |n| n.get()));
+    row!("| measurement | commands | result |");
+    row!("|---|---:|---|");
 
+    STAGES.with(|s| *s.borrow_mut() = Some(crate::progress::Stages::new(7)));
+    let result = measure(&args, &frames);
+    if let Some(stages) = STAGES.with(|s| s.borrow_mut().take()) {
+        stages.finish();
+    }
+    result?;
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// Every row of the table, stage by stage.
+fn measure(args: &crate::BenchArgs, frames: &[[u8; 9]]) -> Result<(), String> {
     // In-process, one core.
+    stage("in-process handle_frame");
     let mut m = Module::built_in("tmcm-1141")?;
     let n = args.in_process;
     let t = Instant::now();
@@ -30,14 +65,16 @@ pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
     }
     let dt = t.elapsed();
     std::hint::black_box(sink);
-    println!(
+    row!(
         "| in-process `handle_frame` | {n} | {:.1} M commands/s ({:.1} ns each) |",
         n as f64 / dt.as_secs_f64() / 1e6,
         dt.as_nanos() as f64 / n as f64
     );
 
+    stage("programs in virtual time");
     programs()?;
     served_programs(args.idle_seconds)?;
+    stage("round trips over TCP");
 
     // Over the links of a `tmclsim serve` process.
     let dir = std::env::temp_dir().join(format!("tmclsim-bench-{}", std::process::id()));
@@ -70,17 +107,18 @@ pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
     let result = (|| -> Result<(), String> {
         let mut s = std::net::TcpStream::connect(&tcp).map_err(|e| e.to_string())?;
         s.set_nodelay(true).ok();
-        report("TCP round trip, Rust client", &mut s, &frames, args.round_trips, Some(pid))?;
+        report("TCP round trip, Rust client", &mut s, frames, args.round_trips, Some(pid))?;
+        stage("round trips over the pty");
         let mut port = std::fs::OpenOptions::new().read(true).write(true).open(&pty).map_err(|e| e.to_string())?;
-        report("pty round trip, Rust client", &mut port, &frames, args.round_trips, Some(pid))?;
+        report("pty round trip, Rust client", &mut port, frames, args.round_trips, Some(pid))?;
         Ok(())
     })();
-    echo_baseline(&frames, args.round_trips)?;
+    stage("echo baseline");
+    echo_baseline(frames, args.round_trips)?;
     let _ = child.kill();
     let _ = child.wait();
     let _ = std::fs::remove_dir_all(&dir);
-    result?;
-    Ok(std::process::ExitCode::SUCCESS)
+    result
 }
 
 fn report(name: &str, link: &mut (impl Read + Write), frames: &[[u8; 9]], n: usize, pid: Option<u32>) -> Result<(), String> {
@@ -115,7 +153,7 @@ fn report(name: &str, link: &mut (impl Read + Write), frames: &[[u8; 9]], n: usi
     };
     samples.sort();
     let pct = |p: f64| samples[((samples.len() as f64 * p) as usize).min(samples.len() - 1)];
-    println!(
+    row!(
         "| {name} | {n} | p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs{cpu} |",
         us(pct(0.50)),
         us(pct(0.99)),
@@ -138,7 +176,7 @@ fn programs() -> Result<(), String> {
     m.advance(3_600_000_000_000);
     let wall = t.elapsed().as_secs_f64();
     let n = m.program().executed;
-    println!(
+    row!(
         "| VM, compute-only loop, 1 h of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
         n as f64 / wall / 1e6,
         3600.0 / wall
@@ -152,7 +190,7 @@ fn programs() -> Result<(), String> {
     m.advance(3_600_000_000_000);
     let wall = t.elapsed().as_secs_f64();
     let n = m.program().executed;
-    println!(
+    row!(
         "| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |",
         3600.0 / wall,
         wall * 1e3
@@ -168,7 +206,7 @@ fn programs() -> Result<(), String> {
     m.advance(600_000_000_000);
     let wall = t.elapsed().as_secs_f64();
     let n = m.program().executed;
-    println!(
+    row!(
         "| VM, polling motion loop (GAP 8/JC), 10 min of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
         n as f64 / wall / 1e6,
         600.0 / wall
@@ -182,7 +220,7 @@ fn programs() -> Result<(), String> {
     let t = Instant::now();
     let p = tmclsim_asm::assemble(&src, "bench.tmc", &tmclsim_asm::NoIncludes, None).map_err(|d| tmclsim_asm::render(&d))?;
     let wall = t.elapsed().as_secs_f64();
-    println!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), lines as f64 / wall / 1e6);
+    row!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), lines as f64 / wall / 1e6);
     Ok(())
 }
 
@@ -201,9 +239,11 @@ fn served_programs(seconds: f64) -> Result<(), String> {
     let waiting = asm("Loop:\n  WAIT TICKS, 0, 1000\n  JA Loop\n")?;
     let config =
         |port: u16| tmclsim_server::ServerConfig { tcp: Some(std::net::SocketAddr::from(([127, 0, 0, 1], port))), ..Default::default() };
+    stage("idle served module");
     let one = tmclsim_server::start(module(&waiting)?, config(0)).map_err(|e| e.to_string())?;
     idle_row("served module, program looping on `WAIT TICKS, 0, 1000`", 1, seconds, &one)?;
     one.stop();
+    stage("idle fleet of 1000 modules");
     let timer = asm(TIMER_INTERRUPT)?;
     let links = (0..1000)
         .map(|_| Ok(tmclsim_server::LinkSpec { modules: vec![(module(&timer)?, None)], config: config(0) }))
@@ -223,7 +263,7 @@ fn idle_row(name: &str, modules: usize, seconds: f64, server: &tmclsim_server::S
     std::thread::sleep(Duration::from_secs_f64(seconds));
     let wall = t.elapsed().as_secs_f64();
     let (cpu, wakeups) = (self_cpu() - cpu0, server.stats().wakeups - wake0);
-    println!(
+    row!(
         "| {name}, {seconds:.0} s idle | {modules} modules | {:.3} % of one core, {:.0} clock wake-ups/s |",
         cpu.as_secs_f64() / wall * 100.0,
         wakeups as f64 / wall

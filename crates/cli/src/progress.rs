@@ -40,3 +40,36 @@ impl Progress {
         }
     }
 }
+
+/// Work in named stages (the benchmark's rows): a bar of stages on
+/// standard error, redrawn only when a stage starts, so that it costs
+/// nothing while a stage measures; rows printed through it keep the bar
+/// below them.
+pub struct Stages {
+    bar: ProgressBar,
+}
+
+impl Stages {
+    pub fn new(total: u64) -> Stages {
+        let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template("{bar:20} stage {pos}/{len}: {msg}") {
+            bar.set_style(style);
+        }
+        Stages { bar }
+    }
+
+    /// The next stage begins.
+    pub fn start(&self, what: &str) {
+        self.bar.inc(1);
+        self.bar.set_message(what.to_string());
+    }
+
+    /// Prints a line of output above the bar.
+    pub fn println(&self, line: &str) {
+        self.bar.suspend(|| println!("{line}"));
+    }
+
+    pub fn finish(self) {
+        self.bar.finish_and_clear();
+    }
+}
