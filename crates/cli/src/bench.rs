@@ -153,12 +153,7 @@ fn report(name: &str, link: &mut (impl Read + Write), frames: &[[u8; 9]], n: usi
     };
     samples.sort();
     let pct = |p: f64| samples[((samples.len() as f64 * p) as usize).min(samples.len() - 1)];
-    row!(
-        "| {name} | {n} | p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs{cpu} |",
-        us(pct(0.50)),
-        us(pct(0.99)),
-        us(*samples.last().unwrap()),
-    );
+    row!("| {name} | {n} | p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs{cpu} |", us(pct(0.50)), us(pct(0.99)), us(*samples.last().unwrap()),);
     Ok(())
 }
 
@@ -190,11 +185,7 @@ fn programs() -> Result<(), String> {
     m.advance(3_600_000_000_000);
     let wall = t.elapsed().as_secs_f64();
     let n = m.program().executed;
-    row!(
-        "| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |",
-        3600.0 / wall,
-        wall * 1e3
-    );
+    row!("| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |", 3600.0 / wall, wall * 1e3);
     // A busy motion loop: GAP/COMP/JC polling while the motor moves.
     let polling = asm(
         "Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n",

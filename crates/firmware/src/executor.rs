@@ -42,6 +42,11 @@ impl Module {
                 if key != MAGIC_KEY {
                     return Outcome::error(Status::InvalidValue, key);
                 }
+                // A locked configuration EEPROM is not erased either
+                // (docs/behaviour.md rule 73).
+                if self.eeprom_locked() {
+                    return Outcome::error(Status::EepromLocked, key);
+                }
                 self.persistence.eeprom.clear();
                 self.persistence.mark_written();
                 self.reset();

@@ -74,6 +74,14 @@ fn eeprom_lock_is_the_feature_not_the_parameter() {
     assert_eq!(reply(&mut m, "STGP 0, 2").status, 5);
     assert_eq!(reply(&mut m, "SGP 77, 0, 1").status, 5, "bank 0 is stored on SGP");
     assert_eq!(reply(&mut m, "SGP 73, 0, 77").status, 4, "only 1234 and 4321");
+    // 137 would erase the EEPROM: refused, and the settings stay.
+    send(&mut m, "SGP 73, 0, 4321");
+    send(&mut m, "SAP 4, 0, 1500");
+    assert_eq!(reply(&mut m, "STAP 4, 0").status, 100);
+    send(&mut m, "SGP 73, 0, 1234");
+    assert_eq!(reply(&mut m, "#137 0 0 1234").status, 5);
+    assert_eq!(send(&mut m, "GAP 4, 0"), 1500);
+    assert_eq!(send(&mut m, "GGP 73, 0"), 1, "still locked");
     send(&mut m, "SGP 73, 0, 4321");
     assert_eq!(reply(&mut m, "STAP 4, 0").status, 100);
     // And the TMCM-351 without the feature cannot be locked any more.

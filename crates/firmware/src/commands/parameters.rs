@@ -199,9 +199,11 @@ impl Module {
             }
             (3, _) => {
                 self.globals[3][param as usize] = value;
-                // A new period restarts the timer.
-                if let Some(t) = self.program.timers.get_mut(param as usize) {
-                    *t = None;
+                // A new period restarts the timer whose interrupt this
+                // parameter configures (bank 3 is indexed by interrupt
+                // number, the timers by 0…2).
+                if let Some(t) = (0..3u8).find(|&t| self.profile.timer_interrupt(t) == Some(param)) {
+                    self.program.timers[t as usize] = None;
                 }
             }
             _ => self.globals[bank as usize][param as usize] = value,
