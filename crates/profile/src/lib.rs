@@ -284,6 +284,9 @@ pub const BUILT_IN: &[(&str, &str)] = &[
     ("tmcm-1141", include_str!("../../../profiles/tmcm-1141.toml")),
     ("tmcm-351", include_str!("../../../profiles/tmcm-351.toml")),
     ("tmcm-1310", include_str!("../../../profiles/tmcm-1310.toml")),
+    ("tmcm-1140", include_str!("../../../profiles/tmcm-1140.toml")),
+    ("tmcm-3110", include_str!("../../../profiles/tmcm-3110.toml")),
+    ("tmcm-6110", include_str!("../../../profiles/tmcm-6110.toml")),
 ];
 
 impl Profile {
