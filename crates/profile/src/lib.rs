@@ -566,7 +566,10 @@ mod tests {
         let row = "[[axis_parameter]]\nnumber = 250\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\n";
         let base = BUILT_IN[0].1;
         let unknown = Profile::from_toml(&format!("{base}\n{row}default_source = \"folklore\"\n")).unwrap_err();
-        assert!(unknown.contains("folklore") && unknown.contains("manual") && unknown.contains("sibling") && unknown.contains("assumed"), "{unknown}");
+        assert!(
+            unknown.contains("folklore") && unknown.contains("manual") && unknown.contains("sibling") && unknown.contains("assumed"),
+            "{unknown}"
+        );
         let bare = Profile::from_toml(&format!("{base}\n{row}default_source = \"sibling\"\n")).unwrap_err();
         assert!(bare.contains("parameter 250 (x)") && bare.contains("needs a note"), "{bare}");
         Profile::from_toml(&format!("{base}\n{row}default_source = \"sibling\"\nnote = \"TMCM-1140 manual\"\n")).unwrap();

@@ -54,7 +54,9 @@ fn every_axis_has_its_interrupts_and_trigger_rows_and_every_input_its_port() {
     for (name, axes, _, inputs, outputs) in SIBLINGS {
         let p = Profile::built_in(name).unwrap();
         for a in 0..axes {
-            for s in [InterruptSource::TargetReached(a), InterruptSource::Stall(a), InterruptSource::StopLeft(a), InterruptSource::StopRight(a)] {
+            for s in
+                [InterruptSource::TargetReached(a), InterruptSource::Stall(a), InterruptSource::StopLeft(a), InterruptSource::StopRight(a)]
+            {
                 assert!(p.interrupt_for(s).is_some(), "{name}: {s:?}");
             }
             assert!(p.global_parameter(3, 27 + 2 * a).is_some() && p.global_parameter(3, 28 + 2 * a).is_some(), "{name} axis {a}");
