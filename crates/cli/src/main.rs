@@ -223,21 +223,29 @@ fn profile(name: &str) -> Result<ExitCode, String> {
     for (key, value) in p.features.list() {
         println!("  {key:<28} {value}");
     }
-    println!("\nAxis parameters (* = default assumed, not stated by the manual)");
-    for q in p.axis_parameters() {
-        let mark = if q.default_source == tmclsim_firmware::profile::DefaultSource::Assumed { "*" } else { " " };
-        println!("  {:>3}  {:<4} {:>11}…{:<11} {:>11}{mark} {}", q.number, q.access.to_string(), q.min, q.max, q.default, q.name);
-    }
+    // The default's source: manual (this module's manual), sibling
+    // (another module or public Trinamic code, the note names it), assumed.
+    let row = |q: &tmclsim_firmware::profile::Parameter| {
+        println!(
+            "  {:>3}  {:<4} {:>11}…{:<11} {:>11} {:<7}  {}",
+            q.number,
+            q.access.to_string(),
+            q.min,
+            q.max,
+            q.default,
+            q.default_source.as_str(),
+            q.name
+        );
+    };
+    println!("\nAxis parameters (default from: manual = this module's manual, sibling = another module or Trinamic code, assumed)");
+    p.axis_parameters().for_each(row);
     for bank in 0..4u8 {
         let rows: Vec<_> = p.global_parameters(bank).collect();
         if rows.is_empty() {
             continue;
         }
         println!("\nGlobal parameters, bank {bank}");
-        for q in rows {
-            let mark = if q.default_source == tmclsim_firmware::profile::DefaultSource::Assumed { "*" } else { " " };
-            println!("  {:>3}  {:<4} {:>11}…{:<11} {:>11}{mark} {}", q.number, q.access.to_string(), q.min, q.max, q.default, q.name);
-        }
+        rows.into_iter().for_each(row);
     }
     Ok(ExitCode::SUCCESS)
 }

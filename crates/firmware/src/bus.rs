@@ -133,6 +133,26 @@ impl Bus {
         let now = self.now_ns();
         self.now_ns = now;
         let mut answer = Answer::default();
+        let wire_timing = self.wire_timing;
+        let reply = |answer: &mut Answer, m: &Module, r: [u8; FRAME_LEN]| {
+            answer.replies.push(r);
+            answer.delay_ns = answer.delay_ns.max(m.reply_delay_ns());
+            if wire_timing {
+                // Request and reply, 10 bits a byte.
+                answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / m.profile().baud_rate(m.baud_rate_code()) as u64;
+            }
+        };
+        if let [m] = self.modules.as_mut_slice() {
+            // A link with one module is point-to-point: it answers a
+            // resync frame (docs/behaviour.md rule 85).
+            if !m.answers_to(frame[0]) {
+                m.advance_to(now);
+                if let Some(r) = m.answer_resync(frame) {
+                    reply(&mut answer, m, r);
+                }
+                return answer;
+            }
+        }
         for m in &mut self.modules {
             // Only the addressed module does anything with a frame; the
             // others catch up when they are next looked at.
@@ -141,12 +161,7 @@ impl Bus {
             }
             m.advance_to(now);
             if let Some(r) = m.handle_frame(frame) {
-                answer.replies.push(r);
-                answer.delay_ns = answer.delay_ns.max(m.reply_delay_ns());
-                if self.wire_timing {
-                    // Request and reply, 10 bits a byte.
-                    answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / m.profile().baud_rate(m.baud_rate_code()) as u64;
-                }
+                reply(&mut answer, m, r);
             }
         }
         answer

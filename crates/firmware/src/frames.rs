@@ -47,6 +47,19 @@ impl Module {
         Some(reply)
     }
 
+    /// A resync frame on a point-to-point link (docs/behaviour.md rule 85):
+    /// address 0 and opcode 0 with a good checksum, as hosts send when they
+    /// open the port, are answered with status 2 (invalid command) from the
+    /// module's own address. Any other frame: `None` (not for this rule).
+    pub fn answer_resync(&mut self, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
+        let request = Request::decode(frame).ok()?;
+        if request.address != 0 || request.instruction.opcode != 0 || self.answers_to(0) || self.replies_suppressed(0) {
+            return None;
+        }
+        self.link.restart_heartbeat(self.now_ns);
+        Some(Reply::new(self.host_address(), self.address(), Status::InvalidCommand, 0, 0).encode())
+    }
+
     /// Does a frame with this address byte reach this module?
     pub fn answers_to(&self, address: u8) -> bool {
         address == self.address() || (self.secondary_address() != 0 && address == self.secondary_address())

@@ -56,12 +56,28 @@ impl std::fmt::Display for Access {
     }
 }
 
-/// Whether a default value comes from the manual or was chosen by us.
+/// Where a parameter's default value comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum DefaultSource {
+    /// The module's own manual states it.
     Manual,
+    /// Another module of the family or public Trinamic code for the same
+    /// chips gives it; the row's note names which.
+    Sibling,
+    /// No source gives it: chosen for the simulator.
     Assumed,
+}
+
+impl DefaultSource {
+    /// The word the profile files use (`manual`, `sibling`, `assumed`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DefaultSource::Manual => "manual",
+            DefaultSource::Sibling => "sibling",
+            DefaultSource::Assumed => "assumed",
+        }
+    }
 }
 
 /// One axis or global parameter (or a run of them, for user variables).
@@ -268,6 +284,9 @@ pub const BUILT_IN: &[(&str, &str)] = &[
     ("tmcm-1141", include_str!("../../../profiles/tmcm-1141.toml")),
     ("tmcm-351", include_str!("../../../profiles/tmcm-351.toml")),
     ("tmcm-1310", include_str!("../../../profiles/tmcm-1310.toml")),
+    ("tmcm-1140", include_str!("../../../profiles/tmcm-1140.toml")),
+    ("tmcm-3110", include_str!("../../../profiles/tmcm-3110.toml")),
+    ("tmcm-6110", include_str!("../../../profiles/tmcm-6110.toml")),
 ];
 
 impl Profile {
@@ -289,6 +308,12 @@ impl Profile {
             }
             if !row.ranges.is_empty() && !row.ranges.iter().any(|&[lo, hi]| (lo..=hi).contains(&row.default)) {
                 return Err(format!("parameter {} ({}): default {} outside its ranges", row.number, row.name, row.default));
+            }
+            if row.default_source == DefaultSource::Sibling && row.note.as_deref().is_none_or(|n| n.trim().is_empty()) {
+                return Err(format!(
+                    "parameter {} ({}): default_source \"sibling\" needs a note naming the module or code the default comes from",
+                    row.number, row.name
+                ));
             }
             let _ = &row.source;
             for n in row.number..=row.last.unwrap_or(row.number) {
@@ -529,6 +554,25 @@ mod tests {
             "{base}\n[[axis_parameter]]\nnumber = 4\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\ndefault_source = \"assumed\"\n"
         );
         assert!(Profile::from_toml(&dup).unwrap_err().contains("twice"));
+    }
+
+    #[test]
+    fn default_sources_are_manual_sibling_or_assumed() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        assert_eq!(p.axis_parameter(140).unwrap().default_source, DefaultSource::Manual);
+        // AP 4's default comes from TMC-API's TMC429 driver, not the manual.
+        assert_eq!(p.axis_parameter(4).unwrap().default_source, DefaultSource::Sibling);
+        assert_eq!(p.axis_parameter(0).unwrap().default_source, DefaultSource::Assumed);
+        let row = "[[axis_parameter]]\nnumber = 250\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\n";
+        let base = BUILT_IN[0].1;
+        let unknown = Profile::from_toml(&format!("{base}\n{row}default_source = \"folklore\"\n")).unwrap_err();
+        assert!(
+            unknown.contains("folklore") && unknown.contains("manual") && unknown.contains("sibling") && unknown.contains("assumed"),
+            "{unknown}"
+        );
+        let bare = Profile::from_toml(&format!("{base}\n{row}default_source = \"sibling\"\n")).unwrap_err();
+        assert!(bare.contains("parameter 250 (x)") && bare.contains("needs a note"), "{bare}");
+        Profile::from_toml(&format!("{base}\n{row}default_source = \"sibling\"\nnote = \"TMCM-1140 manual\"\n")).unwrap();
     }
 
     #[test]

@@ -112,7 +112,8 @@ impl Module {
                 let now = self.closed_loop_encoder(m) as f64 - self.axes[m].closed_loop.encoder_offset;
                 self.axes[m].closed_loop.encoder_offset = value as f64 - now;
             }
-            ap::ENCODER_POSITION => {
+            // Without an encoder input AP 209 is a plain value (profiles/README.md).
+            ap::ENCODER_POSITION if self.profile.features.encoder != tmclsim_profile::Encoder::None => {
                 let now = self.encoder_position(m) as i64 - self.axes[m].encoder_offset;
                 self.axes[m].encoder_offset = value as i64 - now;
             }
