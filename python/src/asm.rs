@@ -76,7 +76,9 @@ impl Program {
             Some(seq) => instructions_from(seq)?,
             None => Vec::new(),
         };
-        Ok(Program { inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new(), ..Default::default() } })
+        Ok(Program {
+            inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new(), ..Default::default() },
+        })
     }
 
     /// from_binary(data: bytes, symbols=None) -> Program
@@ -88,7 +90,9 @@ impl Program {
     #[pyo3(signature = (data, symbols=None))]
     fn from_binary(data: Vec<u8>, symbols: Option<&Bound<'_, PyAny>>) -> PyResult<Program> {
         let instructions = AsmProgram::from_binary(&data).map_err(|e| value_error(format!("binary image: {e}")))?;
-        Ok(Program { inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new(), ..Default::default() } })
+        Ok(Program {
+            inner: AsmProgram { instructions, symbols: symbols_from(symbols)?, constants: BTreeMap::new(), ..Default::default() },
+        })
     }
 
     /// The instructions, one per program memory word.
