@@ -1,26 +1,8 @@
-//! A host's link to any TMCL module: TCP (a tmclsim server or a
-//! serial-to-Ethernet bridge) or a serial port (a real module or a tmclsim
-//! pty).
+//! Where a module is, as the command line names it: `--tcp` or `--port`,
+//! and its address. The link itself is `tmclsim_host::Client`.
 
-use std::io::{Read, Write};
-use std::time::{Duration, Instant};
-use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Request};
-
-trait Stream: Read + Write {
-    fn set_deadline(&mut self, left: Duration) -> std::io::Result<()>;
-}
-
-impl Stream for std::net::TcpStream {
-    fn set_deadline(&mut self, left: Duration) -> std::io::Result<()> {
-        self.set_read_timeout(Some(left.max(Duration::from_millis(1))))
-    }
-}
-
-impl Stream for Box<dyn serialport::SerialPort> {
-    fn set_deadline(&mut self, left: Duration) -> std::io::Result<()> {
-        self.set_timeout(left.max(Duration::from_millis(1))).map_err(std::io::Error::other)
-    }
-}
+use std::time::Duration;
+pub use tmclsim_host::{Client, hex};
 
 /// Where a module is (a tmclsim server or a real module): TCP or a serial
 /// port, and its address.
@@ -44,76 +26,4 @@ impl LinkArgs {
     pub fn open(&self, timeout: Duration) -> Result<Client, String> {
         Client::open(self.tcp.as_deref(), self.port.as_deref(), self.baud, self.address, timeout)
     }
-}
-
-pub struct Client {
-    stream: Box<dyn Stream>,
-    pub address: u8,
-    pub timeout: Duration,
-}
-
-impl Client {
-    /// Connects by `--tcp HOST:PORT` or `--port DEV`.
-    pub fn open(tcp: Option<&str>, port: Option<&str>, baud: u32, address: u8, timeout: Duration) -> Result<Client, String> {
-        let stream: Box<dyn Stream> = match (tcp, port) {
-            (Some(addr), _) => {
-                let s = std::net::TcpStream::connect(addr).map_err(|e| format!("cannot connect to {addr}: {e}"))?;
-                s.set_nodelay(true).ok();
-                Box::new(s)
-            }
-            (None, Some(dev)) => {
-                Box::new(serialport::new(dev, baud).timeout(timeout).open().map_err(|e| format!("cannot open {dev}: {e}"))?)
-            }
-            _ => return Err("give --tcp HOST:PORT or --port DEVICE".into()),
-        };
-        Ok(Client { stream, address, timeout })
-    }
-
-    /// Sends one instruction and returns the raw reply frame.
-    pub fn exchange(&mut self, ins: Instruction) -> Result<[u8; FRAME_LEN], String> {
-        let frame = Request::new(self.address, ins).encode();
-        self.stream.write_all(&frame).map_err(|e| format!("write: {e}"))?;
-        self.read_frame()
-    }
-
-    /// Sends one instruction and returns the decoded reply.
-    pub fn request(&mut self, ins: Instruction) -> Result<Reply, String> {
-        let raw = self.exchange(ins)?;
-        Reply::decode(&raw).ok_or_else(|| format!("the reply {} has a wrong checksum", hex(&raw)))
-    }
-
-    /// Sends without waiting for a reply (137).
-    pub fn send_only(&mut self, ins: Instruction) -> Result<(), String> {
-        let frame = Request::new(self.address, ins).encode();
-        self.stream.write_all(&frame).map_err(|e| format!("write: {e}"))
-    }
-
-    fn read_frame(&mut self) -> Result<[u8; FRAME_LEN], String> {
-        let start = Instant::now();
-        let mut buf = [0u8; FRAME_LEN];
-        let mut got = 0;
-        while got < FRAME_LEN {
-            let left = self.timeout.checked_sub(start.elapsed()).ok_or_else(|| no_reply(got))?;
-            self.stream.set_deadline(left).map_err(|e| e.to_string())?;
-            match self.stream.read(&mut buf[got..]) {
-                Ok(0) => return Err("the link closed before the reply was complete".into()),
-                Ok(n) => got += n,
-                Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {}
-                Err(e) => return Err(format!("read: {e}")),
-            }
-        }
-        Ok(buf)
-    }
-}
-
-fn no_reply(got: usize) -> String {
-    if got == 0 {
-        "no reply within the timeout (wrong address, or replies suppressed by GP 255)".into()
-    } else {
-        format!("only {got} of 9 reply bytes arrived within the timeout")
-    }
-}
-
-pub fn hex(b: &[u8]) -> String {
-    b.iter().map(|x| format!("{x:02X}")).collect::<Vec<_>>().join(" ")
 }

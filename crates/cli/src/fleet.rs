@@ -163,6 +163,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     }
     let server = tmclsim_server::start_fleet(specs).map_err(|e| format!("cannot serve the fleet: {e}"))?;
     println!("tmclsim: fleet of {total} modules on {} links is serving", server.links().len());
+    let web = crate::serve::start_web(args, server.links())?;
     if let Some(first) = server.links().first()
         && let Some(a) = first.endpoints.pytrinamic_args()
     {
@@ -171,6 +172,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     use std::io::Write;
     let _ = std::io::stdout().flush();
     crate::serve::wait_for_signal();
+    drop(web);
     let s = server.stats();
     println!("stats: frames {}, missed real-time deadlines {}, max lateness {} µs", s.frames, s.missed_deadlines, s.max_lateness_ns / 1000);
     let _ = std::io::stdout().flush();

@@ -12,6 +12,7 @@ mod client;
 mod console;
 mod debugger;
 mod fleet;
+mod ide;
 mod plot;
 mod progress;
 mod run;
@@ -50,6 +51,8 @@ enum Command {
     World(WorldArgs),
     /// Serve a fleet from a second process, drive every module, report.
     FleetBench(fleet::FleetBenchArgs),
+    /// The browser IDE against modules on a TMCL link (real or virtual), polled as a host does.
+    Ide(ide::IdeArgs),
 }
 
 #[derive(Args)]
@@ -138,6 +141,12 @@ pub struct ServeArgs {
     /// then send `auth TOKEN` first (the token is printed at start).
     #[arg(long)]
     pub control_public: bool,
+    /// Also serve the browser IDE, on ADDR (default 127.0.0.1:8141).
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = tmclsim_web::DEFAULT_ADDR, value_parser = socket_address)]
+    pub web: Option<SocketAddr>,
+    /// Allow --web on a non-loopback address; every request then needs the token printed at start.
+    #[arg(long, requires = "web")]
+    pub web_public: bool,
 }
 
 #[derive(Args)]
@@ -181,7 +190,7 @@ fn main() -> ExitCode {
         std::process::exit(101);
     }));
     let cli = Cli::parse();
-    if !matches!(cli.command, Command::Serve(_) | Command::Bench(_) | Command::FleetBench(_)) {
+    if !matches!(cli.command, Command::Serve(_) | Command::Bench(_) | Command::FleetBench(_) | Command::Ide(_)) {
         // A command whose output goes to a reader that stops early
         // (`tmclsim profile | head`) ends quietly, as other tools do.
         // Servers keep ignoring the signal: their links report a closed
@@ -195,6 +204,7 @@ fn main() -> ExitCode {
         Command::Serve(a) => serve::run(a),
         Command::Send(a) => send::run(a),
         Command::Console(a) => console::run(a),
+        Command::Ide(a) => ide::run(a),
         Command::Profile(a) => profile(&a.module),
         Command::Bench(a) => bench::run(a),
         Command::Asm(a) => asm::asm(a),
@@ -257,7 +267,7 @@ pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::Wo
 
 /// `HOST:PORT` with a host name or an IP address (IPv4 first when a name
 /// has both).
-fn socket_address(text: &str) -> Result<SocketAddr, String> {
+pub(crate) fn socket_address(text: &str) -> Result<SocketAddr, String> {
     use std::net::ToSocketAddrs;
     if let Ok(a) = text.parse() {
         return Ok(a);

@@ -213,18 +213,29 @@ fn serve(
             "  a bus: each module answers its own address; PyTrinamic reaches module {a} with --module-id {a} in the ConnectionManager arguments, or module_id={a} in its module class"
         );
     }
+    let web = start_web(args, server.links())?;
     if let Some(a) = ep.pytrinamic_args() {
         println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
     wait_for_signal();
+    drop(web);
     if let Some(path) = &args.endpoints {
         let _ = std::fs::remove_file(path);
     }
     println!("tmclsim: stopping");
     server.stop();
     Ok(ExitCode::SUCCESS)
+}
+
+/// `--web`: the browser IDE over the served modules; prints its URL.
+pub(crate) fn start_web(args: &ServeArgs, links: &[tmclsim_server::LinkHandle]) -> Result<Option<tmclsim_web::WebHandle>, String> {
+    let Some(addr) = args.web else { return Ok(None) };
+    let target = Arc::new(tmclsim_web::VirtualTarget::new(links));
+    let web = crate::ide::start(target, addr, args.web_public)?;
+    println!("  web: {}  (the browser IDE)", web.url());
+    Ok(Some(web))
 }
 
 fn send_target(ep: &tmclsim_server::Endpoints) -> String {

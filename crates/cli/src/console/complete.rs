@@ -1,13 +1,13 @@
 //! Completion for the console's line editor: mnemonics first, then the
 //! symbols and parameter names the mnemonic takes.
 
-use super::names::{parameters, snake, table_of};
 use rustyline::completion::{Completer, Pair};
 use rustyline::highlight::Highlighter;
 use rustyline::hint::Hinter;
 use rustyline::validate::Validator;
 use std::sync::Arc;
 use tmclsim_firmware::Profile;
+use tmclsim_host::names::{parameters, snake, table_of};
 use tmclsim_protocol::mnemonic::{self, Operand};
 use tmclsim_protocol::opcode;
 
@@ -53,7 +53,7 @@ impl Completion {
         let Some(profile) = &self.profile else { return Vec::new() };
         let tables = match op.and_then(table_of) {
             Some(t) => vec![t],
-            None => vec![super::names::Table::Axis, super::names::Table::Global],
+            None => vec![tmclsim_host::names::Table::Axis, tmclsim_host::names::Table::Global],
         };
         tables.into_iter().flat_map(|t| parameters(profile, t).into_iter().map(|(_, p)| snake(&p.name))).collect()
     }

@@ -4,15 +4,13 @@
 //! standard input.
 
 mod complete;
-mod line;
-mod names;
-mod reply;
 
 use crate::client::LinkArgs;
 use std::io::{BufRead, IsTerminal};
 use std::process::ExitCode;
 use std::sync::Arc;
 use tmclsim_firmware::Profile;
+use tmclsim_host::{line, names, reply};
 use tmclsim_protocol::{Instruction, mnemonic, opcode};
 
 #[derive(clap::Args)]

@@ -1,8 +1,8 @@
 //! A reply as the console shows it: the status in words, and the value
 //! with the parameter's name and unit.
 
-use super::names::{Table, table_of};
-use tmclsim_firmware::Profile;
+use crate::names::{Table, table_of};
+use tmclsim_profile::Profile;
 use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Status, opcode};
 
 /// One line (or two) for the reply to `ins`.

@@ -1,8 +1,8 @@
 //! Parameter names as the console takes them: the profile's name in lower
 //! case with `_` between words (`actual_position`, `max_current`).
 
-use tmclsim_firmware::Profile;
-use tmclsim_firmware::profile::Parameter;
+use tmclsim_profile::Parameter;
+use tmclsim_profile::Profile;
 
 /// `Actual position` → `actual_position`; `Maximum speed (pps)` →
 /// `maximum_speed_pps`.

@@ -2,8 +2,8 @@
 //! takes it, where the type operand of SAP/GAP/STAP/RSAP/AAP and
 //! SGP/GGP/STGP/RSGP/AGP may also be a parameter's name.
 
-use super::names::{Table, find, parameters, snake, table_of};
-use tmclsim_firmware::Profile;
+use crate::names::{Table, find, parameters, snake, table_of};
+use tmclsim_profile::Profile;
 use tmclsim_protocol::mnemonic::{self, ParseError};
 use tmclsim_protocol::{Instruction, opcode, suggest};
 

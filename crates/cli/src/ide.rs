@@ -1,0 +1,66 @@
+//! `tmclsim ide`: the browser IDE against modules on a TMCL link (a real
+//! module's serial port, a serial-to-Ethernet bridge, or a tmclsim server),
+//! polled over TMCL as a host polls them. `tmclsim serve --web` serves the
+//! same app beside virtual modules.
+
+use std::process::ExitCode;
+use std::sync::Arc;
+
+#[derive(clap::Args)]
+pub struct IdeArgs {
+    /// TCP address of the modules (a tmclsim server or a serial-to-Ethernet bridge).
+    #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
+    pub tcp: Option<String>,
+    /// Serial port of the modules (e.g. /dev/ttyACM0, or a tmclsim pty).
+    #[arg(long, value_name = "DEV")]
+    pub port: Option<String>,
+    /// Baud rate for --port.
+    #[arg(long, default_value_t = 9600)]
+    pub baud: u32,
+    /// The module addresses on the link (an RS485 bus has several).
+    #[arg(long, value_name = "A,B,…", default_value = "1", value_delimiter = ',')]
+    pub bus_addresses: Vec<u8>,
+    /// Where the app listens.
+    #[arg(long, value_name = "ADDR", default_value = tmclsim_web::DEFAULT_ADDR, value_parser = crate::socket_address)]
+    pub web: std::net::SocketAddr,
+    /// Allow --web on a non-loopback address; every request then needs the token printed at start.
+    #[arg(long)]
+    pub web_public: bool,
+    /// How long to wait for each reply, in milliseconds.
+    #[arg(long, value_name = "MS", default_value_t = 1000)]
+    pub timeout: u64,
+}
+
+pub fn run(args: IdeArgs) -> Result<ExitCode, String> {
+    let target = tmclsim_web::LinkTarget::open(
+        args.tcp.as_deref(),
+        args.port.as_deref(),
+        args.baud,
+        &args.bus_addresses,
+        crate::millis(args.timeout),
+    )?;
+    use tmclsim_web::Target;
+    let names: Vec<String> = target.modules().iter().map(|m| format!("{} at address {}", m.firmware, m.address)).collect();
+    let link = target.describe();
+    let web = start(Arc::new(target), args.web, args.web_public)?;
+    println!("tmclsim ide: {} on {link}", names.join(", "));
+    println!("open: {}", web.url());
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    crate::serve::wait_for_signal();
+    println!("tmclsim ide: stopping");
+    drop(web);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Starts the app over `target`, with the warning a public bind deserves.
+pub fn start(target: Arc<dyn tmclsim_web::Target>, addr: std::net::SocketAddr, public: bool) -> Result<tmclsim_web::WebHandle, String> {
+    let web = tmclsim_web::start(target, tmclsim_web::WebConfig { addr, public }).map_err(|e| e.to_string())?;
+    if web.token().is_some() {
+        eprintln!(
+            "tmclsim: warning: the IDE listens on {}, reachable from other machines; requests need the token in the URL below",
+            web.addr()
+        );
+    }
+    Ok(web)
+}

@@ -1,0 +1,85 @@
+//! `GET /api/modules/{id}/live`: a WebSocket that streams the signals the
+//! app subscribed to (TMCL reads through the target) at the rate it asked
+//! for, and the program's state when asked.
+
+use crate::api::{App, Read, read_all};
+use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::{Path, State};
+use axum::response::Response;
+use serde::Deserialize;
+use serde_json::json;
+use std::time::Duration;
+
+/// Most signals per subscription.
+const MAX_SIGNALS: usize = 64;
+
+#[derive(Deserialize, Default)]
+struct Subscription {
+    #[serde(default)]
+    signals: Vec<Read>,
+    rate: Option<f64>,
+    #[serde(default)]
+    program: bool,
+}
+
+pub async fn live(ws: WebSocketUpgrade, State(app): State<App>, Path(id): Path<usize>) -> Response {
+    ws.on_upgrade(move |socket| stream(socket, app, id))
+}
+
+fn period(rate: Option<f64>) -> Duration {
+    let hz = rate.filter(|r| r.is_finite()).unwrap_or(20.0).clamp(1.0, 100.0);
+    Duration::from_secs_f64(1.0 / hz)
+}
+
+async fn stream(mut socket: WebSocket, app: App, id: usize) {
+    if id >= app.target.modules().len() {
+        let _ = socket.send(Message::Text(json!({"error": "no such module"}).to_string().into())).await;
+        return;
+    }
+    let mut sub = Subscription::default();
+    let mut tick = tokio::time::interval(period(None));
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    loop {
+        tokio::select! {
+            msg = socket.recv() => {
+                let Some(Ok(msg)) = msg else { return };
+                let Message::Text(text) = msg else { continue };
+                match serde_json::from_str::<Subscription>(&text) {
+                    Ok(s) if s.signals.len() <= MAX_SIGNALS => {
+                        tick = tokio::time::interval(period(s.rate));
+                        tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+                        sub = s;
+                    }
+                    Ok(_) => {
+                        let _ = socket.send(Message::Text(json!({"error": format!("at most {MAX_SIGNALS} signals")}).to_string().into())).await;
+                    }
+                    Err(e) => {
+                        let _ = socket.send(Message::Text(json!({"error": format!("subscription: {e}")}).to_string().into())).await;
+                    }
+                }
+            }
+            _ = tick.tick() => {
+                if sub.signals.is_empty() && !sub.program {
+                    continue;
+                }
+                let (a, signals, program) = (app.clone(), sub.signals.clone(), sub.program);
+                let sample = tokio::task::spawn_blocking(move || {
+                    let values = read_all(a.target.as_ref(), id, &signals).map_err(|e| format!("{e:?}"))?;
+                    let mut out = json!({"t": a.target.time(id), "values": values});
+                    if program {
+                        out["program"] = crate::program::state_of(&a, id).map_err(|e| e.1)?;
+                    }
+                    Ok::<_, String>(out)
+                }).await;
+                let text = match sample {
+                    Ok(Ok(v)) => v.to_string(),
+                    Ok(Err(e)) => json!({"error": e}).to_string(),
+                    Err(_) => return,
+                };
+                if socket.send(Message::Text(text.into())).await.is_err() {
+                    return;
+                }
+            }
+        }
+    }
+}

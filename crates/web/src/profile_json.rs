@@ -1,0 +1,80 @@
+//! A module's profile as the app shows it: parameter tables with access,
+//! range, default and its source, ports, commands and the reference search
+//! modes by name.
+
+use serde_json::{Value, json};
+use tmclsim_profile::ReferenceSearchFamily;
+use tmclsim_profile::{Parameter, PortDirection, Profile};
+
+fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
+    let a = &p.access;
+    let access: String = [(a.read, 'R'), (a.write, 'W'), (a.eeprom, 'E')].iter().filter(|(on, _)| *on).map(|(_, c)| *c).collect();
+    let source = match p.default_source {
+        tmclsim_profile::DefaultSource::Manual => "manual",
+        tmclsim_profile::DefaultSource::Sibling => "sibling",
+        tmclsim_profile::DefaultSource::Assumed => "assumed",
+    };
+    let mut v = json!({
+        "number": p.number, "name": p.name, "unit": p.unit, "access": access,
+        "min": p.min, "max": p.max, "default": p.default, "default_source": source,
+        "note": p.note, "storable": a.eeprom, "ranges": p.ranges,
+        "snake": tmclsim_host::names::snake(&p.name),
+    });
+    if let Some(b) = bank {
+        v["bank"] = json!(b);
+    }
+    v
+}
+
+/// The modes AP 193 selects, as the manuals name them.
+fn reference_modes(family: ReferenceSearchFamily) -> Vec<(i64, &'static str)> {
+    match family {
+        // TMCM-1141 manual, table 16, AP 193.
+        ReferenceSearchFamily::Tmc429 => vec![
+            (1, "1: left stop switch only"),
+            (2, "2: right stop switch, then left stop switch"),
+            (3, "3: right stop switch, then left stop switch from both sides"),
+            (4, "4: left stop switch from both sides"),
+            (5, "5: home switch, negative direction, reverse at the left stop switch"),
+            (6, "6: home switch, positive direction, reverse at the right stop switch"),
+            (7, "7: home switch, positive direction, end switches ignored"),
+            (8, "8: home switch, negative direction, end switches ignored"),
+            (65, "65: right stop switch only (1 + 64)"),
+            (66, "66: left stop switch, then right stop switch (2 + 64)"),
+            (67, "67: left stop switch, then right stop switch from both sides (3 + 64)"),
+            (68, "68: right stop switch from both sides (4 + 64)"),
+            (133, "133: mode 5, home switch inverted (5 + 128)"),
+            (134, "134: mode 6, home switch inverted (6 + 128)"),
+            (135, "135: mode 7, home switch inverted (7 + 128)"),
+            (136, "136: mode 8, home switch inverted (8 + 128)"),
+        ],
+        // TMCM-351 manual 5.7.5–5.7.8.
+        ReferenceSearchFamily::Tmc428 => vec![
+            (1, "1: left reference switch only"),
+            (2, "2: right switch, then left switch"),
+            (3, "3: right switch, then the reference switch"),
+        ],
+    }
+}
+
+pub fn of(profile: &Profile) -> Value {
+    let m = &profile.module;
+    let commands: Vec<&str> = m.opcodes.iter().filter_map(|&o| tmclsim_protocol::opcode::mnemonic(o)).collect();
+    let axis: Vec<Value> = profile.axis_parameters().map(|p| parameter(p, None)).collect();
+    let global: Vec<Value> = (0..=3u8).flat_map(|b| profile.global_parameters(b).map(move |p| parameter(p, Some(b)))).collect();
+    let port = |d: PortDirection| -> Vec<Value> {
+        profile
+            .ports
+            .iter()
+            .filter(|p| p.direction == d)
+            .map(|p| json!({"bank": p.bank, "number": p.number, "name": p.name, "min": p.min, "max": p.max, "unit": p.unit, "analog": d == PortDirection::Input && p.max > 1}))
+            .collect()
+    };
+    json!({
+        "name": m.name, "axes": m.axes, "program_memory": m.program_memory,
+        "user_variables": m.user_variables, "commands": commands,
+        "axis_parameters": axis, "global_parameters": global,
+        "inputs": port(PortDirection::Input), "outputs": port(PortDirection::Output),
+        "reference_modes": reference_modes(profile.features.reference_search).into_iter().map(|(v, n)| json!({"value": v, "name": n})).collect::<Vec<_>>(),
+    })
+}

@@ -1,0 +1,105 @@
+//! Who may drive the motors: the app binds to loopback by default; a
+//! request whose `Origin` is another site, or whose `Host` is not a name of
+//! this machine's loopback (DNS rebinding), is refused. A non-loopback bind
+//! needs a token in every request: `?token=` once (the page then sets a
+//! cookie), the cookie, or the `x-tmclsim-token` header.
+
+use axum::extract::{Request, State};
+use axum::http::{HeaderMap, StatusCode, header};
+use axum::middleware::Next;
+use axum::response::{IntoResponse, Response};
+use std::io::Read;
+
+pub const COOKIE: &str = "tmclsim_token";
+
+/// 128 random bits from the operating system, in hex.
+pub fn new_token() -> std::io::Result<String> {
+    let mut b = [0u8; 16];
+    std::fs::File::open("/dev/urandom")?.read_exact(&mut b)?;
+    Ok(b.iter().map(|x| format!("{x:02x}")).collect())
+}
+
+/// The host part of `host[:port]` or `[v6]:port`.
+fn host_of(authority: &str) -> &str {
+    if let Some(rest) = authority.strip_prefix('[') {
+        return rest.split(']').next().unwrap_or(rest);
+    }
+    authority.rsplit_once(':').map_or(authority, |(h, _)| h)
+}
+
+fn is_loopback_name(host: &str) -> bool {
+    host.eq_ignore_ascii_case("localhost") || host.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_loopback())
+}
+
+fn refuse(why: &str) -> Response {
+    (StatusCode::FORBIDDEN, axum::Json(serde_json::json!({ "error": why }))).into_response()
+}
+
+fn token_of(req: &Request) -> Option<String> {
+    let h = req.headers();
+    if let Some(t) = h.get("x-tmclsim-token").and_then(|v| v.to_str().ok()) {
+        return Some(t.to_string());
+    }
+    let query = req.uri().query().unwrap_or("");
+    if let Some(t) = query.split('&').find_map(|kv| kv.strip_prefix("token=")) {
+        return Some(t.to_string());
+    }
+    cookie(h)
+}
+
+fn cookie(h: &HeaderMap) -> Option<String> {
+    h.get_all(header::COOKIE)
+        .iter()
+        .filter_map(|v| v.to_str().ok())
+        .flat_map(|v| v.split(';'))
+        .find_map(|kv| kv.trim().strip_prefix(COOKIE).and_then(|r| r.strip_prefix('=')).map(str::to_string))
+}
+
+/// The checks, in front of every route.
+pub async fn guard(State(app): State<crate::api::App>, req: Request, next: Next) -> Response {
+    let host = req.headers().get(header::HOST).and_then(|v| v.to_str().ok()).unwrap_or("").to_string();
+    if let Some(origin) = req.headers().get(header::ORIGIN) {
+        let origin = origin.to_str().unwrap_or("");
+        let authority = origin.split_once("://").map_or("", |(_, a)| a);
+        if authority != host {
+            return refuse(&format!("requests from {origin} are refused: the IDE answers its own pages only"));
+        }
+    }
+    match &app.token {
+        None if !is_loopback_name(host_of(&host)) => {
+            return refuse(&format!("host '{host}' is not this machine's loopback (a DNS-rebinding request is refused)"));
+        }
+        None => {}
+        Some(token) => {
+            let given = token_of(&req);
+            if given.as_deref() != Some(token.as_str()) {
+                return refuse("this IDE needs the token printed when it started (?token=…)");
+            }
+            let set = req.uri().query().is_some_and(|q| q.contains("token="));
+            let mut response = next.run(req).await;
+            if set {
+                let c = format!("{COOKIE}={token}; Path=/; HttpOnly; SameSite=Strict");
+                if let Ok(v) = c.parse() {
+                    response.headers_mut().insert(header::SET_COOKIE, v);
+                }
+            }
+            return response;
+        }
+    }
+    next.run(req).await
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hosts_and_loopback_names() {
+        assert_eq!(host_of("127.0.0.1:8141"), "127.0.0.1");
+        assert_eq!(host_of("[::1]:8141"), "::1");
+        assert_eq!(host_of("localhost"), "localhost");
+        assert!(is_loopback_name("localhost") && is_loopback_name("127.0.0.1") && is_loopback_name("::1"));
+        assert!(!is_loopback_name("evil.example") && !is_loopback_name("10.0.0.1"));
+        assert_eq!(new_token().unwrap().len(), 32);
+    }
+}

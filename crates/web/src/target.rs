@@ -1,0 +1,73 @@
+//! What the app talks to: a list of modules that answer TMCL requests.
+//! Virtual targets (modules this process serves) add what only a
+//! simulator can give: the world, breakpoints in the firmware, flags and
+//! stack depth, virtual time.
+
+use std::sync::Arc;
+use tmclsim_firmware::snapshot::ModuleSnapshot;
+use tmclsim_profile::Profile;
+use tmclsim_protocol::{FRAME_LEN, Instruction};
+
+/// One module of a target, as the module list shows it.
+#[derive(Clone)]
+pub struct ModuleEntry {
+    pub address: u8,
+    /// The profile of the type the module reports (136 type 1), if any.
+    pub profile: Option<Arc<Profile>>,
+    /// The 136 type 0 answer, e.g. `1141V146`.
+    pub firmware: String,
+    /// The link it is reached on, e.g. `tcp 127.0.0.1:1141`.
+    pub link: String,
+}
+
+/// Why a target cannot do something.
+#[derive(Debug)]
+pub enum TargetError {
+    /// No such module id.
+    NoModule,
+    /// The target cannot do this at all (the world of a real module).
+    Unsupported(String),
+    /// The request failed (no reply, a link error).
+    Failed(String),
+}
+
+pub trait Target: Send + Sync + 'static {
+    /// `virtual` or `link`.
+    fn kind(&self) -> &'static str;
+    /// Where the modules are, in words.
+    fn describe(&self) -> String;
+    fn modules(&self) -> &[ModuleEntry];
+    /// One TMCL request to module `id` through the same request path as a
+    /// frame from a link; the raw reply.
+    fn request(&self, id: usize, ins: Instruction) -> Result<[u8; FRAME_LEN], TargetError>;
+    /// The module's clock in seconds: virtual time, or wall time since the
+    /// target was opened.
+    fn time(&self, id: usize) -> f64;
+    /// A typed picture of a virtual module.
+    fn snapshot(&self, _id: usize) -> Option<ModuleSnapshot> {
+        None
+    }
+    /// One line of the control protocol (docs/world.md) for module `id`.
+    fn world(&self, _id: usize, _line: &str) -> Result<String, TargetError> {
+        Err(TargetError::Unsupported("the world exists only around virtual modules".into()))
+    }
+    /// Sets the program's breakpoints; the firmware stops on them (virtual)
+    /// or the target emulates them by single steps (link).
+    fn set_breakpoints(&self, id: usize, addresses: &[u16]) -> Result<(), TargetError>;
+    fn breakpoints(&self, id: usize) -> Vec<u16>;
+    /// The breakpoint the program stands on, if it stopped at one.
+    fn breakpoint_hit(&self, id: usize) -> Option<u16>;
+    /// Starts the program at address 0, or continues it (`start` false),
+    /// honouring the breakpoints.
+    fn run(&self, id: usize, start: bool) -> Result<(), TargetError>;
+    /// Stops a run that the target drives itself (breakpoints by steps).
+    fn halt(&self, _id: usize) {}
+}
+
+/// An error status in a reply as a failure.
+pub fn check(reply: &[u8; FRAME_LEN]) -> Result<(), TargetError> {
+    match reply[2] {
+        s if s >= 100 => Ok(()),
+        s => Err(TargetError::Failed(format!("the module answered status {s} ({})", crate::status_text(s)))),
+    }
+}
