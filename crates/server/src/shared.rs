@@ -10,7 +10,7 @@ use tmclsim_firmware::can::CanFrame;
 use tmclsim_firmware::eeprom::EepromFile;
 use tmclsim_firmware::world_command::WorldCommand;
 use tmclsim_firmware::{Bus, Eeprom, Module};
-use tmclsim_protocol::{FRAME_LEN, Reply, Status};
+use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Request, Status};
 use tokio::sync::{Notify, mpsc};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
@@ -287,6 +287,21 @@ impl SharedBus {
     pub fn frame(&self, frame: &[u8; FRAME_LEN]) -> Vec<[u8; FRAME_LEN]> {
         let (answer, unsaved) = self.with_bus_saved(|bus| bus.handle_frame(frame));
         answer.replies.into_iter().map(|r| if unsaved { Self::not_stored(r, frame[1]) } else { r }).collect()
+    }
+
+    /// [`SharedBus::frame`] for several instructions to module `index` (in
+    /// bus order) at its address, under one lock (an observer's batch of
+    /// reads): the first reply of each, and the bus's time.
+    pub fn requests(&self, index: usize, all: &[Instruction]) -> (Vec<Option<[u8; FRAME_LEN]>>, u64) {
+        let ((replies, now), unsaved) = self.with_bus_saved(|bus| {
+            let address = bus.module(index).address();
+            let replies: Vec<_> =
+                all.iter().map(|ins| bus.handle_frame(&Request::new(address, *ins).encode()).replies.into_iter().next()).collect();
+            (replies, bus.now_ns())
+        });
+        let replies =
+            replies.into_iter().zip(all).map(|(r, ins)| r.map(|r| if unsaved { Self::not_stored(r, ins.opcode) } else { r })).collect();
+        (replies, now)
     }
 
     /// Sends one frame to module `index` (in bus order) alone, from in

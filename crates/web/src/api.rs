@@ -173,15 +173,12 @@ impl Read {
     }
 }
 
-/// The values of `reads`, `None` where the module answered an error.
-pub fn read_all(target: &dyn Target, id: usize, reads: &[Read]) -> Result<Vec<Option<i32>>, TargetError> {
-    reads
-        .iter()
-        .map(|r| {
-            let raw = target.request(id, r.instruction())?;
-            Ok((raw[2] >= 100).then(|| i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]])))
-        })
-        .collect()
+/// The values of `reads` (`None` where the module answered an error) and
+/// the module's clock after them.
+pub fn read_all(target: &dyn Target, id: usize, reads: &[Read]) -> Result<(Vec<Option<i32>>, f64), TargetError> {
+    let all: Vec<Instruction> = reads.iter().map(|r| r.instruction()).collect();
+    let (replies, t) = target.sample(id, &all)?;
+    Ok((replies.iter().map(|raw| (raw[2] >= 100).then(|| i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]))).collect(), t))
 }
 
 #[derive(Deserialize)]
@@ -194,8 +191,8 @@ async fn read(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<Re
     if body.reads.len() > 4096 {
         return Err(bad("at most 4096 reads at once"));
     }
-    let values = blocking(move || read_all(app.target.as_ref(), id, &body.reads)).await??;
-    Ok(Json(json!({ "values": values })))
+    let (values, t) = blocking(move || read_all(app.target.as_ref(), id, &body.reads)).await??;
+    Ok(Json(json!({ "values": values, "t": t })))
 }
 
 #[derive(Deserialize)]

@@ -102,7 +102,9 @@ pub fn start(target: Arc<dyn Target>, config: WebConfig) -> std::io::Result<WebH
     let (stop, mut stopped) = watch::channel(false);
     let state = api::App::new(target, token.clone());
     let thread = std::thread::Builder::new().name("tmclsim-web".into()).spawn(move || {
-        let rt = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().expect("a tokio runtime");
+        // One thread: the app's requests are short; link targets' waits run
+        // on the blocking pool.
+        let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().expect("a tokio runtime");
         rt.block_on(async move {
             let listener = tokio::net::TcpListener::from_std(listener).expect("a tokio listener");
             let app = api::router(state);

@@ -63,14 +63,16 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
                     continue;
                 }
                 let (a, signals, program) = (app.clone(), sub.signals.clone(), sub.program);
-                let sample = tokio::task::spawn_blocking(move || {
-                    let values = read_all(a.target.as_ref(), id, &signals).map_err(|e| format!("{e:?}"))?;
-                    let mut out = json!({"t": a.target.time(id), "values": values});
+                let take = move || {
+                    let (values, t) = read_all(a.target.as_ref(), id, &signals).map_err(|e| e.to_string())?;
+                    let mut out = json!({"t": t, "values": values});
                     if program {
                         out["program"] = crate::program::state_of(&a, id).map_err(|e| e.1)?;
                     }
                     Ok::<_, String>(out)
-                }).await;
+                };
+                // Virtual modules answer in microseconds: no thread hand-off.
+                let sample = if app.target.blocks() { tokio::task::spawn_blocking(take).await } else { Ok(take()) };
                 let text = match sample {
                     Ok(Ok(v)) => v.to_string(),
                     Ok(Err(e)) => json!({"error": e}).to_string(),

@@ -31,6 +31,15 @@ pub enum TargetError {
     Failed(String),
 }
 
+impl std::fmt::Display for TargetError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TargetError::NoModule => write!(f, "no such module"),
+            TargetError::Unsupported(s) | TargetError::Failed(s) => write!(f, "{s}"),
+        }
+    }
+}
+
 pub trait Target: Send + Sync + 'static {
     /// `virtual` or `link`.
     fn kind(&self) -> &'static str;
@@ -40,6 +49,18 @@ pub trait Target: Send + Sync + 'static {
     /// One TMCL request to module `id` through the same request path as a
     /// frame from a link; the raw reply.
     fn request(&self, id: usize, ins: Instruction) -> Result<[u8; FRAME_LEN], TargetError>;
+    /// Several requests to module `id` in one go (the live stream's
+    /// samples), the same path as [`Target::request`], and the module's
+    /// clock after them.
+    fn sample(&self, id: usize, all: &[Instruction]) -> Result<(Vec<[u8; FRAME_LEN]>, f64), TargetError> {
+        let replies = all.iter().map(|ins| self.request(id, *ins)).collect::<Result<_, _>>()?;
+        Ok((replies, self.time(id)))
+    }
+    /// Requests wait on a link (run them off the async threads), or are
+    /// answered in process within microseconds.
+    fn blocks(&self) -> bool {
+        true
+    }
     /// The module's clock in seconds: virtual time, or wall time since the
     /// target was opened.
     fn time(&self, id: usize) -> f64;

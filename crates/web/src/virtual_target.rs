@@ -80,6 +80,20 @@ impl Target for VirtualTarget {
         p.bus.frame(&frame).into_iter().next().ok_or_else(|| TargetError::Failed("no reply (replies suppressed by GP 255?)".into()))
     }
 
+    fn sample(&self, id: usize, all: &[Instruction]) -> Result<(Vec<[u8; FRAME_LEN]>, f64), TargetError> {
+        let p = self.place(id)?;
+        let (replies, now) = p.bus.requests(p.index, all);
+        let replies = replies
+            .into_iter()
+            .map(|r| r.ok_or_else(|| TargetError::Failed("no reply (replies suppressed by GP 255?)".into())))
+            .collect::<Result<_, _>>()?;
+        Ok((replies, now as f64 * 1e-9))
+    }
+
+    fn blocks(&self) -> bool {
+        false
+    }
+
     fn time(&self, id: usize) -> f64 {
         self.place(id).map_or(0.0, |p| p.bus.now_ns() as f64 * 1e-9)
     }
