@@ -157,7 +157,11 @@ def test_assemble_disassemble_round_trip():
     back = Program.from_binary(program.to_binary(), program.symbols)
     assert back == program or back.instructions == program.instructions
     assert "MAXIMUM_SPEED" in program.constants or program.constants
-    assert program.symbol_file() == "Back 1\n"
+    # Labels first, then the source map (crates/asm/README.md, "Symbol file").
+    symbols = program.symbol_file().splitlines()
+    assert symbols[0] == "Back 1"
+    assert symbols[1].startswith("// source map")
+    assert symbols[-1] == "@5\tmover.tmc\t9\t5\tJA Back"
 
 
 def test_raw_words_survive_disassembly():
