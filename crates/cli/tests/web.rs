@@ -1,0 +1,81 @@
+//! `tmclsim serve --web` and `tmclsim ide`: the browser IDE beside served
+//! modules and against modules on a TMCL link, as processes.
+
+mod common;
+
+use common::{Server, text, tmclsim};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Command, Stdio};
+
+/// GET `path` from the app at `url` (`http://ADDR/`): the status line and
+/// the body.
+fn get(url: &str, path: &str) -> (String, String) {
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut s = TcpStream::connect(addr).unwrap();
+    write!(s, "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n").unwrap();
+    let mut all = String::new();
+    s.read_to_string(&mut all).unwrap();
+    let (head, body) = all.split_once("\r\n\r\n").unwrap();
+    (head.lines().next().unwrap().to_string(), body.to_string())
+}
+
+#[test]
+fn serve_web_prints_the_url_and_lists_the_module() {
+    let server = Server::start(&["--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0"]);
+    let url = server.printed("web");
+    assert!(url.starts_with("http://127.0.0.1:"), "{url}");
+    let (status, body) = get(&url, "/api/modules");
+    assert!(status.contains("200"), "{status}");
+    assert!(body.contains("\"profile\":\"TMCM-1141\"") && body.contains("\"virtual\":true"), "{body}");
+    let (status, page) = get(&url, "/");
+    assert!(status.contains("200") && page.to_ascii_lowercase().contains("<html"), "{status}");
+    server.check();
+}
+
+#[test]
+fn a_bus_lists_every_module() {
+    let server = Server::start(&["--bus", "tmcm-1141@1,tmcm-351@2", "--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0"]);
+    let (_, body) = get(&server.printed("web"), "/api/modules");
+    assert!(body.contains("TMCM-1141") && body.contains("TMCM-351") && body.contains("\"address\":2"), "{body}");
+}
+
+#[test]
+fn a_public_web_address_needs_the_flag() {
+    let out = tmclsim(&["serve", "--tcp", "127.0.0.1:0", "--web", "0.0.0.0:0"]);
+    assert!(!out.status.success());
+    assert!(text(&out).contains("--web-public"), "{}", text(&out));
+}
+
+#[test]
+fn ide_reaches_a_served_module_over_tcp() {
+    let server = Server::start(&["--tcp", "127.0.0.1:0"]);
+    let mut ide = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["ide", "--tcp", &server.tcp(), "--web", "127.0.0.1:0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(ide.stdout.take().unwrap());
+    let mut lines = Vec::new();
+    let url = loop {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "ide ended: {lines:?}");
+        if let Some(u) = line.trim().strip_prefix("open: ") {
+            break u.to_string();
+        }
+        lines.push(line);
+    };
+    assert!(lines.iter().any(|l| l.contains("1141V146 at address 1")), "{lines:?}");
+    let (_, body) = get(&url, "/api/modules");
+    assert!(body.contains("\"virtual\":false") && body.contains("TMCM-1141"), "{body}");
+    ide.kill().unwrap();
+    ide.wait().unwrap();
+}
+
+#[test]
+fn ide_names_the_link_it_cannot_open() {
+    let out = tmclsim(&["ide", "--tcp", "127.0.0.1:1", "--web", "127.0.0.1:0"]);
+    assert!(!out.status.success());
+    assert!(text(&out).contains("cannot connect to 127.0.0.1:1"), "{}", text(&out));
+}

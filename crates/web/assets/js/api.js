@@ -1,0 +1,93 @@
+// The IDE server's API (crates/web/README.md): JSON over HTTP, and the live
+// WebSocket of one module.
+
+export async function call(method, path, body) {
+  const init = { method, headers: {} };
+  if (body !== undefined) {
+    init.headers["Content-Type"] = "application/json";
+    init.body = JSON.stringify(body);
+  }
+  const r = await fetch(path, init);
+  let data;
+  try {
+    data = await r.json();
+  } catch {
+    data = { error: `HTTP ${r.status}` };
+  }
+  if (!r.ok && !data.error) data.error = `HTTP ${r.status}`;
+  return data;
+}
+
+export const get = (path) => call("GET", path);
+export const post = (path, body) => call("POST", path, body ?? {});
+
+/** POST that answers newline-delimited JSON; `onLine` gets each object. */
+export async function postLines(path, body, onLine) {
+  const r = await fetch(path, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+  const reader = r.body.getReader();
+  const decoder = new TextDecoder();
+  let buffer = "";
+  let last = null;
+  for (;;) {
+    const { value, done } = await reader.read();
+    if (done) break;
+    buffer += decoder.decode(value, { stream: true });
+    let nl;
+    while ((nl = buffer.indexOf("\n")) >= 0) {
+      const line = buffer.slice(0, nl).trim();
+      buffer = buffer.slice(nl + 1);
+      if (line) {
+        last = JSON.parse(line);
+        onLine(last);
+      }
+    }
+  }
+  if (buffer.trim()) {
+    last = JSON.parse(buffer);
+    onLine(last);
+  }
+  return last;
+}
+
+/** The live stream of module `id`: `subscribe(sub)` (re)sends the
+ * subscription, `onSample` gets every message. */
+export class Live {
+  constructor(id, onSample) {
+    this.id = id;
+    this.onSample = onSample;
+    this.sub = { signals: [], rate: 50, program: false };
+    this.closed = false;
+    this.open();
+  }
+  open() {
+    const proto = location.protocol === "https:" ? "wss" : "ws";
+    this.ws = new WebSocket(`${proto}://${location.host}/api/modules/${this.id}/live`);
+    this.ws.onopen = () => this.ws.send(JSON.stringify(this.sub));
+    this.ws.onmessage = (e) => this.onSample(JSON.parse(e.data));
+    this.ws.onclose = () => {
+      if (!this.closed) setTimeout(() => this.open(), 1000);
+    };
+  }
+  subscribe(sub) {
+    this.sub = { ...this.sub, ...sub };
+    if (this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(this.sub));
+  }
+  close() {
+    this.closed = true;
+    this.ws.close();
+  }
+}
+
+export const m = (id, rest) => `/api/modules/${id}/${rest}`;
+
+export function el(tag, attrs = {}, ...children) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === "class") e.className = v;
+    else if (k.startsWith("on")) e.addEventListener(k.slice(2), v);
+    else if (k === "text") e.textContent = v;
+    else e.setAttribute(k, v);
+  }
+  for (const c of children) e.append(c);
+  return e;
+}

@@ -1,0 +1,144 @@
+// The parameter grid: the profile's axis and global parameters with their
+// live values, edited with validation against the range (SAP/SGP), stored
+// and restored (STAP/RSAP, STGP/RSGP). Values that change flash.
+import { post, el, m } from "./api.js";
+
+const POLL_MS = 300;
+
+export function inRange(row, v) {
+  if (!Number.isInteger(v) || v < row.min || v > row.max) return false;
+  return !row.ranges.length || row.ranges.some(([lo, hi]) => v >= lo && v <= hi);
+}
+
+export class ParamsPanel {
+  constructor() {
+    this.body = document.querySelector("#param-table tbody");
+    this.filter = document.getElementById("param-filter");
+    this.axis = document.getElementById("param-axis");
+    this.status = document.getElementById("param-status");
+    this.filter.addEventListener("input", () => this.draw());
+    this.axis.addEventListener("change", () => this.draw());
+    for (const r of document.querySelectorAll("input[name=ptable]")) r.addEventListener("change", () => this.draw());
+    this.visible = false;
+    setInterval(() => this.poll(), POLL_MS);
+  }
+
+  shown(on) {
+    this.visible = on;
+    if (on) this.poll();
+  }
+
+  setModule(ctx) {
+    this.ctx = ctx;
+    const axes = ctx.profile ? ctx.profile.axes : 1;
+    this.axis.replaceChildren(...Array.from({ length: axes }, (_, i) => el("option", { value: String(i), text: String(i) })));
+    this.draw();
+  }
+
+  table() {
+    return document.querySelector("input[name=ptable]:checked").value;
+  }
+
+  draw() {
+    const p = this.ctx?.profile;
+    this.rows = [];
+    if (!p) {
+      this.body.replaceChildren();
+      this.status.textContent = "no profile for this module type: use direct mode with numbers";
+      return;
+    }
+    const words = this.filter.value.toLowerCase().trim();
+    const global = this.table() === "global";
+    const all = global ? p.global_parameters : p.axis_parameters;
+    const rows = all.filter((r) => !words || r.name.toLowerCase().includes(words) || r.snake.includes(words) || String(r.number) === words);
+    const motor = Number(this.axis.value || 0);
+    this.body.replaceChildren(
+      ...rows.map((r) => {
+        const index = global ? r.bank : motor;
+        const kind = global ? "gp" : "ap";
+        const value = el("td", { class: "value", "data-testid": `value-${kind}-${index}-${r.number}`, text: "–" });
+        const input = el("input", { type: "number", "data-testid": `edit-${kind}-${index}-${r.number}`, step: "1" });
+        const set = el("button", { "data-testid": `set-${kind}-${index}-${r.number}`, text: "Set" });
+        const writable = r.access.includes("W");
+        input.disabled = set.disabled = !writable;
+        input.addEventListener("input", () => input.classList.toggle("invalid", input.value !== "" && !inRange(r, Number(input.value))));
+        const doSet = async () => {
+          const v = Number(input.value);
+          if (input.value === "" || !inRange(r, v)) {
+            this.say(`${r.name}: ${input.value} is outside ${r.min}…${r.max}${r.ranges.length ? " (" + r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") + ")" : ""}`, true);
+            input.classList.add("invalid");
+            return;
+          }
+          const a = await post(m(this.ctx.id, "write"), { kind, number: r.number, index, value: v });
+          this.answer(r, a);
+          if (!a.error && a.status >= 100) input.value = "";
+          this.poll();
+        };
+        set.addEventListener("click", doSet);
+        input.addEventListener("keydown", (e) => e.key === "Enter" && doSet());
+        const extra = el("td");
+        if (r.storable) {
+          for (const op of ["store", "restore"]) {
+            const b = el("button", { text: op === "store" ? "Store" : "Restore", "data-testid": `${op}-${kind}-${index}-${r.number}`, title: op === "store" ? "to EEPROM (STAP/STGP)" : "from EEPROM (RSAP/RSGP)" });
+            b.addEventListener("click", async () => {
+              this.answer(r, await post(m(this.ctx.id, "write"), { op, kind, number: r.number, index }));
+              this.poll();
+            });
+            extra.append(b, " ");
+          }
+        }
+        const range = r.ranges.length ? r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") : `${r.min}…${r.max}`;
+        const tr = el("tr", { "data-testid": `row-${kind}-${index}-${r.number}` },
+          el("td", { class: "num", text: String(r.number) }),
+          el("td", { class: "num", text: global ? String(r.bank) : "" }),
+          el("td", { text: r.name, title: r.note ?? "" }),
+          value,
+          el("td", { text: r.unit ?? "" }),
+          el("td", { text: r.access }),
+          el("td", { text: range }),
+          el("td", { text: String(r.default) }),
+          el("td", { class: `src-${r.default_source}`, text: r.default_source, title: r.note ?? "" }),
+          el("td", {}, input, " ", set),
+          extra);
+        this.rows.push({ r, kind, index, value, readable: r.access.includes("R") });
+        return tr;
+      }),
+    );
+    this.status.textContent = `${rows.length} parameters`;
+    this.poll();
+  }
+
+  answer(r, a) {
+    if (a.error) this.say(a.error, true);
+    else this.say(a.text + (a.status < 100 ? ` [status ${a.status}: ${a.status_text}]` : ""), a.status < 100);
+  }
+
+  say(text, bad) {
+    this.status.textContent = text;
+    this.status.classList.toggle("error", !!bad);
+  }
+
+  async poll() {
+    if (!this.visible || !this.ctx || !this.rows?.length || this.polling) return;
+    const rows = this.rows.filter((x) => x.readable).slice(0, 400);
+    this.polling = true;
+    try {
+      const a = await post(m(this.ctx.id, "read"), { reads: rows.map((x) => ({ kind: x.kind, number: x.r.number, index: x.index })) });
+      if (!a.values) return;
+      rows.forEach((x, i) => {
+        const text = a.values[i] === null ? "error" : String(a.values[i]);
+        if (x.value.textContent !== text) {
+          const changed = x.value.textContent !== "–";
+          x.value.textContent = text;
+          if (changed) {
+            x.value.classList.remove("flash");
+            void x.value.offsetWidth;
+            x.value.classList.add("flash");
+          }
+        }
+      });
+    } finally {
+      this.polling = false;
+    }
+  }
+}

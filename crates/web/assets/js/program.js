@@ -1,0 +1,188 @@
+// Programs: the editor (TMCL highlighting), assembler diagnostics inline at
+// line and column, download with progress and verification (134),
+// run/stop/pause/step/continue/reset, breakpoints on source lines (mapped to
+// addresses with the assembler's source map), the current line and the
+// interpreter's registers live.
+import "./tmcl-mode.js";
+import { post, postLines, el, m } from "./api.js";
+
+const EXAMPLE = `// A shuttle: back and forth between two positions, counting the trips.
+        SAP 4, 0, 1000          // maximum positioning speed
+        SAP 5, 0, 500           // maximum acceleration
+Loop:   MVP ABS, 0, 51200
+        WAIT POS, 0, 0
+        CALC ADD, 1             // trips, in the accumulator
+        AAP 1, 0                // nothing moves: shows AAP
+        MVP ABS, 0, 0
+        WAIT POS, 0, 0
+        JA Loop
+`;
+
+export class ProgramPanel {
+  constructor() {
+    this.editor = CodeMirror(document.getElementById("editor"), {
+      value: localStorage.getItem("tmclsim-program") ?? EXAMPLE,
+      mode: "tmcl",
+      lineNumbers: true,
+      gutters: ["breakpoints", "CodeMirror-linenumbers"],
+      indentUnit: 8,
+    });
+    window.tmclEditor = this.editor;
+    this.breakLines = new Set();
+    this.map = null; // address → line, from the last download
+    this.widgets = [];
+    this.editor.on("gutterClick", (cm, line) => this.toggle(line + 1));
+    this.editor.on("change", () => {
+      localStorage.setItem("tmclsim-program", this.editor.getValue());
+      this.stale = true;
+    });
+    const on = (id, f) => document.getElementById(id).addEventListener("click", f);
+    on("prog-assemble", () => this.assemble());
+    on("prog-download", () => this.download());
+    for (const action of ["run", "stop", "pause", "step", "continue", "reset"]) on(`prog-${action}`, () => this.act(action));
+    this.message = document.getElementById("prog-message");
+  }
+
+  shown(on) {
+    this.visible = on;
+    if (on) setTimeout(() => this.editor.refresh(), 0);
+  }
+
+  setModule(ctx) {
+    this.ctx = ctx;
+    this.map = null;
+    this.showState(null);
+  }
+
+  say(text, bad) {
+    this.message.textContent = text;
+    this.message.classList.toggle("error", !!bad);
+  }
+
+  clearDiagnostics() {
+    for (const w of this.widgets) w.clear();
+    this.widgets = [];
+    this.editor.eachLine((h) => this.editor.removeLineClass(h, "background", "cm-error-line"));
+    document.getElementById("prog-diagnostics").replaceChildren();
+  }
+
+  showDiagnostics(list) {
+    this.clearDiagnostics();
+    const ul = document.getElementById("prog-diagnostics");
+    for (const d of list) {
+      const line = Math.max(0, d.line - 1);
+      this.editor.addLineClass(line, "background", "cm-error-line");
+      const text = `${" ".repeat(Math.max(0, d.column - 1))}^ ${d.line}:${d.column}: ${d.message}`;
+      this.widgets.push(this.editor.addLineWidget(line, el("div", { class: "diag-widget", "data-testid": "diagnostic", text })));
+      const li = el("li", { "data-testid": "diagnostic-item", text: `${d.line}:${d.column}: ${d.message}` });
+      li.addEventListener("click", () => {
+        this.editor.setCursor({ line, ch: Math.max(0, d.column - 1) });
+        this.editor.focus();
+      });
+      ul.append(li);
+    }
+  }
+
+  async assemble() {
+    const a = await post("/api/assemble", { source: this.editor.getValue(), profile: this.ctx?.profile?.name });
+    if (a.error) return this.say(a.error, true);
+    this.showDiagnostics(a.diagnostics);
+    if (a.ok) this.say(`assembled: ${a.words} words`);
+    else this.say(`${a.diagnostics.length} error(s)`, true);
+    return a;
+  }
+
+  useMap(sourceMap) {
+    this.map = new Map(sourceMap.filter((e) => e.file === "program.tmc").map((e) => [e.address, e.line]));
+    this.stale = false;
+  }
+
+  async download() {
+    const bar = document.getElementById("prog-progress");
+    bar.value = 0;
+    this.say("downloading…");
+    const last = await postLines(m(this.ctx.id, "program/download"), { source: this.editor.getValue() }, (x) => {
+      if (x.progress !== undefined) {
+        bar.max = x.total;
+        bar.value = x.progress;
+      }
+    });
+    if (!last) return this.say("no answer", true);
+    if (last.ok === false) {
+      this.showDiagnostics(last.diagnostics);
+      return this.say(`${last.diagnostics.length} error(s): not downloaded`, true);
+    }
+    if (last.error) return this.say(last.error, true);
+    this.clearDiagnostics();
+    this.useMap(last.program.source_map);
+    await this.sendBreakpoints();
+    this.say(`downloaded ${last.words} words, verified by reading back (134)`);
+  }
+
+  /** The first address at a line, or at the next line with an instruction. */
+  addressOf(line) {
+    let best = null;
+    for (const [a, l] of this.map ?? []) if (l >= line && (best === null || l < best[1] || (l === best[1] && a < best[0]))) best = [a, l];
+    return best;
+  }
+
+  toggle(line) {
+    const info = this.editor.lineInfo(line - 1);
+    if (this.breakLines.has(line)) {
+      this.breakLines.delete(line);
+      this.editor.setGutterMarker(line - 1, "breakpoints", null);
+    } else {
+      this.breakLines.add(line);
+      this.editor.setGutterMarker(line - 1, "breakpoints", el("div", { class: "breakpoint", "data-testid": "breakpoint", text: "●" }));
+    }
+    void info;
+    if (this.map) this.sendBreakpoints();
+  }
+
+  async sendBreakpoints() {
+    const addresses = [...this.breakLines].map((l) => this.addressOf(l)).filter(Boolean).map(([a]) => a);
+    const st = await post(m(this.ctx.id, "program/breakpoints"), { addresses });
+    if (st.error) this.say(st.error, true);
+    else this.showState(st);
+  }
+
+  async act(action) {
+    const st = await post(m(this.ctx.id, `program/${action}`));
+    if (st.error) this.say(st.error, true);
+    else this.showState(st);
+  }
+
+  onSample(t, values, msg) {
+    if (msg.program) this.showState(msg.program);
+  }
+
+  showState(st) {
+    const set = (id, v) => (document.getElementById(id).textContent = v ?? "–");
+    if (this.current !== undefined) {
+      this.editor.removeLineClass(this.current, "background", "cm-current-line");
+      this.current = undefined;
+    }
+    if (!st) {
+      for (const id of ["ps-mode", "ps-pc", "ps-acc", "ps-x", "ps-flags", "ps-stack", "ps-break"]) set(id, null);
+      return;
+    }
+    set("ps-mode", `${st.mode}${st.waiting ? " (WAIT)" : ""}`);
+    set("ps-pc", String(st.pc));
+    set("ps-acc", String(st.accumulator));
+    set("ps-x", String(st.x));
+    set("ps-flags", st.flags ?? "not reported over TMCL");
+    set("ps-stack", st.stack_depth ?? "not reported over TMCL");
+    set("ps-break", st.breakpoint === null ? "–" : `at address ${st.breakpoint}`);
+    document.getElementById("ps-vars").replaceChildren(
+      ...st.user_variables.map((v, i) => el("tr", {}, el("td", { text: `#${i}` }), el("td", { text: v ?? "–" }))),
+    );
+    const line = this.map?.get(st.pc);
+    if (line !== undefined && !this.stale) {
+      this.current = this.editor.getLineHandle(line - 1);
+      this.editor.addLineClass(this.current, "background", "cm-current-line");
+      document.getElementById("editor").dataset.currentLine = String(line);
+    } else {
+      delete document.getElementById("editor").dataset.currentLine;
+    }
+  }
+}

@@ -1,0 +1,115 @@
+"""Fixtures of the browser IDE's end-to-end tests: `tmclsim serve --web`
+(and `tmclsim ide`) processes on loopback, and a page in Debian's chromium
+driven by Playwright. Everything started here is stopped here."""
+
+import os
+import pathlib
+import re
+import subprocess
+import sys
+import time
+
+import pytest
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
+from tmclsim_binary import ROOT, tmclsim_binary  # noqa: E402
+
+CHROMIUM = os.environ.get("TMCLSIM_CHROMIUM", "/usr/bin/chromium")
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+SHOTS = ROOT / "docs" / "ide"
+
+
+class Process:
+    """A tmclsim process printing `key: value` lines up to `last`."""
+
+    def __init__(self, args, last):
+        self.proc = subprocess.Popen([tmclsim_binary(), *args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.lines = []
+        deadline = time.monotonic() + 30
+        while True:
+            line = self.proc.stdout.readline()
+            if not line:
+                raise RuntimeError(f"tmclsim {args[0]} exited: " + "".join(self.lines))
+            self.lines.append(line)
+            if line.startswith(last):
+                break
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"tmclsim {args[0]} did not start")
+
+    def printed(self, key):
+        m = re.search(rf"^\s*{key}: (\S+)", "".join(self.lines), re.M)
+        return m.group(1) if m else None
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self.proc.stdout.close()
+
+
+@pytest.fixture
+def start():
+    """Starts tmclsim processes; all are stopped at teardown."""
+    started = []
+
+    def run(args, last="connect with:"):
+        p = Process(args, last)
+        started.append(p)
+        return p
+
+    yield run
+    for p in started:
+        p.stop()
+
+
+@pytest.fixture
+def served(start):
+    """A virtual TMCM-1141 on TCP with the IDE beside it."""
+    s = start(["serve", "--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0"])
+    s.tcp = s.printed("tcp")
+    s.url = s.printed("web")
+    return s
+
+
+@pytest.fixture(scope="session")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    if not os.path.exists(CHROMIUM):
+        pytest.fail(f"no chromium at {CHROMIUM} (apt-get install chromium, or set TMCLSIM_CHROMIUM)")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser):
+    context = browser.new_context(viewport={"width": 1280, "height": 800}, accept_downloads=True)
+    pg = context.new_page()
+    errors = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    yield pg
+    context.close()
+    assert not errors, f"errors in the page: {errors}"
+
+
+def open_app(page, url):
+    page.goto(url)
+    page.wait_for_function("window.tmclsimReady === true")
+    return page
+
+
+def tab(page, name):
+    page.click(f"[data-testid=tab-{name}]")
+
+
+def shot(page, name):
+    """A screenshot for docs/ide.md, taken by the tests so it stays current."""
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(SHOTS / f"{name}.png"))

@@ -1,0 +1,187 @@
+"""The browser IDE end to end: a real browser (Debian's chromium, driven by
+Playwright), the app served by `tmclsim serve --web`, and PyTrinamic on the
+module's TCP link at the same time."""
+
+import json
+import re
+import urllib.error
+import urllib.request
+
+from conftest import open_app, shot, tab
+from pytrinamic.connections import ConnectionManager
+from pytrinamic.modules import TMCM1141
+
+COUNTER_WITH_ERROR = """// counts in the accumulator
+Start:  SAP 4, 0, 1000
+Loop:   CALC ADD, 1
+        WAIT TICKS, 0, 1
+        JA Lop
+"""
+
+
+def pytrinamic(served):
+    return ConnectionManager(f"--interface socket_serial_tmcl --port {served.tcp}").connect()
+
+
+def test_module_list_and_filter(served, page, start):
+    bus = start(["serve", "--bus", "tmcm-1141@1,tmcm-351@2,tmcm-6110@3", "--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0"])
+    open_app(page, bus.printed("web"))
+    items = page.locator("[data-testid=module-item]")
+    assert items.count() == 3
+    page.fill("[data-testid=module-filter]", "351")
+    assert items.count() == 1
+    assert "TMCM-351" in items.first.inner_text()
+    items.first.click()
+    page.wait_for_function("document.querySelector('[data-testid=module-title]').textContent.includes('TMCM-351')")
+    page.fill("[data-testid=module-filter]", "")
+    shot(page, "modules")
+
+
+def test_a_parameter_changed_in_the_grid_is_read_by_pytrinamic(served, page):
+    open_app(page, served.url)
+    tab(page, "params")
+    page.fill("[data-testid=param-filter]", "maximum positioning speed")
+    # Out of range (AP 4 takes 1…2047): refused in the app, nothing sent.
+    page.fill("[data-testid=edit-ap-0-4]", "5000")
+    page.click("[data-testid=set-ap-0-4]")
+    assert "outside 1…2047" in page.inner_text("[data-testid=param-status]")
+    page.fill("[data-testid=edit-ap-0-4]", "1234")
+    page.click("[data-testid=set-ap-0-4]")
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '1234'")
+    with pytrinamic(served) as interface:
+        assert TMCM1141(interface).motors[0].get_axis_parameter(4) == 1234
+        # And the other way round: PyTrinamic writes, the grid shows it.
+        TMCM1141(interface).motors[0].set_axis_parameter(4, 777)
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '777'")
+    page.fill("[data-testid=param-filter]", "")
+    shot(page, "parameters")
+
+
+def test_a_move_from_pytrinamic_shows_on_the_chart_and_the_position(served, page):
+    open_app(page, served.url)
+    tab(page, "charts")
+    with pytrinamic(served) as interface:
+        TMCM1141(interface).motors[0].move_to(51200)
+    page.wait_for_function("Number(document.querySelector('[data-testid=ro-position]').textContent) > 0")
+    page.wait_for_function("Number(document.querySelector('[data-testid=ro-position]').textContent) === 51200", timeout=30000)
+    # The position chart's last sample is the module's position.
+    info = page.inner_text("[data-testid=chart-info]")
+    assert re.search(r"\d+ samples", info), info
+    assert page.locator("[data-testid=chart-position] canvas").count() == 1
+    page.wait_for_timeout(500)
+    shot(page, "charts")
+    with page.expect_download() as d:
+        page.click("[data-testid=chart-csv]")
+    csv = open(d.value.path()).read().splitlines()
+    assert csv[0].startswith("t_s,Actual position (AP 1)")
+    assert csv[-1].split(",")[1] == "51200"
+    tab(page, "motion")
+    assert page.inner_text("[data-testid=ro-position]") == "51200"
+    shot(page, "motion")
+
+
+def test_direct_mode_answers_in_words(served, page):
+    open_app(page, served.url)
+    page.fill("[data-testid=direct-input]", "SAP maximum_positioning_speed, 0, 1500")
+    page.press("[data-testid=direct-input]", "Enter")
+    page.fill("[data-testid=direct-input]", "GAP 4, 0")
+    page.click("[data-testid=direct-send]")
+    replies = page.locator("[data-testid=direct-reply]")
+    replies.nth(1).wait_for()
+    assert replies.nth(1).inner_text().startswith("Maximum positioning speed (4) = 1500")
+    page.fill("[data-testid=direct-input]", "GPA 4, 0")
+    page.press("[data-testid=direct-input]", "Enter")
+    replies.nth(2).wait_for()
+    assert "did you mean 'GAP'" in replies.nth(2).inner_text()
+    # History: the arrow key brings the last line back; Tab completes names.
+    page.press("[data-testid=direct-input]", "ArrowUp")
+    assert page.input_value("[data-testid=direct-input]") == "GPA 4, 0"
+    page.fill("[data-testid=direct-input]", "GAP actual_pos")
+    page.press("[data-testid=direct-input]", "Tab")
+    assert page.input_value("[data-testid=direct-input]") == "GAP actual_position"
+    page.fill("[data-testid=direct-input]", "")
+    shot(page, "direct")
+
+
+def test_a_program_is_fixed_downloaded_and_stops_at_a_breakpoint(served, page):
+    open_app(page, served.url)
+    tab(page, "program")
+    page.evaluate("s => window.tmclEditor.setValue(s)", COUNTER_WITH_ERROR)
+    page.click("[data-testid=prog-assemble]")
+    diag = page.locator("[data-testid=diagnostic]")
+    diag.wait_for()
+    assert "5:12: unknown label 'Lop'" in diag.inner_text() and "did you mean 'Loop'" in diag.inner_text()
+    shot(page, "program-error")
+    page.evaluate("() => { const e = window.tmclEditor; e.setValue(e.getValue().replace('JA Lop', 'JA Loop')); }")
+    page.click("[data-testid=prog-download]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
+    assert page.locator("[data-testid=diagnostic]").count() == 0
+    progress = page.locator("[data-testid=prog-progress]")
+    assert progress.get_attribute("max") == progress.evaluate("p => String(p.value)") == "8"
+    # A breakpoint on line 4 (WAIT TICKS), by a click on its line number.
+    page.locator(".CodeMirror-linenumber").get_by_text("4", exact=True).click()
+    page.locator("[data-testid=breakpoint]").wait_for()
+    page.click("[data-testid=prog-run]")
+    page.wait_for_function("document.querySelector('[data-testid=editor]').dataset.currentLine === '4'")
+    page.wait_for_function("document.querySelector('[data-testid=ps-break]').textContent === 'at address 2'")
+    assert page.inner_text("[data-testid=ps-acc]") == "1"
+    assert page.locator(".cm-current-line").count() == 1
+    shot(page, "program")
+    page.click("[data-testid=prog-continue]")
+    page.wait_for_function("document.querySelector('[data-testid=ps-acc]').textContent === '2'")
+    page.click("[data-testid=prog-stop]")
+    page.wait_for_function("document.querySelector('[data-testid=ps-mode]').textContent.startsWith('stopped')")
+
+
+def test_a_stop_switch_pressed_in_the_world_panel_stops_the_motor(served, page):
+    open_app(page, served.url)
+    with pytrinamic(served) as interface:
+        TMCM1141(interface).motors[0].rotate(-500)
+    tab(page, "motion")
+    page.wait_for_function("Number(document.querySelector('[data-testid=ro-speed]').textContent) < 0")
+    tab(page, "world")
+    page.click("[data-testid=sw-left-press]")
+    page.wait_for_function("document.querySelector('[data-testid=sw-left-state]').textContent === 'pressed'")
+    shot(page, "world")
+    tab(page, "motion")
+    page.wait_for_function("document.querySelector('[data-testid=ro-speed]').textContent === '0'")
+    assert page.inner_text("[data-testid=ro-switches]").startswith("1 /")
+    with pytrinamic(served) as interface:
+        assert TMCM1141(interface).motors[0].actual_velocity == 0
+
+
+def test_io_panel_sets_an_output_and_shows_inputs(served, page):
+    open_app(page, served.url)
+    tab(page, "world")
+    page.click("[data-testid=world-in-1]")
+    tab(page, "io")
+    page.wait_for_selector("[data-testid=in-1].on")
+    page.click("[data-testid=out-0]")
+    page.wait_for_selector("[data-testid=out-0].on")
+    with pytrinamic(served) as interface:
+        # GIO 0, 2 reads the output back over the host's link.
+        assert interface.send(15, 0, 2, 0).value == 1
+    shot(page, "io")
+
+
+def test_ide_against_a_served_module_over_tcp(served, page, start):
+    ide = start(["ide", "--tcp", served.tcp, "--web", "127.0.0.1:0"], last="open:")
+    open_app(page, ide.printed("open"))
+    assert "TMCL link" in page.inner_text("[data-testid=target]")
+    assert "TMCM-1141" in page.inner_text("[data-testid=module-item]")
+    page.fill("[data-testid=direct-input]", "GAP 1, 0")
+    page.press("[data-testid=direct-input]", "Enter")
+    page.locator("[data-testid=direct-reply]").wait_for()
+    assert page.inner_text("[data-testid=direct-reply]").startswith("Actual position (1) = 0")
+    tab(page, "world")
+    assert page.is_visible("#world-none")
+
+
+def test_a_foreign_origin_is_refused(served):
+    req = urllib.request.Request(served.url + "api/modules", headers={"Origin": "http://attacker.example"})
+    try:
+        urllib.request.urlopen(req)
+        raise AssertionError("a foreign origin was served")
+    except urllib.error.HTTPError as e:
+        assert e.code == 403
+        assert "refused" in json.loads(e.read())["error"]
