@@ -38,6 +38,7 @@ from ._tmclsim import (
     status_text,
 )
 from .errors import AssemblyError, Diagnostic, InternalError, TmclError
+from .sweep import sweep
 
 __all__ = [
     "AssemblyError",
@@ -58,6 +59,7 @@ __all__ = [
     "profiles",
     "status_text",
     "serve",
+    "sweep",
 ]
 
 __version__ = "0.1.0"

@@ -18,6 +18,7 @@ mod progress;
 mod run;
 mod send;
 mod serve;
+mod sweep;
 mod upload;
 
 #[derive(Parser)]
@@ -53,6 +54,8 @@ enum Command {
     FleetBench(fleet::FleetBenchArgs),
     /// The browser IDE against modules on a TMCL link (real or virtual), polled as a host does.
     Ide(ide::IdeArgs),
+    /// Run a TMCL program against every scenario of a matrix file, here or on a Dask cluster (docs/sweeps.md).
+    Sweep(sweep::SweepArgs),
 }
 
 #[derive(Args)]
@@ -205,6 +208,7 @@ fn main() -> ExitCode {
         Command::Send(a) => send::run(a),
         Command::Console(a) => console::run(a),
         Command::Ide(a) => ide::run(a),
+        Command::Sweep(a) => sweep::run(a),
         Command::Profile(a) => profile(&a.module),
         Command::Bench(a) => bench::run(a),
         Command::Asm(a) => asm::asm(a),

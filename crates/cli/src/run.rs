@@ -55,6 +55,40 @@ pub struct RunArgs {
     /// The world: a TOML file (docs/world.md), `stage` (default) or `free`.
     #[arg(long, value_name = "FILE", default_value = "stage")]
     pub world: String,
+    /// Direct-mode commands to give the module before the program starts,
+    /// one per line (`SAP 4, 0, 1000`, parameter names allowed, `//`
+    /// comments), e.g. the parameter set a sweep wrote beside a failure.
+    #[arg(long, value_name = "FILE")]
+    pub setup: Option<std::path::PathBuf>,
+}
+
+/// Gives the module the commands of a setup file; a command the module
+/// refuses is an error naming its line.
+fn setup(module: &mut Module, path: &std::path::Path) -> Result<(), String> {
+    use tmclsim_firmware::files::{MAX_CONFIG_BYTES, read_text_limited};
+    let text = read_text_limited(path, MAX_CONFIG_BYTES, "a setup file")?;
+    let profile = module.profile().clone();
+    for (n, raw) in text.lines().enumerate() {
+        let line = raw.split("//").next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let at = format!("{}:{}", path.display(), n + 1);
+        let ins = tmclsim_host::line::parse(line, Some(&profile)).map_err(|e| format!("{at}:{}: {}", e.column, e.message))?;
+        let frame = tmclsim_protocol::Request::new(module.address(), ins).encode();
+        match module.handle_frame(&frame).and_then(|r| tmclsim_protocol::Reply::decode(&r)) {
+            Some(r) if r.status >= 100 => {}
+            Some(r) => {
+                return Err(format!(
+                    "{at}: '{line}' answered status {} ({})",
+                    r.status,
+                    tmclsim_protocol::Status::from_code(r.status).map_or("unknown", |s| s.describe())
+                ));
+            }
+            None => return Err(format!("{at}: '{line}' got no reply")),
+        }
+    }
+    Ok(())
 }
 
 /// Parses `500ms`, `10s`, `5m`, `1h`, `2.5` (seconds) into nanoseconds.
@@ -91,6 +125,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
     let mut module = Module::with_world(profile.clone(), tmclsim_firmware::Eeprom::new(&profile.module.name), world);
     module.load_program(&program.instructions).map_err(|s| format!("the program does not fit the module: {s}"))?;
+    if let Some(path) = &args.setup {
+        setup(&mut module, path)?;
+    }
     let mut breakpoints = Vec::new();
     for b in &args.breakpoints {
         breakpoints.push(crate::debugger::resolve(b, &program).map_err(|e| format!("--break {e}"))?);

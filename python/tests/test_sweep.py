@@ -1,0 +1,180 @@
+"""Scenario sweeps (docs/sweeps.md): matrix files, scenarios run in virtual
+time, pass/fail from the simulator, failures that `tmclsim run` reproduces,
+and the same table from one process, an embedded Dask cluster and a real
+`dask scheduler` with two `dask worker` processes."""
+
+import os
+import pathlib
+import re
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+import tmclsim
+from tmclsim.sweep import MatrixError, parse
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HOMING = ROOT / "examples" / "sweep-homing" / "homing.tmc"
+
+# Homing by reference search; user variable 0: 1 homed, 2 timed out.
+SMALL = {
+    "duration": "60s",
+    "step": "100ms",
+    "metrics": ["time", "position", "carriage", "var 0"],
+    "world": {"base": "stage", "axis": [{"home_switch": {"from": 0, "width": 2000}}]},
+    "vary": [
+        {"name": "home", "world": "axis.0.home_switch.from", "values": [-400000, 800000]},
+        {"name": "load", "world": "axis.0.load.0.torque", "values": [0, 60]},
+    ],
+    "check": [{"name": "homed", "expr": "var 0 == 1"}],
+}
+
+
+def tmclsim_bin():
+    path = os.environ.get("TMCLSIM_BIN") or str(ROOT / "target" / "release" / "tmclsim")
+    if not os.path.exists(path):
+        subprocess.run(["cargo", "build", "--release", "-p", "tmclsim"], cwd=ROOT, check=True)
+    return path
+
+
+def test_the_simulator_decides_pass_and_fail():
+    t = tmclsim.sweep(HOMING, SMALL, workers=0)
+    assert list(t.columns[:3]) == ["scenario", "home", "load"]
+    by = {(r.home, r.load): r for r in t.itertuples()}
+    # A home switch on the search's way, no load: homed, counter 0 there.
+    ok = by[(-400000, 0)]
+    assert ok.passed and ok.failed_check == ""
+    assert ok.position == 0
+    # The negative search meets the switch at its upper edge (from + width).
+    assert ok.carriage == -400000 + 2000
+    # Beyond the left stop and back takes longer than the program's 40 s
+    # timeout; a load of 60 % stalls the motor at the search speed.
+    for key in [(800000, 0), (-400000, 60), (800000, 60)]:
+        r = by[key]
+        assert not r.passed and r.failed_check == "homed"
+        assert r.time > 40.0
+    assert t.loc[t.home == -400000].loc[t.load == 60, "var 0"].item() == 2
+
+
+def test_parameters_by_name_and_random_draws_are_reproducible():
+    m = dict(SMALL)
+    m["seed"] = 7
+    m["vary"] = [
+        {"name": "speed", "ap": "reference_search_speed", "motor": 0, "values": [500, 2047]},
+        {"name": "home", "world": "axis.0.home_switch.from", "random": {"min": -600000, "max": -100000, "count": 3}},
+    ]
+    a = tmclsim.sweep(HOMING, m, workers=0)
+    b = tmclsim.sweep(HOMING, m, workers=0)
+    assert a.equals(b)
+    assert len(a) == 6 and a.home.nunique() == 3
+    assert all(-600000 <= h <= -100000 for h in a.home)
+    # The program sets AP 194 itself (2047): a varied AP 194 is overwritten,
+    # so both speeds home alike; the parameter reached the module first.
+    assert a.passed.all()
+
+
+def test_matrix_errors_name_the_key():
+    cases = [
+        ({"vary": [{"world": "axis.0.start"}]}, "vary[0]: give exactly one of values"),
+        ({"vary": [{"ap": 4, "values": []}]}, "vary[0].values: a non-empty list"),
+        ({"vary": [{"world": "x", "ap": 4, "values": [1]}]}, "vary[0]: name what it varies"),
+        ({"check": [{"expr": "var 0 = 1"}]}, "check[0].expr"),
+        ({"duration": "soon"}, "duration: 'soon' is not a duration"),
+        ({"metrics": ["speed"]}, "metrics[0]: 'speed'"),
+        ({"colour": 1}, "colour: unknown key"),
+        ({"vary": [{"world": "a", "range": [10, 0, 1]}]}, "vary[0].range"),
+    ]
+    for doc, message in cases:
+        with pytest.raises(MatrixError) as e:
+            parse(doc)
+        assert message in str(e.value), (doc, str(e.value))
+
+
+def test_a_failure_is_reproduced_by_tmclsim_run(tmp_path):
+    m = dict(SMALL)
+    m["vary"] = SMALL["vary"] + [{"name": "accel", "ap": 5, "motor": 0, "values": [1500]}]
+    s = tmclsim.sweep(HOMING, m, workers=0, failures=tmp_path, details=True)
+    failed = s.table[~s.table.passed]
+    assert len(failed) == 3 and set(s.failures) == set(failed.scenario)
+    row = failed.iloc[0]
+    i = int(row.scenario)
+    setup = (tmp_path / f"failure-{i}.setup").read_text()
+    assert "SAP 5, 0, 1500" in setup
+    out = subprocess.run(
+        [tmclsim_bin(), "run", str(HOMING), "--world", str(tmp_path / f"failure-{i}.toml"),
+         "--setup", str(tmp_path / f"failure-{i}.setup"), "--for", f"{row.time}s"],
+        capture_output=True, text=True, check=True,
+    ).stdout
+    # The same final state as in the sweep: position counter and variable 0.
+    assert re.search(rf"axis 0: position {int(row.position)} ", out), out
+    assert re.search(rf"user variables 0={int(row['var 0'])}\b", out), out
+
+
+def same(a, b):
+    return a.drop(columns=[]).to_dict("records") == b.to_dict("records")
+
+
+def test_an_embedded_cluster_gives_the_serial_table(tmp_path):
+    serial = tmclsim.sweep(HOMING, SMALL, workers=0)
+    parallel = tmclsim.sweep(HOMING, SMALL, workers=2, batch=1, out=tmp_path / "r.parquet")
+    assert same(serial, parallel)
+    import pandas as pd
+
+    assert same(serial, pd.read_parquet(tmp_path / "r.parquet"))
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_a_real_scheduler_and_two_workers_give_the_serial_table():
+    dask = os.path.join(os.path.dirname(sys.executable), "dask")
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        for _ in range(2):
+            procs.append(subprocess.Popen([dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--host", "127.0.0.1", "--no-dashboard"],
+                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        from dask.distributed import Client
+
+        with Client(address, timeout=30) as c:
+            c.wait_for_workers(2, timeout=60)
+            assert len(c.scheduler_info()["workers"]) == 2
+        serial = tmclsim.sweep(HOMING, SMALL, workers=0)
+        remote = tmclsim.sweep(HOMING, SMALL, scheduler=address, batch=1)
+        assert same(serial, remote)
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+
+def test_the_command_line(tmp_path):
+    matrix = tmp_path / "m.toml"
+    matrix.write_text('duration = "60s"\nmetrics = ["time"]\n[world]\naxis = [{ home_switch = { from = 0, width = 2000 } }]\n'
+                      '[[vary]]\nworld = "axis.0.home_switch.from"\nvalues = [-400000, 800000]\n'
+                      '[[check]]\nname = "homed"\nexpr = "var 0 == 1"\n')
+    env = dict(os.environ, TMCLSIM_PYTHON=sys.executable)
+    out = tmp_path / "r.csv"
+    r = subprocess.run([tmclsim_bin(), "sweep", str(HOMING), "--matrix", str(matrix), "--workers", "0", "--out", str(out),
+                        "--failures", str(tmp_path / "f")], capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert r.returncode == 1, r.stderr  # a failure: exit status 1
+    assert "2 scenarios" in r.stdout and "1 passed, 1 failed" in r.stdout and "homed" in r.stdout
+    assert "--world " in r.stdout and (tmp_path / "f" / "failure-1.toml").exists()
+    assert out.read_text().splitlines()[0].startswith("scenario,axis.0.home_switch.from,passed")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[[vary]]\nworld = 3\nvalues = [1]\n")
+    r = subprocess.run([tmclsim_bin(), "sweep", str(HOMING), "--matrix", str(bad)], capture_output=True, text=True, env=env)
+    assert r.returncode == 2 and "vary[0].world" in r.stderr

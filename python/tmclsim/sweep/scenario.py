@@ -1,0 +1,201 @@
+"""One scenario: a virtual module in its world with its parameter set, the
+program run in virtual time until it ends, a stop condition holds or the
+duration is over; then the checks and the metrics. Pure and deterministic:
+the same scenario gives the same row on any machine."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, Dict, List, Optional, Tuple
+
+from .matrix import Check, Condition, Matrix, MatrixError, Read
+
+
+class ScenarioError(Exception):
+    """The scenario could not be set up (a world value or a parameter the
+    module refuses)."""
+
+
+def set_world(doc: Dict[str, Any], path: str, value: Any) -> None:
+    """Sets a dotted key of a world document (`axis.0.home_switch.from`;
+    numbers index lists, which grow as needed). `…switch.width` of the home
+    switch sets `to` from `from`."""
+    parts = path.split(".")
+    node: Any = doc
+    for i, part in enumerate(parts[:-1]):
+        nxt = parts[i + 1]
+        want = [] if nxt.isdigit() else {}
+        if part.isdigit():
+            if not isinstance(node, list):
+                raise MatrixError(f"world key {path}: '{part}' indexes a list")
+            k = int(part)
+            while len(node) <= k:
+                node.append(copy.deepcopy(want))
+            node = node[k]
+        else:
+            if not isinstance(node, dict):
+                raise MatrixError(f"world key {path}: '{part}' names a table")
+            node = node.setdefault(part, want)
+    last = parts[-1]
+    if last.isdigit():
+        raise MatrixError(f"world key {path}: ends in a list index")
+    node[last] = value
+
+
+def world_document(mx: Matrix, values: Dict[str, Any]) -> Dict[str, Any]:
+    doc = copy.deepcopy(mx.world)
+    for a in mx.axes:
+        if a.target == "world":
+            set_world(doc, a.key, values[a.name])
+    # A home switch given as from + width.
+    for axis in doc.get("axis", []) if isinstance(doc.get("axis"), list) else []:
+        home = axis.get("home_switch") if isinstance(axis, dict) else None
+        if isinstance(home, dict) and "width" in home:
+            width = home.pop("width")
+            home["to"] = home.get("from", 0) + width
+    return doc
+
+
+def world_toml(doc: Dict[str, Any]) -> str:
+    import tomli_w
+
+    return tomli_w.dumps(doc)
+
+
+def _number(m, kind: str, what: Any, index: int) -> int:
+    """A parameter's number from its number or its name."""
+    if isinstance(what, int):
+        return what
+    rows = m.axis_parameters() if kind == "ap" else m.global_parameters(index)
+    w = str(what).lower().replace(" ", "_")
+    for r in rows:
+        if r["snake_name"] == w or r["name"].lower() == str(what).lower():
+            return r["number"]
+    raise ScenarioError(f"the {m.profile} has no {'axis' if kind == 'ap' else 'global'} parameter '{what}'")
+
+
+def setup_lines(m, mx: Matrix, values: Dict[str, Any]) -> List[str]:
+    """The matrix's setup commands, then one SAP/SGP per varied parameter."""
+    lines = list(mx.setup)
+    for a in mx.axes:
+        if a.target in ("ap", "gp"):
+            v = values[a.name]
+            if isinstance(v, float) and not v.is_integer():
+                raise ScenarioError(f"{a.name}: a parameter takes whole numbers, not {v}")
+            op = "SAP" if a.target == "ap" else "SGP"
+            lines.append(f"{op} {_number(m, a.target, a.key, a.index)}, {a.index}, {int(v)}")
+    return lines
+
+
+def read(m, r: Read) -> int:
+    if r.kind == "var":
+        return m.get_global_parameter(r.what, 2)
+    if r.kind == "ap":
+        return m.get_axis_parameter(r.what, r.index)
+    return m.get_global_parameter(r.what, r.index)
+
+
+def profile_of(mx: Matrix, values: Dict[str, Any]) -> str:
+    for a in mx.axes:
+        if a.target == "profile":
+            return str(values[a.name]).lower()
+    return mx.profile
+
+
+def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, Any]) -> Tuple[Dict[str, Any], Optional[Dict[str, str]]]:
+    """Runs one scenario: its row, and for a failure the files that
+    reproduce it (world TOML and setup lines)."""
+    import tmclsim
+
+    row: Dict[str, Any] = {"scenario": index, **values}
+    profile = profile_of(mx, values)
+    doc = world_document(mx, values)
+    text = world_toml(doc)
+    try:
+        m = tmclsim.Module(profile, world=text)
+        m.load_program(tmclsim.Program.from_binary(programs[profile]))
+        lines = setup_lines(m, mx, values)
+        for line in lines:
+            r = m.send(line)
+            if r is None or r.status < 100:
+                raise ScenarioError(f"'{line}' answered {'nothing' if r is None else f'status {r.status} ({r.description})'}")
+    except (ValueError, ScenarioError, MatrixError) as e:
+        row.update(passed=False, failed_check="setup", error=str(e))
+        for name in mx.metrics:
+            row[name] = None
+        return row, {"world": text, "setup": ""}
+    m.run()
+    axes = m.axes
+    stalled = end_stop = False
+    max_load = max_speed = 0
+    ended_at: Optional[float] = None
+    watch_load = "max_load" in mx.metrics
+    t = 0.0
+    while t < mx.duration - 1e-12:
+        step = min(mx.step, mx.duration - t)
+        m.advance(step)
+        t = m.time
+        for a in range(axes):
+            speed = abs(m.actual_speed(a))
+            max_speed = max(max_speed, speed)
+            left, right, _home = m.switches(a)
+            end_stop = end_stop or left or right
+            if any(c.kind == "no_stall" for c in mx.checks) or "stalled" in mx.metrics:
+                # AP 207 reads 1 after a stallGuard stop (and is cleared by
+                # the read, as a host's read would).
+                try:
+                    stalled = stalled or m.get_axis_parameter(207, a) != 0
+                except Exception:
+                    pass
+            if watch_load:
+                try:
+                    max_load = max(max_load, m.get_axis_parameter(206, a))
+                except Exception:
+                    pass
+        if m.program_mode == "stop" and ended_at is None:
+            ended_at = t
+            if mx.stop_program_ended:
+                break
+        if any(c.holds(read(m, c.read)) for c in mx.stop_when):
+            break
+    failed = ""
+    for c in mx.checks:
+        ok = _check(m, c, ended_at, stalled, end_stop)
+        if not ok:
+            failed = c.name
+            break
+    row.update(passed=not failed, failed_check=failed, error="")
+    for name in mx.metrics:
+        row[name] = {
+            "time": lambda: round(m.time, 9),
+            "position": lambda: m.actual_position(0),
+            "carriage": lambda: m.mechanical_position(0),
+            "max_load": lambda: max_load,
+            "max_speed": lambda: max_speed,
+            "stalled": lambda: stalled,
+            "end_stop": lambda: end_stop,
+        }.get(name, lambda: None)()
+    for r in mx.metric_reads:
+        row[r.label()] = read(m, r)
+    files = None if not failed else {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
+    return row, files
+
+
+def _check(m, c: Check, ended_at, stalled, end_stop) -> bool:
+    if c.kind == "expr":
+        cond: Condition = c.condition
+        return cond.holds(read(m, cond.read))
+    if c.kind == "no_stall":
+        return not stalled
+    if c.kind == "no_end_stop":
+        return not end_stop
+    if c.kind == "program_ended":
+        return ended_at is not None
+    if c.kind == "finished_within":
+        return ended_at is not None and ended_at <= c.seconds + 1e-9
+    raise AssertionError(c.kind)
+
+
+def run_batch(mx: Matrix, programs: Dict[str, bytes], batch: List[Tuple[int, Dict[str, Any]]]):
+    """A batch of scenarios in one process (one Dask task)."""
+    return [run(mx, programs, i, values) for i, values in batch]
