@@ -129,34 +129,35 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
     stalled = end_stop = False
     max_load = max_speed = 0
     ended_at: Optional[float] = None
+    # Only what a check or a metric needs is looked at after each step.
+    kinds = {c.kind for c in mx.checks}
+    watch_speed = "max_speed" in mx.metrics
+    watch_switches = "no_end_stop" in kinds or "end_stop" in mx.metrics
+    watch_stall = "no_stall" in kinds or "stalled" in mx.metrics
     watch_load = "max_load" in mx.metrics
+    watch_any = watch_speed or watch_switches or watch_stall or watch_load
     t = 0.0
     while t < mx.duration - 1e-12:
-        step = min(mx.step, mx.duration - t)
-        m.advance(step)
+        m.advance(min(mx.step, mx.duration - t))
         t = m.time
-        for a in range(axes):
-            speed = abs(m.actual_speed(a))
-            max_speed = max(max_speed, speed)
-            left, right, _home = m.switches(a)
-            end_stop = end_stop or left or right
-            if any(c.kind == "no_stall" for c in mx.checks) or "stalled" in mx.metrics:
+        for a in range(axes) if watch_any else ():
+            if watch_speed:
+                max_speed = max(max_speed, abs(m.actual_speed(a)))
+            if watch_switches:
+                left, right, _home = m.switches(a)
+                end_stop = end_stop or left or right
+            if watch_stall:
                 # AP 207 reads 1 after a stallGuard stop (and is cleared by
                 # the read, as a host's read would).
-                try:
-                    stalled = stalled or m.get_axis_parameter(207, a) != 0
-                except Exception:
-                    pass
+                stalled = stalled or m.get_axis_parameter(207, a) != 0
             if watch_load:
-                try:
-                    max_load = max(max_load, m.get_axis_parameter(206, a))
-                except Exception:
-                    pass
-        if m.program_mode == "stop" and ended_at is None:
+                max_load = max(max_load, m.get_axis_parameter(206, a))
+        if mx.stop_program_ended and m.program_mode == "stop":
             ended_at = t
-            if mx.stop_program_ended:
-                break
-        if any(c.holds(read(m, c.read)) for c in mx.stop_when):
+            break
+        if ended_at is None and not mx.stop_program_ended and m.program_mode == "stop":
+            ended_at = t
+        if mx.stop_when and any(c.holds(read(m, c.read)) for c in mx.stop_when):
             break
     failed = ""
     for c in mx.checks:
