@@ -57,7 +57,8 @@ pub struct RunArgs {
     pub world: String,
     /// Direct-mode commands to give the module before the program starts,
     /// one per line (`SAP 4, 0, 1000`, parameter names allowed, `//`
-    /// comments), e.g. the parameter set a sweep wrote beside a failure.
+    /// comments), e.g. the parameter set a sweep wrote beside a failure
+    /// (docs/behaviour.md rule 87).
     #[arg(long, value_name = "FILE")]
     pub setup: Option<std::path::PathBuf>,
 }

@@ -1,7 +1,8 @@
 //! Modules reached over a TMCL link (`tmclsim ide --tcp` / `--port`), real
 //! or virtual, polled as a host polls them. TMCL has no breakpoints: with
 //! breakpoints set, `run` single-steps the program (130) and reads the
-//! program counter (135 type 1) after every step, until it reaches one.
+//! program counter (135 type 1) after every step, until it reaches one
+//! (docs/behaviour.md rule 86).
 
 use crate::target::{ModuleEntry, Target, TargetError, check};
 use std::collections::HashMap;

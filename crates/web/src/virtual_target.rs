@@ -1,6 +1,7 @@
 //! The modules this process serves (`tmclsim serve --web`): requests go
 //! through `SharedBus::frame`, the path of a frame from a link, so the app
-//! and a host on the link see each other's effects.
+//! and a host on the link see each other's effects (docs/behaviour.md
+//! rule 86).
 
 use crate::target::{ModuleEntry, Target, TargetError};
 use std::sync::Arc;

@@ -1,7 +1,8 @@
 """One scenario: a virtual module in its world with its parameter set, the
 program run in virtual time until it ends, a stop condition holds or the
 duration is over; then the checks and the metrics. Pure and deterministic:
-the same scenario gives the same row on any machine."""
+the same scenario gives the same row on any machine (docs/behaviour.md
+rule 87)."""
 
 from __future__ import annotations
 
