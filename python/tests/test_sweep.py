@@ -178,3 +178,22 @@ def test_the_command_line(tmp_path):
     bad.write_text("[[vary]]\nworld = 3\nvalues = [1]\n")
     r = subprocess.run([tmclsim_bin(), "sweep", str(HOMING), "--matrix", str(bad)], capture_output=True, text=True, env=env)
     assert r.returncode == 2 and "vary[0].world" in r.stderr
+
+
+def test_world_keys_reach_lists_of_tables_and_of_numbers():
+    from tmclsim.sweep.scenario import set_world
+
+    doc = {"base": "stage"}
+    set_world(doc, "axis.0.load.1.torque", 30)
+    set_world(doc, "inputs.2", 1)
+    set_world(doc, "axis.0.start", -5000)
+    assert doc == {"base": "stage", "axis": [{"load": [{}, {"torque": 30}], "start": -5000}], "inputs": [0, 0, 1]}
+    # The input reaches the module: GIO 2, 0 reads 1 in the scenario.
+    m = {"duration": "1s", "step": "1s", "metrics": ["gp 0 2"],
+         "setup": [], "vary": [{"name": "in2", "world": "inputs.2", "values": [0, 1]}],
+         "check": [{"name": "input seen", "expr": "var 0 == 0"}]}
+    # The program copies input 2 into user variable 0.
+    program = tmclsim.assemble("GIO 2, 0\nAGP 0, 2\nSTOP\n")
+    t = tmclsim.sweep(program, m, workers=0)
+    assert list(t["gp 0 2"]) == [0, 1]
+    assert list(t.passed) == [True, False]

@@ -25,6 +25,8 @@ def set_world(doc: Dict[str, Any], path: str, value: Any) -> None:
     node: Any = doc
     for i, part in enumerate(parts[:-1]):
         nxt = parts[i + 1]
+        # A list when the next part is a number; its entries are tables,
+        # unless it is the last part (a list of numbers, `inputs.2`).
         want = [] if nxt.isdigit() else {}
         if part.isdigit():
             if not isinstance(node, list):
@@ -39,8 +41,15 @@ def set_world(doc: Dict[str, Any], path: str, value: Any) -> None:
             node = node.setdefault(part, want)
     last = parts[-1]
     if last.isdigit():
-        raise MatrixError(f"world key {path}: ends in a list index")
-    node[last] = value
+        # An entry of a list of numbers (`inputs.2`, `analog.0`).
+        if not isinstance(node, list):
+            raise MatrixError(f"world key {path}: '{last}' indexes a list")
+        k = int(last)
+        while len(node) <= k:
+            node.append(0)
+        node[k] = value
+    else:
+        node[last] = value
 
 
 def world_document(mx: Matrix, values: Dict[str, Any]) -> Dict[str, Any]:
