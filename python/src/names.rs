@@ -12,18 +12,8 @@ pub fn key(name: &str) -> String {
 }
 
 /// The snake_case spelling of a profile name ("Maximum positioning
-/// speed" → "maximum_positioning_speed").
-pub fn snake_case(name: &str) -> String {
-    let mut out = String::new();
-    for c in name.chars() {
-        if c.is_ascii_alphanumeric() {
-            out.push(c.to_ascii_lowercase());
-        } else if !out.is_empty() && !out.ends_with('_') {
-            out.push('_');
-        }
-    }
-    out.trim_end_matches('_').to_string()
-}
+/// speed" → "maximum_positioning_speed"), as the console and the IDE take it.
+pub use tmclsim_host::names::snake as snake_case;
 
 /// The parameter names of one profile.
 #[derive(Debug, Default)]

@@ -4,10 +4,9 @@
 use std::time::Duration;
 pub use tmclsim_host::{Client, hex};
 
-/// Where a module is (a tmclsim server or a real module): TCP or a serial
-/// port, and its address.
+/// A link to modules (a tmclsim server or real ones): TCP or a serial port.
 #[derive(clap::Args)]
-pub struct LinkArgs {
+pub struct Link {
     /// TCP address of the module (a tmclsim server or a serial-to-Ethernet bridge).
     #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
     pub tcp: Option<String>,
@@ -17,6 +16,13 @@ pub struct LinkArgs {
     /// Baud rate for --port.
     #[arg(long, default_value_t = 9600)]
     pub baud: u32,
+}
+
+/// Where a module is: the link, and its address.
+#[derive(clap::Args)]
+pub struct LinkArgs {
+    #[command(flatten)]
+    pub link: Link,
     /// Module address.
     #[arg(long, default_value_t = 1)]
     pub address: u8,
@@ -24,6 +30,7 @@ pub struct LinkArgs {
 
 impl LinkArgs {
     pub fn open(&self, timeout: Duration) -> Result<Client, String> {
-        Client::open(self.tcp.as_deref(), self.port.as_deref(), self.baud, self.address, timeout)
+        let l = &self.link;
+        Client::open(l.tcp.as_deref(), l.port.as_deref(), l.baud, self.address, timeout)
     }
 }

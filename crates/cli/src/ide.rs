@@ -8,15 +8,8 @@ use std::sync::Arc;
 
 #[derive(clap::Args)]
 pub struct IdeArgs {
-    /// TCP address of the modules (a tmclsim server or a serial-to-Ethernet bridge).
-    #[arg(long, value_name = "HOST:PORT", conflicts_with = "port", required_unless_present = "port")]
-    pub tcp: Option<String>,
-    /// Serial port of the modules (e.g. /dev/ttyACM0, or a tmclsim pty).
-    #[arg(long, value_name = "DEV")]
-    pub port: Option<String>,
-    /// Baud rate for --port.
-    #[arg(long, default_value_t = 9600)]
-    pub baud: u32,
+    #[command(flatten)]
+    pub link: crate::client::Link,
     /// The module addresses on the link (an RS485 bus has several).
     #[arg(long, value_name = "A,B,…", default_value = "1", value_delimiter = ',')]
     pub bus_addresses: Vec<u8>,
@@ -33,9 +26,9 @@ pub struct IdeArgs {
 
 pub fn run(args: IdeArgs) -> Result<ExitCode, String> {
     let target = tmclsim_web::LinkTarget::open(
-        args.tcp.as_deref(),
-        args.port.as_deref(),
-        args.baud,
+        args.link.tcp.as_deref(),
+        args.link.port.as_deref(),
+        args.link.baud,
         &args.bus_addresses,
         crate::millis(args.timeout),
     )?;

@@ -39,7 +39,7 @@ Tab completes mnemonics, symbols and parameter names.";
 pub fn run(args: ConsoleArgs) -> Result<ExitCode, String> {
     let mut client = args.link.open(crate::millis(args.timeout))?;
     let profile = profile(&mut client, args.module.as_deref())?;
-    let link = args.link.tcp.as_deref().map_or_else(|| args.link.port.clone().unwrap_or_default(), |t| format!("TCP {t}"));
+    let link = args.link.link.tcp.as_deref().map_or_else(|| args.link.link.port.clone().unwrap_or_default(), |t| format!("TCP {t}"));
     match &profile {
         Some(p) => println!(
             "{} (firmware V{}.{:02}) at address {} on {link}; help for help, quit to leave",
