@@ -15,3 +15,17 @@ def tmclsim_binary():
     if not built.exists():
         subprocess.run(["cargo", "build", "--release", "-p", "tmclsim"], cwd=ROOT, check=True)
     return str(built)
+
+
+def stop(proc):
+    """Stops a tmclsim process a test started: SIGTERM, then SIGKILL after
+    10 s; its piped output is closed."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+    if proc.stdout:
+        proc.stdout.close()

@@ -12,7 +12,7 @@ import time
 import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from tmclsim_binary import ROOT, tmclsim_binary  # noqa: E402
+from tmclsim_binary import ROOT, stop, tmclsim_binary  # noqa: E402
 
 CHROMIUM = os.environ.get("TMCLSIM_CHROMIUM", "/usr/bin/chromium")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -42,14 +42,7 @@ class Process:
         return m.group(1) if m else None
 
     def stop(self):
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        self.proc.stdout.close()
+        stop(self.proc)
 
 
 @pytest.fixture

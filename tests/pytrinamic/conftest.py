@@ -9,7 +9,7 @@ import time
 import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from tmclsim_binary import ROOT, tmclsim_binary  # noqa: E402,F401
+from tmclsim_binary import ROOT, stop, tmclsim_binary  # noqa: E402,F401
 
 
 class Served:
@@ -48,14 +48,7 @@ class Served:
         return answer
 
     def stop(self):
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        self.proc.stdout.close()
+        stop(self.proc)
 
 
 @pytest.fixture
