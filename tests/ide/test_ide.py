@@ -185,3 +185,22 @@ def test_a_foreign_origin_is_refused(served):
     except urllib.error.HTTPError as e:
         assert e.code == 403
         assert "refused" in json.loads(e.read())["error"]
+
+
+def test_a_drag_zooms_the_charts_and_pauses_them(served, page):
+    open_app(page, served.url)
+    tab(page, "charts")
+    page.wait_for_function("/\\d+ samples/.test(document.querySelector('[data-testid=chart-info]').textContent)")
+    page.wait_for_timeout(1500)
+    box = page.locator("[data-testid=chart-position] .u-over").bounding_box()
+    y = box["y"] + box["height"] / 2
+    page.mouse.move(box["x"] + box["width"] * 0.2, y)
+    page.mouse.down()
+    page.mouse.move(box["x"] + box["width"] * 0.6, y, steps=5)
+    page.mouse.up()
+    assert page.inner_text("[data-testid=chart-pause]") == "Resume"
+    info = page.inner_text("[data-testid=chart-info]")
+    page.wait_for_timeout(400)
+    assert page.inner_text("[data-testid=chart-info]") == info, "paused: no redraw"
+    page.click("[data-testid=chart-pause]")
+    page.wait_for_function(f"document.querySelector('[data-testid=chart-info]').textContent !== {info!r}")

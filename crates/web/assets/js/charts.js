@@ -13,12 +13,7 @@ export class ChartsPanel {
     this.visible = false;
     this.windowS = 30;
     this.added = [];
-    const pause = document.getElementById("chart-pause");
-    pause.addEventListener("click", () => {
-      this.paused = !this.paused;
-      pause.textContent = this.paused ? "Resume" : "Pause";
-      if (!this.paused) this.redraw();
-    });
+    document.getElementById("chart-pause").addEventListener("click", () => this.pause(!this.paused));
     document.getElementById("chart-clear").addEventListener("click", () => this.clear());
     document.getElementById("chart-csv").addEventListener("click", () => this.csv());
     document.getElementById("chart-window").addEventListener("change", (e) => {
@@ -38,6 +33,14 @@ export class ChartsPanel {
     });
     setInterval(() => this.redraw(), REDRAW_MS);
     window.addEventListener("resize", () => this.resize());
+  }
+
+  /** Pausing freezes the view; a drag that zooms pauses too, so that the
+   * zoom stays until Resume. */
+  pause(on) {
+    this.paused = on;
+    document.getElementById("chart-pause").textContent = on ? "Resume" : "Pause";
+    if (!on) this.redraw();
   }
 
   rate() {
@@ -105,6 +108,7 @@ export class ChartsPanel {
         width,
         height: panel.step ? 120 : 170,
         cursor: { sync: { key: sync.key }, drag: { x: true, y: false } },
+        hooks: { setSelect: [(u) => u.select.width > 0 && this.pause(true)] },
         scales: { x: { time: false } },
         axes: [
           { label: "time (s)", stroke: "#6a7683" },
