@@ -47,3 +47,25 @@ fn an_address_that_does_not_answer_is_named() {
     let e = LinkTarget::open(Some(&tcp), None, 9600, &[1, 7], Duration::from_millis(200)).err().unwrap();
     assert!(e.contains("module 7"), "{e}");
 }
+
+#[test]
+fn a_module_on_a_serial_port_is_reached_as_a_real_one() {
+    // A served module's pty stands in for a module's USB serial port.
+    let dir = tempfile::tempdir().unwrap();
+    let link = dir.path().join("ttyTMCM");
+    let module = tmclsim_firmware::Module::new(tmclsim_firmware::Profile::built_in("tmcm-3110").unwrap());
+    let config = tmclsim_server::ServerConfig { pty: Some(link.clone()), warn_exposure: false, ..Default::default() };
+    let server = tmclsim_server::start(module, config).unwrap();
+    let target = LinkTarget::open(None, Some(link.to_str().unwrap()), 9600, &[1], Duration::from_secs(1)).unwrap();
+    let web = tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false }).unwrap();
+    let url = |p: &str| format!("http://{}{p}", web.addr());
+    let (_, list) = get(&url("/api/modules"));
+    assert_eq!(list[0]["profile"], "TMCM-3110");
+    assert!(list[0]["link"].as_str().unwrap().starts_with("serial "));
+    let (_, p) = get(&url("/api/modules/0/profile"));
+    assert_eq!(p["axes"], 3);
+    let (_, r) = post(&url("/api/modules/0/command"), json!({"line": "GAP 4, 2"}));
+    assert_eq!(r["status"].as_u64(), Some(100), "{r}");
+    drop(web);
+    drop(server);
+}
