@@ -89,7 +89,7 @@ fn download_words(app: &App, id: usize, words: &[Instruction], tx: &tokio::sync:
         }
     }
     check(&t.request(id, Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0))?)?;
-    let address = app.modules_address(id);
+    let address = app.target.modules().get(id).ok_or(TargetError::NoModule)?.address;
     for (a, w) in words.iter().enumerate() {
         let raw = t.request(id, Instruction::new(opcode::READ_MEMORY, 0, 0, a as i32))?;
         if raw[1] == address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
@@ -105,12 +105,6 @@ fn download_words(app: &App, id: usize, words: &[Instruction], tx: &tokio::sync:
         }
     }
     Ok(())
-}
-
-impl App {
-    fn modules_address(&self, id: usize) -> u8 {
-        self.target.modules().get(id).map_or(0, |m| m.address)
-    }
 }
 
 pub async fn download(State(app): State<App>, Path(id): Path<usize>, Json(b): Json<DownloadBody>) -> Result<Response, ApiError> {
