@@ -11,6 +11,7 @@ use axum::{Json, Router};
 use serde::Deserialize;
 use serde_json::{Value, json};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use tmclsim_profile::Profile;
 use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
 
@@ -18,11 +19,51 @@ use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
 pub struct App {
     pub target: Arc<dyn Target>,
     pub token: Option<String>,
+    /// Per module: a download is under way. In download mode a module
+    /// stores every command it receives as a program word, so the app
+    /// sends nothing else to it meanwhile (its live stream pauses, other
+    /// requests are answered 409).
+    downloading: Arc<Vec<AtomicBool>>,
+}
+
+/// Marks a module as downloading until dropped.
+pub struct Downloading(Arc<Vec<AtomicBool>>, usize);
+
+impl Drop for Downloading {
+    fn drop(&mut self) {
+        self.0[self.1].store(false, Ordering::SeqCst);
+    }
 }
 
 impl App {
     pub fn new(target: Arc<dyn Target>, token: Option<String>) -> App {
-        App { target, token }
+        let downloading = Arc::new(target.modules().iter().map(|_| AtomicBool::new(false)).collect());
+        App { target, token, downloading }
+    }
+
+    pub fn is_downloading(&self, id: usize) -> bool {
+        self.downloading.get(id).is_some_and(|d| d.load(Ordering::SeqCst))
+    }
+
+    /// The module exists and takes requests now (no download under way).
+    pub fn idle(&self, id: usize) -> Result<(), ApiError> {
+        self.address(id)?;
+        if self.is_downloading(id) {
+            return Err(ApiError(
+                StatusCode::CONFLICT,
+                "a program is being downloaded to this module: wait until the download ends".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Claims the module for a download; refused while another runs.
+    pub fn start_download(&self, id: usize) -> Result<Downloading, ApiError> {
+        self.address(id)?;
+        if self.downloading[id].compare_exchange(false, true, Ordering::SeqCst, Ordering::SeqCst).is_err() {
+            return Err(ApiError(StatusCode::CONFLICT, "a program is being downloaded to this module already".into()));
+        }
+        Ok(Downloading(self.downloading.clone(), id))
     }
 
     pub fn profile(&self, id: usize) -> Result<Option<Arc<Profile>>, ApiError> {
@@ -140,6 +181,7 @@ struct CommandBody {
 }
 
 async fn command(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<CommandBody>) -> Result<Json<Value>, ApiError> {
+    app.idle(id)?;
     let profile = app.profile(id)?;
     let ins = tmclsim_host::line::parse(&body.line, profile.as_deref()).map_err(|e| bad(format!("column {}: {}", e.column, e.message)))?;
     Ok(Json(blocking(move || exchange(&app, id, ins)).await??))
@@ -187,7 +229,7 @@ struct ReadBody {
 }
 
 async fn read(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<ReadBody>) -> Result<Json<Value>, ApiError> {
-    app.address(id)?;
+    app.idle(id)?;
     if body.reads.len() > 4096 {
         return Err(bad("at most 4096 reads at once"));
     }
@@ -206,6 +248,7 @@ struct WriteBody {
 }
 
 async fn write(State(app): State<App>, Path(id): Path<usize>, Json(b): Json<WriteBody>) -> Result<Json<Value>, ApiError> {
+    app.idle(id)?;
     let axis = match b.kind {
         ReadKind::Ap => true,
         ReadKind::Gp => false,

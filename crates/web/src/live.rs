@@ -59,7 +59,9 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
                 }
             }
             _ = tick.tick() => {
-                if sub.signals.is_empty() && !sub.program {
+                if (sub.signals.is_empty() && !sub.program) || app.is_downloading(id) {
+                    // In download mode the module would store the reads as
+                    // program words: the stream pauses.
                     continue;
                 }
                 let (a, signals, program) = (app.clone(), sub.signals.clone(), sub.program);

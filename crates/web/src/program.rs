@@ -116,8 +116,10 @@ pub async fn download(State(app): State<App>, Path(id): Path<usize>, Json(b): Js
         Ok(p) => p,
         Err(diagnostics) => return Ok(Json(diagnostics).into_response()),
     };
+    let claim = app.start_download(id)?;
     let (tx, rx) = tokio::sync::mpsc::channel::<String>(64);
     tokio::task::spawn_blocking(move || {
+        let _claim = claim;
         let words = &program.instructions;
         let end = match download_words(&app, id, words, &tx) {
             Ok(()) => json!({"done": true, "verified": true, "words": words.len(), "program": program_json(&program)}),
@@ -185,6 +187,7 @@ pub fn state_of(app: &App, id: usize) -> Result<Value, ApiError> {
 }
 
 pub async fn state(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
+    app.idle(id)?;
     Ok(Json(blocking(move || state_of(&app, id)).await??))
 }
 
@@ -194,6 +197,7 @@ pub struct BreakpointsBody {
 }
 
 pub async fn breakpoints(State(app): State<App>, Path(id): Path<usize>, Json(b): Json<BreakpointsBody>) -> Result<Json<Value>, ApiError> {
+    app.idle(id)?;
     Ok(Json(
         blocking(move || {
             app.target.set_breakpoints(id, &b.addresses)?;
@@ -204,6 +208,7 @@ pub async fn breakpoints(State(app): State<App>, Path(id): Path<usize>, Json(b):
 }
 
 pub async fn action(State(app): State<App>, Path((id, action)): Path<(usize, String)>) -> Result<Json<Value>, ApiError> {
+    app.idle(id)?;
     let ins = |op: u8, kind: u8| Instruction::new(op, kind, 0, 0);
     let out = blocking(move || -> Result<Value, ApiError> {
         let t = &app.target;

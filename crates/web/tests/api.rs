@@ -216,3 +216,36 @@ fn a_public_bind_needs_the_flag_and_then_the_token() {
     assert_eq!(get(&format!("{base}/api/info?token={token}")).0, 200);
     assert!(web.url().ends_with(&format!("?token={token}")));
 }
+
+#[test]
+fn a_live_stream_does_not_slip_into_a_download() {
+    // In download mode a module stores every command as a program word: the
+    // app's own reads must wait, or the program read back would differ.
+    let s = Served::new();
+    let url = format!("ws://{}/api/modules/0/live", s.web.addr());
+    let (mut ws, _) = tungstenite::connect(url).unwrap();
+    let sub = json!({"signals": [{"kind": "ap", "number": 1, "index": 0}], "rate": 100, "program": true});
+    ws.send(tungstenite::Message::Text(sub.to_string().into())).unwrap();
+    ws.read().unwrap();
+    let source: String = "CALC ADD, 1\n".repeat(1000) + "STOP\n";
+    let reader = {
+        let url = s.url("/api/modules/0/read");
+        std::thread::spawn(move || {
+            let mut refused = 0;
+            for _ in 0..200 {
+                let (code, _) = post(&url, json!({"reads": [{"kind": "ap", "number": 1, "index": 0}]}));
+                assert!(code == 200 || code == 409, "{code}");
+                refused += usize::from(code == 409);
+            }
+            refused
+        })
+    };
+    let lines = download(&s, &source);
+    let last = lines.last().unwrap();
+    assert_eq!((last["verified"].as_bool(), last["words"].as_u64()), (Some(true), Some(1001)), "{last}");
+    reader.join().unwrap();
+    // The stream goes on after the download.
+    ws.read().unwrap();
+    let (code, _) = post(&s.url("/api/modules/0/read"), json!({"reads": [{"kind": "ap", "number": 1, "index": 0}]}));
+    assert_eq!(code, 200);
+}
