@@ -91,3 +91,9 @@ export function el(tag, attrs = {}, ...children) {
   for (const c of children) e.append(c);
   return e;
 }
+
+/** Fills a motor selector with the module's axes (one without a profile). */
+export function axisOptions(select, profile) {
+  const axes = profile ? profile.axes : 1;
+  select.replaceChildren(...Array.from({ length: axes }, (_, i) => el("option", { value: String(i), text: String(i) })));
+}

@@ -1,7 +1,7 @@
 // Motion: rotate, stop, move absolute/relative with a speed, reference
 // search with the mode chosen by name; the axis's position, speed and
 // switches from the live stream.
-import { post, el, m } from "./api.js";
+import { post, el, m, axisOptions } from "./api.js";
 
 // AP 1 actual, AP 0 target position, AP 3 actual speed, AP 8 position
 // reached, AP 11 / 10 / 9 left, right and home switch.
@@ -41,8 +41,7 @@ export class MotionPanel {
   setModule(ctx) {
     this.ctx = ctx;
     const p = ctx.profile;
-    const axes = p ? p.axes : 1;
-    this.axis.replaceChildren(...Array.from({ length: axes }, (_, i) => el("option", { value: String(i), text: String(i) })));
+    axisOptions(this.axis, ctx.profile);
     const modes = p ? p.reference_modes : [];
     document.getElementById("rfs-mode").replaceChildren(
       el("option", { value: "", text: "as set (AP 193)" }),

@@ -1,7 +1,7 @@
 // The parameter grid: the profile's axis and global parameters with their
 // live values, edited with validation against the range (SAP/SGP), stored
 // and restored (STAP/RSAP, STGP/RSGP). Values that change flash.
-import { post, el, m } from "./api.js";
+import { post, el, m, axisOptions } from "./api.js";
 
 const POLL_MS = 300;
 
@@ -30,8 +30,7 @@ export class ParamsPanel {
 
   setModule(ctx) {
     this.ctx = ctx;
-    const axes = ctx.profile ? ctx.profile.axes : 1;
-    this.axis.replaceChildren(...Array.from({ length: axes }, (_, i) => el("option", { value: String(i), text: String(i) })));
+    axisOptions(this.axis, ctx.profile);
     this.draw();
   }
 

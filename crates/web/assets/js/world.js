@@ -1,7 +1,7 @@
 // The world around a virtual module: switches, placement, load, supply,
 // temperature, inputs, driver and link faults, reset; each one line of the
 // control protocol (docs/world.md).
-import { get, post, el, m } from "./api.js";
+import { get, post, el, m, axisOptions } from "./api.js";
 
 const POLL_MS = 250;
 
@@ -37,8 +37,7 @@ export class WorldPanel {
     this.ctx = ctx;
     document.getElementById("world-none").hidden = ctx.virtual;
     document.getElementById("world-controls").hidden = !ctx.virtual;
-    const axes = ctx.profile ? ctx.profile.axes : 1;
-    this.axis.replaceChildren(...Array.from({ length: axes }, (_, i) => el("option", { value: String(i), text: String(i) })));
+    axisOptions(this.axis, ctx.profile);
     const inputs = (ctx.profile?.inputs ?? []).filter((x) => x.bank === 0 && !x.analog);
     this.inputLeds = inputs.map((x) => {
       const led = el("span", { class: "led clickable", "data-testid": `world-in-${x.number}`, text: x.name, title: "click: set or clear the input" });
