@@ -72,6 +72,13 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
 
 /// Refusals before anything is opened (docs/robustness.md).
 fn check_args(args: &ServeArgs) -> Result<(), String> {
+    if args.web.is_some() && args.ethercat.is_some() {
+        return Err(
+            "--web cannot serve EtherCAT slaves: the IDE reaches modules by TMCL requests, and EtherCAT slaves answer their master; \
+                    serve the module on --tcp/--pty with --web, or run `tmclsim ide` against a TMCL link"
+                .into(),
+        );
+    }
     if args.max_connections == 0 {
         return Err("--max-connections 0 would serve no client: give 1 or more".into());
     }

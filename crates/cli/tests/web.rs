@@ -79,3 +79,10 @@ fn ide_names_the_link_it_cannot_open() {
     assert!(!out.status.success());
     assert!(text(&out).contains("cannot connect to 127.0.0.1:1"), "{}", text(&out));
 }
+
+#[test]
+fn ethercat_slaves_are_not_served_to_the_ide() {
+    let out = tmclsim(&["serve", "--module", "tmcm-1310", "--ethercat", "lo", "--web"]);
+    assert!(!out.status.success());
+    assert!(text(&out).contains("--web cannot serve EtherCAT slaves"), "{}", text(&out));
+}
