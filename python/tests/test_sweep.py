@@ -86,6 +86,9 @@ def test_matrix_errors_name_the_key():
         ({"metrics": ["speed"]}, "metrics[0]: 'speed'"),
         ({"colour": 1}, "colour: unknown key"),
         ({"vary": [{"world": "a", "range": [10, 0, 1]}]}, "vary[0].range"),
+        ({"vary": 3}, "vary: a list of tables"),
+        ({"check": {"expr": "var 0 == 1"}}, "check: a list of tables"),
+        ({"stop": {"when": "var 0 == 1"}}, "stop.when: a list of conditions"),
     ]
     for doc, message in cases:
         with pytest.raises(MatrixError) as e:

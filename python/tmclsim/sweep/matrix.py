@@ -203,6 +203,9 @@ def parse(doc: Dict[str, Any]) -> Matrix:
     if not isinstance(setup, list) or not all(isinstance(x, str) for x in setup):
         raise MatrixError("setup: a list of direct-mode commands, e.g. [\"SAP 4, 0, 1000\"]")
     mx.setup = list(setup)
+    for k in ("vary", "check"):
+        if not isinstance(doc.get(k, []), list):
+            raise MatrixError(f"{k}: a list of tables ([[{k}]] sections)")
     seen = set()
     for i, entry in enumerate(doc.get("vary", [])):
         key = f"vary[{i}]"
@@ -244,7 +247,10 @@ def parse(doc: Dict[str, Any]) -> Matrix:
     if not isinstance(stop, dict) or set(stop) - {"program_ended", "when"}:
         raise MatrixError("stop: a table with program_ended = true|false and when = [\"var 0 != 0\", …]")
     mx.stop_program_ended = bool(stop.get("program_ended", True))
-    mx.stop_when = [Condition.parse(t, f"stop.when[{i}]") for i, t in enumerate(stop.get("when", []))]
+    when = stop.get("when", [])
+    if not isinstance(when, list):
+        raise MatrixError("stop.when: a list of conditions, e.g. [\"var 0 != 0\"]")
+    mx.stop_when = [Condition.parse(t, f"stop.when[{i}]") for i, t in enumerate(when)]
     for i, c in enumerate(doc.get("check", [])):
         key = f"check[{i}]"
         if not isinstance(c, dict):
