@@ -89,6 +89,10 @@ def test_matrix_errors_name_the_key():
         ({"vary": 3}, "vary: a list of tables"),
         ({"check": {"expr": "var 0 == 1"}}, "check: a list of tables"),
         ({"stop": {"when": "var 0 == 1"}}, "stop.when: a list of conditions"),
+        ({"vary": [{"world": "a", "range": [float("inf"), float("inf"), 1]}]}, "vary[0].range"),
+        ({"vary": [{"world": "a", "random": {"min": 5, "max": 1, "count": 2}}]}, "min not above max"),
+        ({"vary": [{"world": "a", "name": [1], "values": [1]}]}, "vary[0].name"),
+        ({"vary": [{"profile": True, "values": [1]}]}, "vary[0].values: profile names"),
     ]
     for doc, message in cases:
         with pytest.raises(MatrixError) as e:
@@ -200,3 +204,36 @@ def test_world_keys_reach_lists_of_tables_and_of_numbers():
     t = tmclsim.sweep(program, m, workers=0)
     assert list(t["gp 0 2"]) == [0, 1]
     assert list(t.passed) == [True, False]
+
+
+def test_any_matrix_document_is_parsed_or_refused_with_a_matrix_error():
+    import random as rnd
+
+    r = rnd.Random(17)
+    atoms = [0, 1, -5, 2.5, "x", "60s", "var 0 == 1", True, [], {}, [1, 2], {"min": 0, "max": 1, "count": 2}, [0, 10, 5], None]
+    keys = ["profile", "duration", "step", "seed", "world", "setup", "vary", "stop", "check", "metrics", "values", "range",
+            "random", "ap", "gp", "motor", "bank", "name", "expr", "when", "program_ended", "tolerance", "no_stall", "finished_within"]
+
+    def value(depth):
+        k = r.random()
+        if depth > 2 or k < 0.5:
+            v = r.choice(atoms)
+            return v if v is not None else {}
+        if k < 0.75:
+            return [value(depth + 1) for _ in range(r.randint(0, 3))]
+        return {r.choice(keys): value(depth + 1) for _ in range(r.randint(0, 4))}
+
+    def entry(names):
+        return {r.choice(names): value(1) for _ in range(r.randint(1, 5))}
+
+    for i in range(6000):
+        doc = {r.choice(keys[:10]): value(0) for _ in range(r.randint(0, 5))}
+        if i % 2:
+            # Tables shaped like the real ones, with values of every type.
+            doc["vary"] = [entry(["world", "ap", "gp", "profile", "name", "motor", "bank", "values", "range", "random"]) for _ in range(r.randint(1, 3))]
+            doc["check"] = [entry(["expr", "name", "tolerance", "no_stall", "finished_within"]) for _ in range(r.randint(0, 2))]
+        try:
+            m = parse(doc)
+            m.scenarios()
+        except MatrixError:
+            pass

@@ -157,7 +157,7 @@ def _values(entry: Dict[str, Any], key: str, seed: int, name: str) -> List[Any]:
         return v
     if "range" in entry:
         r = entry["range"]
-        if not (isinstance(r, list) and len(r) == 3 and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in r)):
+        if not (isinstance(r, list) and len(r) == 3 and all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in r)):
             raise MatrixError(f"{key}.range: [start, stop, step] (stop included)")
         start, stop, step = r
         if step <= 0 or stop < start:
@@ -177,7 +177,12 @@ def _values(entry: Dict[str, Any], key: str, seed: int, name: str) -> List[Any]:
     # same values on every machine.
     rng = random.Random(f"{seed}:{name}")
     lo, hi = d["min"], d["max"]
-    if d.get("integer", isinstance(lo, int) and isinstance(hi, int)):
+    if not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in (lo, hi)) or lo > hi:
+        raise MatrixError(f"{key}.random: min and max are numbers, min not above max")
+    integer = d.get("integer", isinstance(lo, int) and isinstance(hi, int))
+    if not isinstance(integer, bool):
+        raise MatrixError(f"{key}.random.integer: true or false")
+    if integer:
         return [rng.randint(int(lo), int(hi)) for _ in range(count)]
     return [rng.uniform(float(lo), float(hi)) for _ in range(count)]
 
@@ -215,7 +220,7 @@ def parse(doc: Dict[str, Any]) -> Matrix:
         if len(targets) != 1:
             raise MatrixError(f"{key}: name what it varies with exactly one of world = \"axis.0.home_switch.from\", ap = N, gp = N, profile = true")
         target = targets[0]
-        allowed = {"name", target, "motor", "bank", "values", "range", "random"}
+        allowed = {"name", target, "values", "range", "random"} | ({"motor"} if target == "ap" else {"bank"} if target == "gp" else set())
         for k in entry:
             if k not in allowed:
                 raise MatrixError(f"{key}.{k}: unknown key")
@@ -230,13 +235,19 @@ def parse(doc: Dict[str, Any]) -> Matrix:
             axis = Axis(name, "profile", None, 0, [])
         else:
             what = entry[target]
+            if isinstance(what, bool) or not isinstance(what, (int, str)):
+                raise MatrixError(f"{key}.{target}: a parameter number or name")
             index = _int(entry.get("motor" if target == "ap" else "bank", 0), f"{key}.{'motor' if target == 'ap' else 'bank'}")
             name = entry.get("name", f"{target} {what} {index}")
             axis = Axis(name, target, what, index, [])
+        if not isinstance(name, str) or not name:
+            raise MatrixError(f"{key}.name: a column name (text)")
         if name in seen:
             raise MatrixError(f"{key}.name: '{name}' is used twice")
         seen.add(name)
         axis.values = _values(entry, key, mx.seed, name)
+        if target == "profile" and not all(isinstance(v, str) for v in axis.values):
+            raise MatrixError(f"{key}.values: profile names, e.g. [\"tmcm-1141\", \"tmcm-1140\"]")
         mx.axes.append(axis)
     total = 1
     for a in mx.axes:
@@ -263,9 +274,11 @@ def parse(doc: Dict[str, Any]) -> Matrix:
             if k not in {"name", kind, "tolerance"}:
                 raise MatrixError(f"{key}.{k}: unknown key")
         name = c.get("name", c[kind] if kind == "expr" else kind)
+        if not isinstance(name, str):
+            raise MatrixError(f"{key}.name: text")
         if kind == "expr":
             tol = c.get("tolerance", 0)
-            if not isinstance(tol, (int, float)) or tol < 0:
+            if isinstance(tol, bool) or not isinstance(tol, (int, float)) or tol < 0:
                 raise MatrixError(f"{key}.tolerance: a number, 0 or more")
             mx.checks.append(Check(name, kind, Condition.parse(c["expr"], f"{key}.expr", float(tol))))
         elif kind == "finished_within":
