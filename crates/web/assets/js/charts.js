@@ -1,7 +1,7 @@
 // Live charts (uPlot): panels with one shared time axis, fed by the live
 // stream; pause, zoom (drag; double-click resets), CSV export, any readable
 // parameter added. Switches and outputs are step traces.
-import { el } from "./api.js";
+import { el, axisOptions } from "./api.js";
 
 const COLORS = ["#0b6bcb", "#e67e22", "#1e8e3e", "#8e44ad", "#c0392b", "#16697a", "#7f8c8d"];
 const REDRAW_MS = 100;
@@ -21,13 +21,20 @@ export class ChartsPanel {
       this.redraw();
     });
     document.getElementById("chart-rate").addEventListener("change", () => this.ctx?.resubscribe());
+    this.axis = document.getElementById("chart-axis");
+    this.axis.addEventListener("change", () => {
+      this.build();
+      this.ctx.resubscribe();
+    });
     document.getElementById("chart-add").addEventListener("change", (e) => {
       const n = e.target.value;
       e.target.value = "";
       if (n === "") return;
-      const [kind, index, number] = n.split(":").map((x, i) => (i === 0 ? x : Number(x)));
-      const row = (kind === "ap" ? this.ctx.profile.axis_parameters : this.ctx.profile.global_parameters).find((r) => r.number === number && (kind === "ap" || r.bank === index));
-      this.added.push({ kind, number, index, label: `${row.name} (${kind.toUpperCase()} ${number})`, unit: row.unit });
+      const [kind, bank, number] = n.split(":").map((x, i) => (i === 0 ? x : Number(x)));
+      const index = kind === "ap" ? this.motor() : bank;
+      const row = (kind === "ap" ? this.ctx.profile.axis_parameters : this.ctx.profile.global_parameters).find((r) => r.number === number && (kind === "ap" || r.bank === bank));
+      const where = kind === "ap" ? this.motorSuffix(index) : `, bank ${bank}`;
+      this.added.push({ kind, number, index, label: `${row.name} (${kind.toUpperCase()} ${number}${where})`, unit: row.unit });
       this.build();
       this.ctx.resubscribe();
     });
@@ -41,6 +48,15 @@ export class ChartsPanel {
     this.paused = on;
     document.getElementById("chart-pause").textContent = on ? "Resume" : "Pause";
     if (!on) this.redraw();
+  }
+
+  motor() {
+    return Number(this.axis.value || 0);
+  }
+
+  /** ", motor N" on modules with more than one. */
+  motorSuffix(index) {
+    return (this.ctx.profile?.axes ?? 1) > 1 ? `, motor ${index}` : "";
   }
 
   rate() {
@@ -59,6 +75,8 @@ export class ChartsPanel {
     this.ctx = ctx;
     this.added = [];
     const p = ctx.profile;
+    axisOptions(this.axis, p);
+    this.axis.closest("label").hidden = (p?.axes ?? 1) < 2;
     const add = document.getElementById("chart-add");
     add.replaceChildren(el("option", { value: "", text: "parameter…" }));
     if (p) {
@@ -73,7 +91,8 @@ export class ChartsPanel {
     const p = this.ctx.profile;
     const has = new Set(p ? p.axis_parameters.map((r) => r.number) : [0, 1, 3]);
     const name = (n) => p?.axis_parameters.find((r) => r.number === n)?.name ?? `AP ${n}`;
-    const ap = (n, step = false) => ({ kind: "ap", number: n, index: 0, label: `${name(n)} (AP ${n})`, step });
+    const motor = this.motor();
+    const ap = (n, step = false) => ({ kind: "ap", number: n, index: motor, label: `${name(n)} (AP ${n}${this.motorSuffix(motor)})`, step });
     const panels = [
       { title: "Position", unit: "µsteps", series: [ap(1), ap(0)].filter((s) => has.has(s.number)) },
       { title: "Velocity", unit: "internal units", series: [ap(3)].filter((s) => has.has(s.number)) },

@@ -4,6 +4,8 @@
 import { post, el, m, axisOptions } from "./api.js";
 
 const POLL_MS = 300;
+const INT_MIN = -2147483648;
+const INT_MAX = 2147483647;
 
 export function inRange(row, v) {
   if (!Number.isInteger(v) || v < row.min || v > row.max) return false;
@@ -51,6 +53,8 @@ export class ParamsPanel {
     const all = global ? p.global_parameters : p.axis_parameters;
     const rows = all.filter((r) => !words || r.name.toLowerCase().includes(words) || r.snake.includes(words) || String(r.number) === words);
     const motor = Number(this.axis.value || 0);
+    document.getElementById("param-table").classList.toggle("axis", !global);
+    this.axis.disabled = global;
     this.body.replaceChildren(
       ...rows.map((r) => {
         const index = global ? r.bank : motor;
@@ -75,7 +79,7 @@ export class ParamsPanel {
         };
         set.addEventListener("click", doSet);
         input.addEventListener("keydown", (e) => e.key === "Enter" && doSet());
-        const extra = el("td");
+        const extra = el("td", { class: "actions" });
         if (r.storable) {
           for (const op of ["store", "restore"]) {
             const b = el("button", { text: op === "store" ? "Store" : "Restore", "data-testid": `${op}-${kind}-${index}-${r.number}`, title: op === "store" ? "to EEPROM (STAP/STGP)" : "from EEPROM (RSAP/RSGP)" });
@@ -86,18 +90,17 @@ export class ParamsPanel {
             extra.append(b, " ");
           }
         }
-        const range = r.ranges.length ? r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") : `${r.min}…${r.max}`;
+        const range = r.ranges.length ? r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") : r.min === INT_MIN && r.max === INT_MAX ? "signed 32 bit" : `${r.min}…${r.max}`;
         const tr = el("tr", { "data-testid": `row-${kind}-${index}-${r.number}` },
           el("td", { class: "num", text: String(r.number) }),
-          el("td", { class: "num", text: global ? String(r.bank) : "" }),
-          el("td", { text: r.name, title: r.note ?? "" }),
+          el("td", { class: "num bank", text: global ? String(r.bank) : "" }),
+          el("td", { class: "name", text: r.name, title: r.note ?? "" }),
           value,
           el("td", { text: r.unit ?? "" }),
           el("td", { text: r.access }),
-          el("td", { text: range }),
-          el("td", { text: String(r.default) }),
-          el("td", { class: `src-${r.default_source}`, text: r.default_source, title: r.note ?? "" }),
-          el("td", {}, input, " ", set),
+          el("td", { class: "range", text: range, title: `${r.min}…${r.max}` }),
+          el("td", { class: "default", title: r.note ?? "" }, String(r.default), " ", el("span", { class: `src src-${r.default_source}`, text: r.default_source })),
+          el("td", { class: "actions" }, input, " ", set),
           extra);
         this.rows.push({ r, kind, index, value, readable: r.access.includes("R") });
         return tr;

@@ -21,6 +21,7 @@ export class WorldPanel {
     on("world-load-set", () => this.line(`load ${a()} ${val("world-load")}`));
     on("world-supply-set", () => this.line(`supply ${val("world-supply")}`));
     on("world-temp-set", () => this.line(`temperature ${val("world-temp")}`));
+    on("world-analog-set", () => this.line(`analog ${val("world-analog")} ${val("world-analog-value")}`));
     on("fault-on", () => this.line(`fault ${a()} ${val("fault-kind")} on`));
     on("fault-off", () => this.line(`fault ${a()} ${val("fault-kind")} off`));
     on("link-fault-go", () => this.line(val("link-fault")));
@@ -45,6 +46,10 @@ export class WorldPanel {
       return led;
     });
     document.getElementById("world-inputs").replaceChildren(...this.inputLeds);
+    // The ADC inputs (GIO N, 1) the world drives, not the supply's reading.
+    const adcs = (ctx.profile?.inputs ?? []).filter((x) => x.analog && x.bank === 1 && x.max === 4095);
+    document.getElementById("world-analog").replaceChildren(...adcs.map((x) => el("option", { value: String(x.number), text: `${x.name} (0…4095)` })));
+    for (const id of ["world-analog", "world-analog-value", "world-analog-set"]) document.getElementById(id).hidden = !adcs.length;
   }
 
   async line(text) {
@@ -62,6 +67,10 @@ export class WorldPanel {
     for (const which of ["left", "right", "home"]) {
       document.querySelector(`[data-testid=sw-${which}-state]`).textContent = ax[which] ? "pressed" : "open";
     }
+    const num = (x, digits) => (typeof x === "number" ? x.toFixed(digits) : "–");
+    document.getElementById("world-state").textContent =
+      `t = ${num(w.time, 2)} s · carriage ${num(ax.carriage, 0)} · load ${num(Math.abs(ax.load), 0)} % · ` +
+      `supply ${num(w.supply, 1)} V · ${num(w.temperature, 1)} °C${ax.stopped_by_switch ? " · stopped by a switch" : ""}`;
     this.inputLeds.forEach((l) => l.classList.toggle("on", !!(w.inputs & (1 << Number(l.dataset.testid.split("-").pop())))));
   }
 }
