@@ -3,10 +3,13 @@ Playwright), the app served by `tmclsim serve --web`, and PyTrinamic on the
 module's TCP link at the same time."""
 
 import json
+import pathlib
 import re
+import tempfile
 import urllib.error
 import urllib.request
 
+import pytest
 from conftest import open_app, shot, tab
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1141
@@ -34,7 +37,6 @@ def test_module_list_and_filter(served, page, start):
     items.first.click()
     page.wait_for_function("document.querySelector('[data-testid=module-title]').textContent.includes('TMCM-351')")
     page.fill("[data-testid=module-filter]", "")
-    shot(page, "modules")
 
 
 def test_a_parameter_changed_in_the_grid_is_read_by_pytrinamic(served, page):
@@ -175,6 +177,7 @@ def test_ide_against_a_served_module_over_tcp(served, page, start):
     assert page.inner_text("[data-testid=direct-reply]").startswith("Actual position (1) = 0")
     tab(page, "world")
     assert page.is_visible("#world-none")
+    assert not page.is_visible("#world-controls")
 
 
 def test_a_foreign_origin_is_refused(served):
@@ -204,3 +207,83 @@ def test_a_drag_zooms_the_charts_and_pauses_them(served, page):
     assert page.inner_text("[data-testid=chart-info]") == info, "paused: no redraw"
     page.click("[data-testid=chart-pause]")
     page.wait_for_function(f"document.querySelector('[data-testid=chart-info]').textContent !== {info!r}")
+
+
+FLEET = """world = "stage"
+[[link]]
+pty = "{dir}/bus"
+count = 4
+bus = "tmcm-1141"
+size = 250
+"""
+
+
+@pytest.fixture
+def fleet_dir():
+    """A short, neutral directory for the fleet's ptys (shown in the list);
+    requested before `start`, so removed after the fleet has stopped."""
+    with tempfile.TemporaryDirectory(prefix="tmclsim-fleet-") as d:
+        yield pathlib.Path(d)
+
+
+def test_one_module_found_among_a_thousand(page, fleet_dir, start):
+    tmp_path = fleet_dir
+    fleet = tmp_path / "fleet.toml"
+    fleet.write_text(FLEET.format(dir=tmp_path))
+    served = start(["serve", "--fleet", str(fleet), "--web", "127.0.0.1:0"])
+    open_app(page, served.printed("web"))
+    items = page.locator("[data-testid=module-item]")
+    assert page.inner_text("[data-testid=module-count]") == "1000 of 1000 modules (first 200 shown)"
+    assert items.count() == 200
+    page.fill("[data-testid=module-filter]", "bus-3")
+    assert page.inner_text("[data-testid=module-count]").startswith("250 of 1000")
+    # A word that is an address brings that module first.
+    page.fill("[data-testid=module-filter]", "bus-3 250")
+    assert "address 250" in items.first.inner_text() and "bus-3" in items.first.inner_text()
+    items.first.click()
+    page.wait_for_function("document.querySelector('[data-testid=module-title]').textContent.includes('address 250')")
+    page.fill("[data-testid=direct-input]", "SAP 4, 0, 1250")
+    page.press("[data-testid=direct-input]", "Enter")
+    page.locator("[data-testid=direct-reply]").wait_for()
+    page.fill("[data-testid=module-filter]", "250")
+    assert items.count() == 4  # address 250 of each bus
+    shot(page, "modules")
+    # The app talked to module 250 of the fourth bus, and to no other.
+    with ConnectionManager(f"--interface serial_tmcl --port {tmp_path}/bus-3 --module-id 250").connect() as interface:
+        assert interface.get_axis_parameter(4, 0) == 1250
+    with ConnectionManager(f"--interface serial_tmcl --port {tmp_path}/bus-0 --module-id 250").connect() as interface:
+        assert interface.get_axis_parameter(4, 0) != 1250
+
+
+def test_charts_follow_a_chosen_motor_and_the_world_sets_an_analog_input(page, start):
+    served = start(["serve", "--module", "tmcm-6110", "--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0"])
+    open_app(page, served.printed("web"))
+    tab(page, "charts")
+    page.select_option("[data-testid=chart-axis]", "2")
+    with ConnectionManager(f"--interface socket_serial_tmcl --port {served.printed('tcp')}").connect() as interface:
+        interface.send(1, 0, 2, 300)  # ROR 2, 300
+        for _ in range(100):
+            speed = interface.get_axis_parameter(3, 2)
+            if speed == 300:
+                break
+            page.wait_for_timeout(50)
+        assert speed == 300
+        other = interface.get_axis_parameter(3, 0)
+    page.wait_for_timeout(500)
+    with page.expect_download() as d:
+        page.click("[data-testid=chart-csv]")
+    csv = open(d.value.path()).read().splitlines()
+    head = csv[0].split(",")
+    assert "Actual speed (AP 3; motor 2)" in head, head
+    assert not any("motor 0" in h for h in head)
+    last = csv[-1].split(",")
+    assert int(last[head.index("Actual speed (AP 3; motor 2)")]) == 300 != other
+    # An ADC value set in the world is what GIO N, 1 reads in the IO panel.
+    tab(page, "world")
+    page.select_option("[data-testid=world-analog]", "4")
+    page.fill("[data-testid=world-analog-value]", "3071")
+    page.click("[data-testid=world-analog-set]")
+    tab(page, "io")
+    page.wait_for_function("document.querySelector('[data-testid=analog-1-4] .value').textContent === '3071'")
+    with ConnectionManager(f"--interface socket_serial_tmcl --port {served.printed('tcp')}").connect() as interface:
+        assert interface.send(15, 4, 1, 0).value == 3071
