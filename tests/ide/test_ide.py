@@ -56,6 +56,21 @@ def test_a_parameter_changed_in_the_grid_is_read_by_pytrinamic(served, page):
         TMCM1141(interface).motors[0].set_axis_parameter(4, 777)
     page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '777'")
     page.fill("[data-testid=param-filter]", "")
+    # Only the rows on screen are read: the last readable one is read once
+    # it is scrolled into view, and shows what PyTrinamic reads.
+    last = page.evaluate("""() => {
+        const rows = [...document.querySelectorAll('[data-testid^=row-ap-0-]')].filter((r) => r.cells[5].textContent.includes('R'));
+        return Number(rows[rows.length - 1].dataset.testid.split('-').pop());
+    }""")
+    cell = f"[data-testid=value-ap-0-{last}]"
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-1]').textContent !== '–'")
+    page.wait_for_timeout(700)
+    assert page.inner_text(cell) == "–"
+    page.locator(cell).scroll_into_view_if_needed()
+    page.wait_for_function(f"document.querySelector({cell!r}).textContent !== '–'")
+    with pytrinamic(served) as interface:
+        assert page.inner_text(cell) == str(TMCM1141(interface).motors[0].get_axis_parameter(last))
+    page.locator("[data-testid=value-ap-0-0]").scroll_into_view_if_needed()
     shot(page, "parameters")
 
 

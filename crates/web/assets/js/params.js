@@ -22,6 +22,19 @@ export class ParamsPanel {
     this.axis.addEventListener("change", () => this.draw());
     for (const r of document.querySelectorAll("input[name=ptable]")) r.addEventListener("change", () => this.draw());
     this.visible = false;
+    // Only the rows on screen are read: a real module on a slow link answers
+    // a few hundred requests a second at best.
+    this.onScreen = new Set();
+    this.observer = new IntersectionObserver(
+      (entries) => {
+        for (const e of entries) {
+          if (e.isIntersecting) this.onScreen.add(e.target);
+          else this.onScreen.delete(e.target);
+        }
+        this.poll();
+      },
+      { root: document.querySelector("#panel-params .table-wrap") },
+    );
     setInterval(() => this.poll(), POLL_MS);
   }
 
@@ -43,6 +56,8 @@ export class ParamsPanel {
   draw() {
     const p = this.ctx?.profile;
     this.rows = [];
+    this.observer.disconnect();
+    this.onScreen.clear();
     if (!p) {
       this.body.replaceChildren();
       this.status.textContent = "no profile for this module type: use direct mode with numbers";
@@ -102,7 +117,8 @@ export class ParamsPanel {
           el("td", { class: "default", title: r.note ?? "" }, String(r.default), " ", el("span", { class: `src src-${r.default_source}`, text: r.default_source })),
           el("td", { class: "actions" }, input, " ", set),
           extra);
-        this.rows.push({ r, kind, index, value, readable: r.access.includes("R") });
+        this.rows.push({ r, kind, index, value, tr, readable: r.access.includes("R") });
+        this.observer.observe(tr);
         return tr;
       }),
     );
@@ -122,7 +138,8 @@ export class ParamsPanel {
 
   async poll() {
     if (!this.visible || !this.ctx || !this.rows?.length || this.polling) return;
-    const rows = this.rows.filter((x) => x.readable).slice(0, 400);
+    const rows = this.rows.filter((x) => x.readable && this.onScreen.has(x.tr));
+    if (!rows.length) return;
     this.polling = true;
     try {
       const a = await post(m(this.ctx.id, "read"), { reads: rows.map((x) => ({ kind: x.kind, number: x.r.number, index: x.index })) });
