@@ -20,14 +20,18 @@ def test_the_failing_regions_are_the_explained_ones(tmp_path):
     # Load 40 %: every position, every width stalls and times out.
     heavy = t[t.load == 40]
     assert (~heavy.passed).all() and (heavy["var 0"] == 2).all()
+    assert heavy.stalled.all() and (heavy.failed_check == "no stall").all()
     assert (heavy.carriage.abs() < 100).all(), "the motor stalls at the start"
+    # The counter runs on (in the search's negative direction) while the
+    # carriage stands.
+    assert (heavy["min ap 1 0"] < -2_000_000).all()
     # Without that load: the switch at +400 000 (wide) and beyond times out.
     light = t[t.load < 40]
     far = (light.home_from > 400000) | ((light.home_from == 400000) & (light.home_width == 20000))
     assert (~light[far].passed).all() and light[~far].passed.all()
     assert (light[far]["var 0"] == 2).all() and (light[far].time > 40).all()
+    assert not light.stalled.any() and (light[far].failed_check == "homed").all()
     assert len(failed) == 18 + 10
-    assert set(failed.failed_check) == {"homed"}
     # Homed scenarios: the counter is 0 where the search met the switch.
     assert (t[t.passed].position == 0).all()
 

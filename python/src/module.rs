@@ -530,6 +530,32 @@ impl Module {
         self.with(|m| m.switches(motor))
     }
 
+    /// error_flags(motor=0) -> int
+    /// --
+    ///
+    /// AP 207 (extended error flags: 1 stall stop, 2 deviation, 4 encoder
+    /// lost) as it stands, without clearing it as GAP 207 does: an observer
+    /// (a sweep) that reads it does not change what the program will read.
+    #[pyo3(signature = (motor=0))]
+    fn error_flags(&mut self, motor: usize) -> PyResult<i32> {
+        self.check_motor(motor)?;
+        self.with(|m| m.axis(motor).params[207])
+    }
+
+    /// at_end_stop(motor=0) -> bool
+    /// --
+    ///
+    /// Whether the carriage stands at one of the world's mechanical end
+    /// stops (`travel`; never in a world without them).
+    #[pyo3(signature = (motor=0))]
+    fn at_end_stop(&mut self, motor: usize) -> PyResult<bool> {
+        self.check_motor(motor)?;
+        self.with(|m| {
+            let c = m.mechanical_position(motor);
+            m.world().axes[motor].travel.is_some_and(|(lo, hi)| c <= lo || c >= hi)
+        })
+    }
+
     /// The digital outputs as a bit vector (OUT0 = bit 0).
     #[getter]
     fn outputs(&mut self) -> PyResult<u32> {

@@ -237,3 +237,98 @@ def test_any_matrix_document_is_parsed_or_refused_with_a_matrix_error():
             m.scenarios()
         except MatrixError:
             pass
+
+
+STALL_WATCH = """\
+        SAP 181, 0, 100         // stop on stall from speed 100 up
+        SGP 1, 2, 0
+        ROR 0, 1500
+Loop:   WAIT TICKS, 0, 50       // look every 0.5 s
+        GAP 207, 0              // (reading clears it)
+        COMP 0
+        JC EQ, Loop
+        SGP 1, 2, 1             // the program saw the stall
+        STOP
+"""
+
+
+def test_looking_for_stalls_leaves_the_flag_to_the_program(tmp_path):
+    # The sweep looks at AP 207 every 100 ms, the program every 500 ms: a
+    # look that cleared it (as GAP 207 does) would hide the stall from the
+    # program, and `tmclsim run` would end otherwise.
+    source = tmp_path / "stall.tmc"
+    source.write_text(STALL_WATCH)
+    m = {"duration": "3s", "world": {"base": "free"}, "metrics": ["stalled", "var 1", "time"],
+         "vary": [{"name": "load", "world": "axis.0.load.0.torque", "values": [0, 60]}],
+         "check": [{"name": "no stall", "no_stall": True}]}
+    s = tmclsim.sweep(source, m, workers=0, failures=tmp_path / "f", details=True)
+    t = s.table
+    assert list(t.passed) == [True, False] and list(t.stalled) == [False, True]
+    assert list(t["var 1"]) == [0, 1], "the program saw its stall"
+    assert t.failed_check[1] == "no stall" and t.time[1] < 3
+    out = subprocess.run(
+        [tmclsim_bin(), "run", str(source), "--world", str(tmp_path / "f" / "failure-1.toml"),
+         "--setup", str(tmp_path / "f" / "failure-1.setup"), "--for", f"{t.time[1]}s"],
+        capture_output=True, text=True, check=True,
+    ).stdout
+    assert re.search(r"user variables 1=1\b", out), out
+
+
+def test_end_stops_limit_switches_and_values_over_the_run():
+    # A move to +200 000 on a free axis whose travel may end before it: the
+    # counter gets there, the carriage stops at the end stop. (The program
+    # stays there for 0.5 s: values over the run are looked at every step.)
+    program = tmclsim.assemble("MVP ABS, 0, 200000\nWAIT POS, 0, 0\nWAIT TICKS, 0, 50\nMVP ABS, 0, 0\nWAIT POS, 0, 0\nSTOP\n")
+    m = {"duration": "30s", "world": {"base": "free"},
+         "metrics": ["end_stop", "limit_switch", "max ap 1 0", "min ap 1 0", "carriage", "position"],
+         "vary": [{"name": "travel", "world": "axis.0.travel", "values": [[-300000, 300000], [-300000, 100000]]}],
+         "check": [{"name": "overrun", "expr": "max ap 1 0 <= 200000"}, {"name": "end stop", "no_end_stop": True},
+                   {"name": "switches", "no_limit_switch": True}]}
+    t = tmclsim.sweep(program, m, workers=0)
+    assert list(t["max ap 1 0"]) == [200000, 200000] and list(t["min ap 1 0"]) == [0, 0]
+    assert list(t.end_stop) == [False, True] and not t.limit_switch.any()
+    assert list(t.passed) == [True, False] and t.failed_check[1] == "end stop"
+    # Back at 0 by the counter; the carriage lost the steps beyond the stop.
+    assert list(t.position) == [0, 0]
+    assert t.carriage[0] == 0 and t.carriage[1] == -100000
+    # On the stage, the right stop switch at +1 000 000 stops the move.
+    m2 = dict(m, world={"base": "stage"}, vary=[{"name": "target", "ap": 4, "motor": 0, "values": [2047]}], check=m["check"][1:])
+    program2 = tmclsim.assemble("MVP ABS, 0, 1010000\nWAIT TICKS, 0, 3000\nSTOP\n")
+    t2 = tmclsim.sweep(program2, m2, workers=0)
+    assert t2.limit_switch[0] and not t2.end_stop[0] and t2.failed_check[0] == "switches"
+
+
+def test_a_scenario_the_module_refuses_is_a_setup_failure():
+    m = {"duration": "1s", "metrics": ["time", "ap 4 0"],
+         "vary": [{"name": "speed", "ap": "maximum_positioning_speed", "values": [1000, 5000]}]}
+    t = tmclsim.sweep(tmclsim.assemble("STOP\n"), m, workers=0)
+    assert list(t.passed) == [True, False]
+    assert t.failed_check[1] == "setup" and "SAP 4, 0, 5000" in t.error[1] and "status 4" in t.error[1]
+    assert t["ap 4 0"][0] == 1000
+    # A value the module does not have: the scenario's error, not a traceback.
+    t = tmclsim.sweep(tmclsim.assemble("STOP\n"), {"duration": "1s", "metrics": ["ap no_such_parameter 0"]}, workers=0)
+    assert t.failed_check[0] == "setup" and "no_such_parameter" in t.error[0]
+
+
+def test_columns_have_one_name():
+    with pytest.raises(MatrixError, match=r"metrics\[1\]: 'time' is listed twice"):
+        parse({"metrics": ["time", "time"]})
+    with pytest.raises(MatrixError, match=r"metrics\[0\]: 'var 0' is a column"):
+        parse({"metrics": ["var 0"], "vary": [{"name": "var 0", "world": "supply", "values": [24]}]})
+    with pytest.raises(MatrixError, match=r"vary\[0\].name: 'passed'"):
+        parse({"vary": [{"name": "passed", "world": "supply", "values": [24]}]})
+    with pytest.raises(MatrixError, match=r"check\[0\].expr"):
+        parse({"check": [{"expr": "max 0 == 1"}]})
+    assert parse({"metrics": ["max ap 1 0", "min var 3"]}).metrics == ["max ap 1 0", "min var 3"]
+
+
+def test_the_command_line_without_the_python_package(tmp_path):
+    # An interpreter without tmclsim: the command says how to install it.
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(tmp_path / "bare")], check=True)
+    bare = tmp_path / "bare" / "bin" / "python"
+    r = subprocess.run([tmclsim_bin(), "sweep", str(HOMING), "--matrix", "m.toml"], capture_output=True, text=True,
+                       env=dict(os.environ, TMCLSIM_PYTHON=str(bare)))
+    assert r.returncode != 0 and "pip install './python[sweep]'" in r.stderr, r.stderr
+    r = subprocess.run([tmclsim_bin(), "sweep", "--help"], capture_output=True, text=True,
+                       env=dict(os.environ, TMCLSIM_PYTHON=sys.executable))
+    assert r.returncode == 0 and "--scheduler" in r.stdout and "--matrix" in r.stdout

@@ -192,6 +192,10 @@ class Module:
         """Where the carriage is, in the world's microsteps."""
     def switches(self, motor: int = 0) -> Tuple[bool, bool, bool]:
         """(left, right, home) as the module reads them."""
+    def error_flags(self, motor: int = 0) -> int:
+        """AP 207 as it stands, not cleared (GAP 207 clears it)."""
+    def at_end_stop(self, motor: int = 0) -> bool:
+        """Whether the carriage stands at a mechanical end stop."""
     @property
     def outputs(self) -> int:
         """Digital outputs as a bit vector."""

@@ -13,7 +13,11 @@ from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
 OPS = ("==", "!=", "<=", ">=", "<", ">")
-METRICS = ("time", "position", "carriage", "max_load", "max_speed", "stalled", "end_stop")
+METRICS = ("time", "position", "carriage", "max_load", "max_speed", "stalled", "end_stop", "limit_switch")
+# A value read at every look (each `step`) and kept at its highest or
+# lowest: `max ap 1 0` (how far the counter went), `min ap 206 0`.
+AGGREGATES = ("max", "min")
+CHECKS = ("expr", "no_stall", "no_end_stop", "no_limit_switch", "program_ended", "finished_within")
 
 
 class MatrixError(ValueError):
@@ -36,26 +40,32 @@ def duration(text: Any, key: str) -> float:
 
 @dataclass(frozen=True)
 class Read:
-    """A value of the module: `var N`, `ap N|name MOTOR`, `gp N BANK`."""
+    """A value of the module: `var N`, `ap N|name MOTOR`, `gp N BANK`; with
+    `max ` or `min ` in front, its highest or lowest over every look."""
 
     kind: str
     what: Any
     index: int = 0
+    aggregate: str = ""
 
     @staticmethod
     def parse(words: List[str], key: str) -> Tuple["Read", List[str]]:
+        aggregate = ""
+        if words and words[0].lower() in AGGREGATES:
+            aggregate, words = words[0].lower(), words[1:]
         if not words:
-            raise MatrixError(f"{key}: a value is 'var N', 'ap N MOTOR' or 'gp N BANK'")
+            raise MatrixError(f"{key}: a value is 'var N', 'ap N MOTOR' or 'gp N BANK' (with 'max ' or 'min ' in front: over the run)")
         kind = words[0].lower()
         if kind == "var" and len(words) >= 2:
-            return Read("var", _int(words[1], key)), words[2:]
+            return Read("var", _int(words[1], key), 0, aggregate), words[2:]
         if kind in ("ap", "gp") and len(words) >= 3:
             what = int(words[1]) if words[1].lstrip("-").isdigit() else words[1]
-            return Read(kind, what, _int(words[2], key)), words[3:]
-        raise MatrixError(f"{key}: '{' '.join(words)}': a value is 'var N', 'ap N|NAME MOTOR' or 'gp N BANK'")
+            return Read(kind, what, _int(words[2], key), aggregate), words[3:]
+        raise MatrixError(f"{key}: '{' '.join(words)}': a value is 'var N', 'ap N|NAME MOTOR' or 'gp N BANK' (with 'max ' or 'min ' in front: over the run)")
 
     def label(self) -> str:
-        return f"var {self.what}" if self.kind == "var" else f"{self.kind} {self.what} {self.index}"
+        text = f"var {self.what}" if self.kind == "var" else f"{self.kind} {self.what} {self.index}"
+        return f"{self.aggregate} {text}" if self.aggregate else text
 
 
 @dataclass(frozen=True)
@@ -96,8 +106,9 @@ class Condition:
 
 @dataclass(frozen=True)
 class Check:
-    """What decides pass or fail: a condition on the final state, or one of
-    `no_stall`, `no_end_stop`, `program_ended`, `finished_within`."""
+    """What decides pass or fail: a condition on the final state (or on a
+    `max`/`min` over the run), or one of `no_stall`, `no_end_stop`,
+    `no_limit_switch`, `program_ended`, `finished_within`."""
 
     name: str
     kind: str
@@ -266,9 +277,9 @@ def parse(doc: Dict[str, Any]) -> Matrix:
         key = f"check[{i}]"
         if not isinstance(c, dict):
             raise MatrixError(f"{key}: a table ([[check]])")
-        kinds = [k for k in ("expr", "no_stall", "no_end_stop", "program_ended", "finished_within") if k in c]
+        kinds = [k for k in CHECKS if k in c]
         if len(kinds) != 1:
-            raise MatrixError(f"{key}: exactly one of expr = \"var 0 == 1\", no_stall, no_end_stop, program_ended, finished_within = \"30s\"")
+            raise MatrixError(f"{key}: exactly one of expr = \"var 0 == 1\", no_stall, no_end_stop, no_limit_switch, program_ended, finished_within = \"30s\"")
         kind = kinds[0]
         for k in c:
             if k not in {"name", kind, "tolerance"}:
@@ -293,16 +304,29 @@ def parse(doc: Dict[str, Any]) -> Matrix:
     mx.metrics = []
     for i, x in enumerate(metrics):
         if x in METRICS:
+            if x in mx.metrics:
+                raise MatrixError(f"metrics[{i}]: '{x}' is listed twice")
             mx.metrics.append(x)
         else:
             try:
                 read, rest = Read.parse(str(x).split(), f"metrics[{i}]")
             except MatrixError:
-                raise MatrixError(f"metrics[{i}]: '{x}' is none of {', '.join(METRICS)} and no value ('var N', 'ap N MOTOR', 'gp N BANK')") from None
+                raise MatrixError(f"metrics[{i}]: '{x}' is none of {', '.join(METRICS)} and no value ('var N', 'ap N MOTOR', 'gp N BANK', 'max ap N MOTOR', …)") from None
             if rest:
                 raise MatrixError(f"metrics[{i}]: '{x}': extra words")
+            if read.label() in mx.metrics:
+                raise MatrixError(f"metrics[{i}]: '{x}' is listed twice")
             mx.metrics.append(read.label())
             mx.metric_reads.append(read)
+    # Every column of the table has one name.
+    columns = {"scenario", "passed", "failed_check", "error"}
+    for i, a in enumerate(mx.axes):
+        if a.name in columns:
+            raise MatrixError(f"vary[{i}].name: '{a.name}' is a column of the table already")
+        columns.add(a.name)
+    for i, name in enumerate(mx.metrics):
+        if name in columns:
+            raise MatrixError(f"metrics[{i}]: '{name}' is a column of the table already (a [[vary]] name?)")
     return mx
 
 

@@ -7,6 +7,7 @@ rule 87)."""
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 from typing import Any, Dict, List, Optional, Tuple
 
 from .matrix import Check, Condition, Matrix, MatrixError, Read
@@ -97,10 +98,21 @@ def setup_lines(m, mx: Matrix, values: Dict[str, Any]) -> List[str]:
     return lines
 
 
+def _is_207(r: Read) -> bool:
+    if isinstance(r.what, int):
+        return r.what == 207
+    return str(r.what).lower().replace(" ", "_") == "extended_error_flags"
+
+
 def read(m, r: Read) -> int:
+    """The value now. The sweep only looks: AP 207, which a GAP clears,
+    is read without clearing it, so the program reads what it would have
+    read without the sweep (and `tmclsim run` replays the same run)."""
     if r.kind == "var":
         return m.get_global_parameter(r.what, 2)
     if r.kind == "ap":
+        if _is_207(r):
+            return m.error_flags(r.index)
         return m.get_axis_parameter(r.what, r.index)
     return m.get_global_parameter(r.what, r.index)
 
@@ -121,6 +133,12 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
     profile = profile_of(mx, values)
     doc = world_document(mx, values)
     text = world_toml(doc)
+    # Every value a stop condition, a check or a metric reads; those with
+    # max/min are kept over the run.
+    reads = list(mx.metric_reads) + [c.read for c in mx.stop_when] + [c.condition.read for c in mx.checks if c.condition]
+    kept: Dict[Read, Optional[int]] = {r: None for r in reads if r.aggregate}
+    plain = {r: replace(r, aggregate="") for r in kept}
+    lines: List[str] = []
     try:
         m = tmclsim.Module(profile, world=text)
         m.load_program(tmclsim.Program.from_binary(programs[profile]))
@@ -129,23 +147,39 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
             r = m.send(line)
             if r is None or r.status < 100:
                 raise ScenarioError(f"'{line}' answered {'nothing' if r is None else f'status {r.status} ({r.description})'}")
-    except (ValueError, ScenarioError, MatrixError) as e:
+        for r in reads:
+            # A value the module does not have is the scenario's error,
+            # found before the program runs.
+            read(m, plain.get(r, r))
+    except (ValueError, ScenarioError, MatrixError, tmclsim.TmclError) as e:
         row.update(passed=False, failed_check="setup", error=str(e))
         for name in mx.metrics:
             row[name] = None
-        return row, {"world": text, "setup": ""}
+        return row, {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
     m.run()
     axes = m.axes
-    stalled = end_stop = False
+    stalled = end_stop = limit_switch = False
     max_load = max_speed = 0
     ended_at: Optional[float] = None
     # Only what a check or a metric needs is looked at after each step.
     kinds = {c.kind for c in mx.checks}
     watch_speed = "max_speed" in mx.metrics
-    watch_switches = "no_end_stop" in kinds or "end_stop" in mx.metrics
+    watch_end_stop = "no_end_stop" in kinds or "end_stop" in mx.metrics
+    watch_switches = "no_limit_switch" in kinds or "limit_switch" in mx.metrics
     watch_stall = "no_stall" in kinds or "stalled" in mx.metrics
+    stallguard = m.features.get("stall_detection", "").startswith("stallGuard2")
     watch_load = "max_load" in mx.metrics
-    watch_any = watch_speed or watch_switches or watch_stall or watch_load
+    watch_any = watch_speed or watch_end_stop or watch_switches or watch_stall or watch_load
+
+    def value(r: Read) -> int:
+        return kept[r] if r.aggregate else read(m, r)
+
+    def keep():
+        for r, v in kept.items():
+            now = read(m, plain[r])
+            kept[r] = now if v is None else max(v, now) if r.aggregate == "max" else min(v, now)
+
+    keep()  # the state the scenario starts from counts
     t = 0.0
     while t < mx.duration - 1e-12:
         m.advance(min(mx.step, mx.duration - t))
@@ -153,25 +187,29 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
         for a in range(axes) if watch_any else ():
             if watch_speed:
                 max_speed = max(max_speed, abs(m.actual_speed(a)))
+            if watch_end_stop:
+                end_stop = end_stop or m.at_end_stop(a)
             if watch_switches:
                 left, right, _home = m.switches(a)
-                end_stop = end_stop or left or right
+                limit_switch = limit_switch or left or right
             if watch_stall:
-                # AP 207 reads 1 after a stallGuard stop (and is cleared by
-                # the read, as a host's read would).
-                stalled = stalled or m.get_axis_parameter(207, a) != 0
+                # A stall stop (AP 207 bit 0, looked at without clearing
+                # it), or stallGuard2's flag (AP 208 bit 0: the motor turns
+                # with a load reading of 0, losing steps).
+                stalled = stalled or bool(m.error_flags(a) & 1) or (stallguard and bool(m.get_axis_parameter(208, a) & 1))
             if watch_load:
                 max_load = max(max_load, m.get_axis_parameter(206, a))
+        keep()
         if mx.stop_program_ended and m.program_mode == "stop":
             ended_at = t
             break
         if ended_at is None and not mx.stop_program_ended and m.program_mode == "stop":
             ended_at = t
-        if mx.stop_when and any(c.holds(read(m, c.read)) for c in mx.stop_when):
+        if mx.stop_when and any(c.holds(value(c.read)) for c in mx.stop_when):
             break
     failed = ""
     for c in mx.checks:
-        ok = _check(m, c, ended_at, stalled, end_stop)
+        ok = _check(c, value, ended_at, stalled, end_stop, limit_switch)
         if not ok:
             failed = c.name
             break
@@ -185,21 +223,24 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
             "max_speed": lambda: max_speed,
             "stalled": lambda: stalled,
             "end_stop": lambda: end_stop,
+            "limit_switch": lambda: limit_switch,
         }.get(name, lambda: None)()
     for r in mx.metric_reads:
-        row[r.label()] = read(m, r)
+        row[r.label()] = value(r)
     files = None if not failed else {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
     return row, files
 
 
-def _check(m, c: Check, ended_at, stalled, end_stop) -> bool:
+def _check(c: Check, value, ended_at, stalled, end_stop, limit_switch) -> bool:
     if c.kind == "expr":
         cond: Condition = c.condition
-        return cond.holds(read(m, cond.read))
+        return cond.holds(value(cond.read))
     if c.kind == "no_stall":
         return not stalled
     if c.kind == "no_end_stop":
         return not end_stop
+    if c.kind == "no_limit_switch":
+        return not limit_switch
     if c.kind == "program_ended":
         return ended_at is not None
     if c.kind == "finished_within":
