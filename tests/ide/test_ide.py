@@ -193,6 +193,25 @@ def test_ide_against_a_served_module_over_tcp(served, page, start):
     tab(page, "world")
     assert page.is_visible("#world-none")
     assert not page.is_visible("#world-controls")
+    # A program over TMCL: downloaded and verified, a breakpoint reached by
+    # single steps; flags and stack depth are not in TMCL's answers.
+    tab(page, "program")
+    page.evaluate("s => window.tmclEditor.setValue(s)", COUNTER_WITH_ERROR.replace("JA Lop", "JA Loop"))
+    page.click("[data-testid=prog-download]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
+    page.locator(".CodeMirror-linenumber").get_by_text("4", exact=True).click()
+    page.click("[data-testid=prog-run]")
+    page.wait_for_function("document.querySelector('[data-testid=editor]').dataset.currentLine === '4'")
+    page.wait_for_function("document.querySelector('[data-testid=ps-acc]').textContent === '1'")
+    assert page.inner_text("[data-testid=ps-flags]") == "not reported over TMCL"
+    assert page.inner_text("[data-testid=ps-stack]") == "not reported over TMCL"
+    with pytrinamic(served) as interface:
+        # The module the app drives over TMCL is the served one: 135 type 1
+        # answers mode << 24 | waiting << 16 | program counter (behaviour
+        # rule 17): in step mode, on the breakpoint's address.
+        status = interface.send(135, 1, 0, 0).value
+        assert (status >> 24, status & 0xFFFF) == (2, 2)
+    page.click("[data-testid=prog-stop]")
 
 
 def test_a_foreign_origin_is_refused(served):
