@@ -118,7 +118,9 @@ export class ChartsPanel {
     const width = this.width();
     const sync = uPlot.sync("tmclsim");
     let i = 0;
-    this.charts = this.panels.map((panel) => {
+    this.charts = this.panels.map((panel, p) => {
+      // One time axis label, under the last panel.
+      const last = p === this.panels.length - 1;
       const idx = panel.series.map(() => i++);
       const div = el("div", { class: "chart", "data-testid": `chart-${panel.title.toLowerCase().replace(/\W+/g, "-")}` });
       this.box.append(div);
@@ -130,7 +132,7 @@ export class ChartsPanel {
         hooks: { setSelect: [(u) => u.select.width > 0 && this.pause(true)] },
         scales: { x: { time: false } },
         axes: [
-          { label: "time (s)", stroke: "#6a7683" },
+          last ? { label: "time (s)", stroke: "#6a7683" } : { stroke: "#6a7683", labelSize: 0, size: 30 },
           { label: panel.unit, stroke: "#6a7683", size: 70 },
         ],
         series: [
