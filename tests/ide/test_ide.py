@@ -115,7 +115,19 @@ def test_direct_mode_answers_in_words(served, page):
     assert page.input_value("[data-testid=direct-input]") == "GPA 4, 0"
     page.fill("[data-testid=direct-input]", "GAP actual_pos")
     page.press("[data-testid=direct-input]", "Tab")
-    assert page.input_value("[data-testid=direct-input]") == "GAP actual_position"
+    assert page.input_value("[data-testid=direct-input]") == "GAP actual_position, "
+    # A mnemonic, then its symbolic operand, are completed the same way, and
+    # the completed line is one the module takes.
+    page.fill("[data-testid=direct-input]", "rs")
+    page.press("[data-testid=direct-input]", "Tab")
+    assert page.input_value("[data-testid=direct-input]") == "RS"  # RSAP, RSGP, RSUB…
+    page.fill("[data-testid=direct-input]", "MVP r")
+    page.press("[data-testid=direct-input]", "Tab")
+    assert page.input_value("[data-testid=direct-input]") == "MVP REL, "
+    page.type("[data-testid=direct-input]", "0, 0")
+    page.press("[data-testid=direct-input]", "Enter")
+    replies.nth(3).wait_for()
+    assert "[100 " in replies.nth(3).inner_text(), replies.nth(3).inner_text()
     page.fill("[data-testid=direct-input]", "")
     shot(page, "direct")
 

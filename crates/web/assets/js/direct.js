@@ -2,6 +2,21 @@
 // parameter names), replies decoded by the server.
 import { post, el, m } from "./api.js";
 
+// The symbolic first operands the command line takes (the protocol crate's
+// mnemonic tables); parameter names for the parameter commands.
+const CALC = ["ADD", "SUB", "MUL", "DIV", "MOD", "AND", "OR", "XOR", "NOT", "LOAD", "SWAP", "COMP"];
+const SYMBOLS = {
+  MVP: ["ABS", "REL", "COORD"],
+  MVPA: ["ABS", "REL", "COORD"],
+  RFS: ["START", "STOP", "STATUS"],
+  JC: ["ZE", "NZ", "EQ", "NE", "GT", "GE", "LT", "LE", "ETO", "EAL", "EDV", "EPO"],
+  WAIT: ["TICKS", "POS", "REFSW", "LIMSW", "RFS"],
+  CLE: ["ALL", "ETO", "EAL", "EDV", "EPO", "ESD"],
+  ...Object.fromEntries(["CALC", "CALCX", "CALCV", "CALCVV", "CALCVA", "CALCAV", "CALCVX", "CALCXV"].map((c) => [c, CALC])),
+};
+const AXIS_COMMANDS = ["SAP", "GAP", "STAP", "RSAP", "AAP"];
+const GLOBAL_COMMANDS = ["SGP", "GGP", "STGP", "RSGP", "AGP"];
+
 export class DirectPanel {
   constructor() {
     this.input = document.getElementById("direct-input");
@@ -31,16 +46,21 @@ export class DirectPanel {
     this.ctx = ctx;
     const p = ctx.profile;
     this.commands = p ? p.commands : [];
-    this.names = p ? [...p.axis_parameters, ...p.global_parameters].map((r) => r.snake) : [];
+    this.axisNames = p ? [...new Set(p.axis_parameters.map((r) => r.snake))] : [];
+    this.globalNames = p ? [...new Set(p.global_parameters.map((r) => r.snake))] : [];
     this.fillCompletions();
   }
 
-  /** Candidates for the word being typed: a mnemonic first, then names. */
+  /** Candidates for the word being typed: a mnemonic first, then its
+   * first operand's symbols or parameter names. */
   candidates() {
     const text = this.input.value;
     const words = text.split(/[\s,]+/);
     const word = words[words.length - 1];
-    const pool = words.length <= 1 ? this.commands : this.names;
+    const cmd = words[0].toUpperCase();
+    let pool = [];
+    if (words.length <= 1) pool = this.commands;
+    else if (words.length === 2) pool = SYMBOLS[cmd] ?? (AXIS_COMMANDS.includes(cmd) ? this.axisNames : GLOBAL_COMMANDS.includes(cmd) ? this.globalNames : []);
     return { word, text, hits: pool.filter((c) => c.toLowerCase().startsWith(word.toLowerCase())) };
   }
 
@@ -55,7 +75,8 @@ export class DirectPanel {
     if (!hits.length) return;
     let common = hits[0];
     for (const h of hits) while (!h.toLowerCase().startsWith(common.toLowerCase())) common = common.slice(0, -1);
-    const add = hits.length === 1 ? hits[0] + (text.trim().split(/\s+/).length <= 1 ? " " : "") : common;
+    // A unique mnemonic gets its space, a unique first operand its comma.
+    const add = hits.length === 1 ? hits[0] + (text.trim().split(/[\s,]+/).length <= 1 ? " " : ", ") : common;
     this.input.value = text.slice(0, text.length - word.length) + add;
   }
 
