@@ -160,6 +160,16 @@ def test_a_program_is_fixed_downloaded_and_stops_at_a_breakpoint(served, page):
     page.wait_for_function("document.querySelector('[data-testid=ps-acc]').textContent === '2'")
     page.click("[data-testid=prog-stop]")
     page.wait_for_function("document.querySelector('[data-testid=ps-mode]').textContent.startsWith('stopped')")
+    # A line inserted above moves the breakpoint with its line; after the
+    # next download the program stops there, now line 5.
+    page.evaluate("() => window.tmclEditor.replaceRange('// one line more\\n', { line: 0, ch: 0 })")
+    page.evaluate("() => { document.querySelector('[data-testid=prog-message]').textContent = ''; }")
+    page.click("[data-testid=prog-download]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
+    page.click("[data-testid=prog-run]")
+    page.wait_for_function("document.querySelector('[data-testid=editor]').dataset.currentLine === '5'")
+    assert page.inner_text("[data-testid=ps-break]") == "at address 2"
+    page.click("[data-testid=prog-stop]")
 
 
 def test_a_stop_switch_pressed_in_the_world_panel_stops_the_motor(served, page):

@@ -28,7 +28,6 @@ export class ProgramPanel {
       indentUnit: 8,
     });
     window.tmclEditor = this.editor;
-    this.breakLines = new Set();
     this.map = null; // address → line, from the last download
     this.widgets = [];
     this.editor.on("gutterClick", (cm, line) => this.toggle(line + 1));
@@ -126,21 +125,28 @@ export class ProgramPanel {
     return best;
   }
 
+  /** Lines (1-based) with a breakpoint marker: the markers move with
+   * their lines as the source is edited. */
+  breakLines() {
+    const lines = [];
+    this.editor.eachLine((h) => {
+      if (h.gutterMarkers?.breakpoints) lines.push(this.editor.getLineNumber(h) + 1);
+    });
+    return lines;
+  }
+
   toggle(line) {
-    const info = this.editor.lineInfo(line - 1);
-    if (this.breakLines.has(line)) {
-      this.breakLines.delete(line);
-      this.editor.setGutterMarker(line - 1, "breakpoints", null);
-    } else {
-      this.breakLines.add(line);
-      this.editor.setGutterMarker(line - 1, "breakpoints", el("div", { class: "breakpoint", "data-testid": "breakpoint", text: "●" }));
-    }
-    void info;
-    if (this.map) this.sendBreakpoints();
+    const on = !this.editor.lineInfo(line - 1).gutterMarkers?.breakpoints;
+    this.editor.setGutterMarker(line - 1, "breakpoints", on ? el("div", { class: "breakpoint", "data-testid": "breakpoint", text: "●" }) : null);
+    if (!this.map) return;
+    // The addresses come from the downloaded program's source map: after an
+    // edit, they are sent with the next download.
+    if (this.stale) this.say("edited since the download: the breakpoints apply after the next download");
+    else this.sendBreakpoints();
   }
 
   async sendBreakpoints() {
-    const addresses = [...this.breakLines].map((l) => this.addressOf(l)).filter(Boolean).map(([a]) => a);
+    const addresses = this.breakLines().map((l) => this.addressOf(l)).filter(Boolean).map(([a]) => a);
     const st = await post(m(this.ctx.id, "program/breakpoints"), { addresses });
     if (st.error) this.say(st.error, true);
     else this.showState(st);
