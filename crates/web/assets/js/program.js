@@ -86,7 +86,8 @@ export class ProgramPanel {
     const a = await post("/api/assemble", { source: this.editor.getValue(), profile: this.ctx?.profile?.name });
     if (a.error) return this.say(a.error, true);
     this.showDiagnostics(a.diagnostics);
-    if (a.ok) this.say(`assembled: ${a.words} words`);
+    const room = this.ctx?.profile ? ` of ${this.ctx.profile.program_memory}` : "";
+    if (a.ok) this.say(`assembled: ${a.words} words${room}`);
     else this.say(`${a.diagnostics.length} error(s)`, true);
     return a;
   }
@@ -98,14 +99,16 @@ export class ProgramPanel {
 
   async download() {
     const bar = document.getElementById("prog-progress");
+    const button = document.getElementById("prog-download");
     bar.value = 0;
     this.say("downloading…");
+    button.disabled = true;
     const last = await postLines(m(this.ctx.id, "program/download"), { source: this.editor.getValue() }, (x) => {
       if (x.progress !== undefined) {
         bar.max = x.total;
         bar.value = x.progress;
       }
-    });
+    }).finally(() => (button.disabled = false));
     if (!last) return this.say("no answer", true);
     if (last.ok === false) {
       this.showDiagnostics(last.diagnostics);
@@ -115,7 +118,8 @@ export class ProgramPanel {
     this.clearDiagnostics();
     this.useMap(last.program.source_map);
     await this.sendBreakpoints();
-    this.say(`downloaded ${last.words} words, verified by reading back (134)`);
+    if (last.verified) this.say(`downloaded ${last.words} words, verified by reading back (134)`);
+    else this.say(`downloaded ${last.words} words, but reading them back (134) found a difference`, true);
   }
 
   /** The first address at a line, or at the next line with an instruction. */
