@@ -343,3 +343,21 @@ def test_charts_follow_a_chosen_motor_and_the_world_sets_an_analog_input(page, s
     page.wait_for_function("document.querySelector('[data-testid=analog-1-4] .value').textContent === '3071'")
     with ConnectionManager(f"--interface socket_serial_tmcl --port {served.printed('tcp')}").connect() as interface:
         assert interface.send(15, 4, 1, 0).value == 3071
+
+
+def test_a_public_address_needs_the_token(page, start):
+    served = start(["serve", "--tcp", "127.0.0.1:0", "--web", "0.0.0.0:0", "--web-public"])
+    url = served.printed("web").replace("0.0.0.0", "127.0.0.1")
+    base, token = url.split("?token=")
+    try:
+        urllib.request.urlopen(base + "api/modules")
+        raise AssertionError("served without the token")
+    except urllib.error.HTTPError as e:
+        assert e.code == 403
+    # The page opened with the token keeps it (a cookie) for the API and
+    # the live stream.
+    open_app(page, url)
+    tab(page, "motion")
+    page.wait_for_function("document.querySelector('[data-testid=ro-position]').textContent === '0'")
+    with urllib.request.urlopen(f"{base}api/modules?token={token}") as r:
+        assert json.loads(r.read())[0]["profile"] == "TMCM-1141"
