@@ -175,11 +175,16 @@ def test_the_command_line(tmp_path):
                       '[[check]]\nname = "homed"\nexpr = "var 0 == 1"\n')
     env = dict(os.environ, TMCLSIM_PYTHON=sys.executable)
     out = tmp_path / "r.csv"
+    # Failure files of an earlier sweep go; other files stay.
+    (tmp_path / "f").mkdir()
+    (tmp_path / "f" / "failure-99.toml").write_text("")
+    (tmp_path / "f" / "notes.txt").write_text("mine")
     r = subprocess.run([tmclsim_bin(), "sweep", str(HOMING), "--matrix", str(matrix), "--workers", "0", "--out", str(out),
                         "--failures", str(tmp_path / "f")], capture_output=True, text=True, env=env, cwd=tmp_path)
     assert r.returncode == 1, r.stderr  # a failure: exit status 1
     assert "2 scenarios" in r.stdout and "1 passed, 1 failed" in r.stdout and "homed" in r.stdout
     assert "--world " in r.stdout and (tmp_path / "f" / "failure-1.toml").exists()
+    assert sorted(p.name for p in (tmp_path / "f").iterdir()) == ["failure-1.setup", "failure-1.toml", "notes.txt"]
     assert out.read_text().splitlines()[0].startswith("scenario,axis.0.home_switch.from,passed")
     bad = tmp_path / "bad.toml"
     bad.write_text("[[vary]]\nworld = 3\nvalues = [1]\n")

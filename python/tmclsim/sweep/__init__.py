@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import pathlib
+import re
 import sys
 import time
 from typing import Any, Dict, Optional, Union
@@ -50,6 +51,20 @@ def _programs(program, mx: Matrix) -> Dict[str, bytes]:
     return out
 
 
+_FAILURE_FILE = re.compile(r"failure-[0-9]+\.(toml|setup)")
+
+
+def clear_failures(directory: _Path) -> None:
+    """Removes the failure files an earlier sweep left in `directory` (only
+    files named failure-N.toml and failure-N.setup), so that the directory
+    holds this sweep's failures and no others."""
+    d = pathlib.Path(directory)
+    if d.is_dir():
+        for f in d.iterdir():
+            if _FAILURE_FILE.fullmatch(f.name) and f.is_file():
+                f.unlink()
+
+
 def write_failure(directory: _Path, index: int, files: Dict[str, str]) -> pathlib.Path:
     """`failure-N.toml` (the world) and `failure-N.setup` (the parameter
     set as direct-mode commands) for `tmclsim run --world … --setup …`."""
@@ -78,7 +93,8 @@ def sweep(program, matrix, workers: Optional[int] = None, scheduler: Optional[st
     Returns a pandas DataFrame, one row per scenario in scenario order
     (with `details=True`, a `Sweep` with the failures' files too). `out`
     writes the table (.parquet or .csv); `failures` a directory for each
-    failure's world and setup files."""
+    failure's world and setup files (those an earlier sweep left there are
+    removed first)."""
     import pandas as pd
 
     mx = matrix if isinstance(matrix, Matrix) else parse(matrix) if isinstance(matrix, dict) else load(matrix)
@@ -117,6 +133,7 @@ def sweep(program, matrix, workers: Optional[int] = None, scheduler: Optional[st
         else:
             raise ValueError(f"{path}: the table is written as .parquet or .csv")
     if failures is not None:
+        clear_failures(failures)
         for i, files in failed.items():
             write_failure(failures, i, files)
     return Sweep(table, failed, seconds) if details else table
