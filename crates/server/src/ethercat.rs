@@ -4,10 +4,10 @@
 
 use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 use tmclsim_ethercat::Segment;
-use tmclsim_firmware::eeprom::EepromFile;
+use tmclsim_firmware::eeprom::{Eeprom, EepromFile};
 
 const ETH_P_ALL: u16 = 0x0003;
 const PACKET_OUTGOING: u8 = 4;
@@ -16,6 +16,9 @@ const PACKET_OUTGOING: u8 = 4;
 pub struct EthercatHandle {
     stop: Arc<AtomicBool>,
     thread: Option<std::thread::JoinHandle<()>>,
+    /// Saves EEPROM writes; ends once the frame thread has ended and
+    /// every write it handed over is saved.
+    saver: Option<std::thread::JoinHandle<()>>,
     pub segment: Arc<Mutex<Segment>>,
     /// Frames processed and frames ignored (not EtherCAT or malformed).
     pub counters: Arc<Mutex<(u64, u64)>>,
@@ -28,13 +31,15 @@ impl EthercatHandle {
 
     fn shutdown(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
+        self.join();
     }
 
     pub fn wait(mut self) {
-        if let Some(t) = self.thread.take() {
+        self.join();
+    }
+
+    fn join(&mut self) {
+        for t in [self.thread.take(), self.saver.take()].into_iter().flatten() {
             let _ = t.join();
         }
     }
@@ -83,17 +88,27 @@ fn open(iface: &str) -> io::Result<(libc::c_int, libc::c_int)> {
 }
 
 /// Serves `segment` on `iface` in a background thread, in wall-clock
-/// time; module `i`'s EEPROM is saved to `eeproms[i]` on every write (the
-/// files stay held until the segment stops).
+/// time; module `i`'s EEPROM is saved to `eeproms[i]` after every write
+/// (the files stay held until the segment stops).
+///
+/// Frames never wait for the disk: an EtherCAT slave controller answers
+/// a frame as it passes, while the module's EEPROM write runs behind it.
+/// A master's frame timeout is a few milliseconds, a synced file write
+/// on a busy machine can take longer, so saves run on their own thread.
 pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>) -> io::Result<EthercatHandle> {
     let (fd, index) = open(iface)?;
     segment.bus.set_stepped(false);
-    // What each file holds: a module goes back to it when a save fails
-    // (docs/behaviour.md rule 82).
-    let mut persisted: Vec<_> = segment.bus.modules().iter().map(|m| m.eeprom().clone()).collect();
+    let persisted: Vec<_> = segment.bus.modules().iter().map(|m| m.eeprom().clone()).collect();
     let stop = Arc::new(AtomicBool::new(false));
     let segment = Arc::new(Mutex::new(segment));
     let counters = Arc::new(Mutex::new((0u64, 0u64)));
+    let (writes, written) = mpsc::channel::<(usize, Eeprom)>();
+    let saver = {
+        let segment = segment.clone();
+        std::thread::Builder::new()
+            .name("tmclsim-ethercat-eeprom".into())
+            .spawn(move || save_writes(written, eeproms, persisted, segment))?
+    };
     let (t_stop, t_segment, t_counters) = (stop.clone(), segment.clone(), counters.clone());
     let thread = std::thread::Builder::new().name("tmclsim-ethercat".into()).spawn(move || {
         let mut buf = vec![0u8; 2048];
@@ -115,20 +130,9 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>
             let processed = {
                 let mut seg = t_segment.lock().unwrap_or_else(|p| p.into_inner());
                 let processed = seg.process(frame);
-                // Effects: EEPROM writes are saved; events have no link.
+                // Effects: EEPROM writes go to the saver; events have no link.
                 for i in seg.bus.take_effects().eeprom_written {
-                    let Some(Some(file)) = eeproms.get(i) else { continue };
-                    let image = seg.bus.module(i).eeprom();
-                    match file.save(image) {
-                        Ok(()) => persisted[i] = image.clone(),
-                        Err(e) => {
-                            eprintln!(
-                                "tmclsim: cannot write EEPROM file {}: {e}; the write is not kept (the module keeps the EEPROM the file holds)",
-                                file.named().display()
-                            );
-                            seg.bus.module_mut(i).restore_eeprom(persisted[i].clone());
-                        }
-                    }
+                    let _ = writes.send((i, seg.bus.module(i).eeprom().clone()));
                 }
                 processed
             };
@@ -159,7 +163,40 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>
         unsafe {
             libc::close(fd);
         }
-        let _ = Duration::ZERO;
     })?;
-    Ok(EthercatHandle { stop, thread: Some(thread), segment, counters })
+    Ok(EthercatHandle { stop, thread: Some(thread), saver: Some(saver), segment, counters })
+}
+
+/// Saves each module's EEPROM writes to its file, the newest image of a
+/// module when several wait. A save that fails puts the module back to
+/// what its file holds (docs/behaviour.md rule 82). Returns when the
+/// frame thread has ended and nothing waits.
+fn save_writes(
+    written: mpsc::Receiver<(usize, Eeprom)>,
+    eeproms: Vec<Option<EepromFile>>,
+    mut persisted: Vec<Eeprom>,
+    segment: Arc<Mutex<Segment>>,
+) {
+    while let Ok(first) = written.recv() {
+        let mut newest: Vec<Option<Eeprom>> = vec![None; persisted.len()];
+        for (i, image) in std::iter::once(first).chain(written.try_iter()) {
+            if let Some(slot) = newest.get_mut(i) {
+                *slot = Some(image);
+            }
+        }
+        for (i, image) in newest.into_iter().enumerate() {
+            let (Some(image), Some(Some(file))) = (image, eeproms.get(i)) else { continue };
+            match file.save(&image) {
+                Ok(()) => persisted[i] = image,
+                Err(e) => {
+                    eprintln!(
+                        "tmclsim: cannot write EEPROM file {}: {e}; the write is not kept (the module keeps the EEPROM the file holds)",
+                        file.named().display()
+                    );
+                    let mut seg = segment.lock().unwrap_or_else(|p| p.into_inner());
+                    seg.bus.module_mut(i).restore_eeprom(persisted[i].clone());
+                }
+            }
+        }
+    }
 }
