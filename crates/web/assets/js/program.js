@@ -184,7 +184,7 @@ export class ProgramPanel {
     set("ps-stack", st.stack_depth ?? "not reported over TMCL");
     set("ps-break", st.breakpoint === null ? "–" : `at address ${st.breakpoint}`);
     document.getElementById("ps-vars").replaceChildren(
-      ...st.user_variables.map((v, i) => el("tr", {}, el("td", { text: `#${i}` }), el("td", { text: v ?? "–" }))),
+      ...st.user_variables.flatMap((v, i) => [el("span", { class: "var", text: `#${i}` }), el("span", { "data-testid": `var-${i}`, text: v ?? "–" })]),
     );
     const line = this.map?.get(st.pc);
     if (line !== undefined && !this.stale) {
