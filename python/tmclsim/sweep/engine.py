@@ -16,9 +16,9 @@ Result = Tuple[Dict[str, Any], Optional[Dict[str, str]]]
 
 def batches(items: List[Tuple[int, Dict[str, Any]]], workers: int, size: Optional[int]) -> List[List[Tuple[int, Dict[str, Any]]]]:
     """About eight batches per worker (so that late ones balance), at most
-    200 scenarios each."""
+    1000 scenarios each (a few seconds of work)."""
     if size is None:
-        size = max(1, min(200, -(-len(items) // max(1, 8 * workers))))
+        size = max(1, min(1000, -(-len(items) // max(1, 8 * workers))))
     return [items[i : i + size] for i in range(0, len(items), size)]
 
 
