@@ -137,7 +137,8 @@ pub struct ServeArgs {
     #[arg(long, value_name = "FILE")]
     pub endpoints: Option<PathBuf>,
     /// Print every frame in and out on stderr, decoded (command or status
-    /// and value), with the time since start and the link it came on.
+    /// and value), with the time since start and the link it came on
+    /// (the browser IDE's commands: `web`; its polled reads are not logged).
     #[arg(long, short = 'v')]
     pub log_frames: bool,
     /// Allow --control on an address other machines reach; clients must

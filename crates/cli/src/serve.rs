@@ -239,7 +239,7 @@ fn serve(
 /// `--web`: the browser IDE over the served modules; prints its URL.
 pub(crate) fn start_web(args: &ServeArgs, links: &[tmclsim_server::LinkHandle]) -> Result<Option<tmclsim_web::WebHandle>, String> {
     let Some(addr) = args.web else { return Ok(None) };
-    let target = Arc::new(tmclsim_web::VirtualTarget::new(links));
+    let target = Arc::new(tmclsim_web::VirtualTarget::new(links).with_frame_log(args.log_frames));
     let web = crate::ide::start(target, addr, args.web_public)?;
     println!("  web: {}  (the browser IDE)", web.url());
     Ok(Some(web))

@@ -86,3 +86,41 @@ fn ethercat_slaves_are_not_served_to_the_ide() {
     assert!(!out.status.success());
     assert!(text(&out).contains("--web cannot serve EtherCAT slaves"), "{}", text(&out));
 }
+
+/// POST a JSON body to the app at `url`: the status line and the body.
+fn post(url: &str, path: &str, json: &str) -> (String, String) {
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut s = TcpStream::connect(addr).unwrap();
+    write!(
+        s,
+        "POST {path} HTTP/1.1\r\nHost: {addr}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{json}",
+        json.len()
+    )
+    .unwrap();
+    let mut all = String::new();
+    s.read_to_string(&mut all).unwrap();
+    let (head, body) = all.split_once("\r\n\r\n").unwrap();
+    (head.lines().next().unwrap().to_string(), body.to_string())
+}
+
+#[test]
+fn log_frames_shows_the_apps_commands_on_the_link_web() {
+    let server = Server::start(&["--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0", "--log-frames"]);
+    let url = server.printed("web");
+    let (status, body) = post(&url, "/api/modules/0/command", r#"{"line":"SAP 4, 0, 1234"}"#);
+    assert!(status.contains("200") && body.contains("\"status\":100"), "{status} {body}");
+    let line = server.logged(&[" web ← "]).expect("the app's reply logged");
+    assert!(line.ends_with("from 1: status 100 (ok), value 1234"), "{line}");
+    let log = server.log.lock().unwrap().join("\n");
+    assert!(log.contains(" s web → 01 05 04 00 00 00 04 D2 E0  to 1: SAP 4, 0, 1234"), "{log}");
+    // The app's polled reads (charts, grid) are not logged; the next
+    // command is, right after the first.
+    let (status, body) = post(&url, "/api/modules/0/read", r#"{"reads":[{"kind":"ap","number":4}]}"#);
+    assert!(status.contains("200") && body.contains("1234"), "{status} {body}");
+    post(&url, "/api/modules/0/command", r#"{"line":"GAP 4, 0"}"#);
+    server.logged(&[" web ← 02 01 64 06 "]).expect("the reply to GAP logged");
+    let log = server.log.lock().unwrap().join("\n");
+    let web: Vec<&str> = log.lines().filter(|l| l.contains(" s web ")).collect();
+    assert_eq!(web.len(), 4, "{log}");
+    assert!(web[2].ends_with("to 1: GAP 4, 0"), "{}", web[2]);
+}

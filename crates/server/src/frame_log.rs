@@ -5,13 +5,17 @@
 //! tmclsim: 12.345678 s tcp 127.0.0.1:40112 #3 → 01 06 01 00 00 00 00 00 08  to 1: GAP 1, 0
 //! tmclsim: 12.345701 s tcp 127.0.0.1:40112 #3 ← 02 01 64 06 00 00 03 E8 58  from 1: status 100 (ok), value 1000
 //! ```
+//!
+//! The browser IDE's commands (`serve --web`) are logged as coming on the
+//! link `web`; its polled reads for charts, the grid and the program state
+//! are not (fifty lines a second would bury everything else).
 
 use std::sync::OnceLock;
 use std::time::Instant;
 use tmclsim_protocol::{FRAME_LEN, Reply, Request, Status, mnemonic};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Direction {
+pub enum Direction {
     In,
     Out,
 }
@@ -24,7 +28,7 @@ pub(crate) fn started() -> Instant {
 }
 
 /// The log line of one frame (without the `tmclsim:` prefix and time).
-pub(crate) fn describe(direction: Direction, frame: &[u8; FRAME_LEN]) -> String {
+pub fn describe(direction: Direction, frame: &[u8; FRAME_LEN]) -> String {
     let hex: Vec<String> = frame.iter().map(|b| format!("{b:02X}")).collect();
     let meaning = match direction {
         Direction::In => match Request::decode(frame) {
@@ -44,8 +48,13 @@ pub(crate) fn describe(direction: Direction, frame: &[u8; FRAME_LEN]) -> String 
 }
 
 pub(crate) fn print(link_name: &str, link: u64, direction: Direction, frame: &[u8; FRAME_LEN]) {
+    print_from(&format!("{link_name} #{link}"), direction, frame);
+}
+
+/// One frame's log line, from `source` (a link and its number, or `web`).
+pub fn print_from(source: &str, direction: Direction, frame: &[u8; FRAME_LEN]) {
     let t = started().elapsed().as_secs_f64();
-    eprintln!("tmclsim: {t:.6} s {link_name} #{link} {}", describe(direction, frame));
+    eprintln!("tmclsim: {t:.6} s {source} {}", describe(direction, frame));
 }
 
 #[cfg(test)]

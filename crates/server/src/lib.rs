@@ -11,7 +11,7 @@ mod clock;
 pub mod control;
 pub mod ethercat;
 mod faults;
-mod frame_log;
+pub mod frame_log;
 mod link;
 mod pty;
 mod shared;

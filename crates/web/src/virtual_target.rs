@@ -7,6 +7,7 @@ use crate::target::{ModuleEntry, Target, TargetError};
 use std::sync::Arc;
 use tmclsim_firmware::snapshot::ModuleSnapshot;
 use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
+use tmclsim_server::frame_log::{self, Direction};
 use tmclsim_server::{LinkHandle, SharedBus};
 
 struct Place {
@@ -18,6 +19,8 @@ pub struct VirtualTarget {
     entries: Vec<ModuleEntry>,
     places: Vec<Place>,
     description: String,
+    /// `serve --log-frames`: the app's commands are logged on link `web`.
+    log_frames: bool,
 }
 
 impl VirtualTarget {
@@ -40,7 +43,14 @@ impl VirtualTarget {
             [one] => link_name(one),
             _ => format!("{} links", links.len()),
         };
-        VirtualTarget { entries, places, description }
+        VirtualTarget { entries, places, description, log_frames: false }
+    }
+
+    /// Logs each command of the app and its reply as `serve --log-frames`
+    /// logs a link's frames (polled reads are not logged).
+    pub fn with_frame_log(mut self, on: bool) -> VirtualTarget {
+        self.log_frames = on;
+        self
     }
 
     fn place(&self, id: usize) -> Result<&Place, TargetError> {
@@ -76,9 +86,16 @@ impl Target for VirtualTarget {
         // The module's address now: a program or a host may have changed it.
         let address = p.bus.with_module(p.index, |m| m.address());
         let frame = Request::new(address, ins).encode();
+        if self.log_frames {
+            frame_log::print_from("web", Direction::In, &frame);
+        }
         // Only the addressed module answers (136 type 0 and 134 replies
         // carry text or the stored word where the address would be).
-        p.bus.frame(&frame).into_iter().next().ok_or_else(|| TargetError::Failed("no reply (replies suppressed by GP 255?)".into()))
+        let reply = p.bus.frame(&frame).into_iter().next();
+        if let (true, Some(r)) = (self.log_frames, &reply) {
+            frame_log::print_from("web", Direction::Out, r);
+        }
+        reply.ok_or_else(|| TargetError::Failed("no reply (replies suppressed by GP 255?)".into()))
     }
 
     fn sample(&self, id: usize, all: &[Instruction]) -> Result<(Vec<[u8; FRAME_LEN]>, f64), TargetError> {
