@@ -111,6 +111,7 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>
     };
     let (t_stop, t_segment, t_counters) = (stop.clone(), segment.clone(), counters.clone());
     let thread = std::thread::Builder::new().name("tmclsim-ethercat".into()).spawn(move || {
+        realtime();
         let mut buf = vec![0u8; 2048];
         while !t_stop.load(Ordering::Relaxed) {
             // SAFETY: receiving into a buffer we own, with its length.
@@ -165,6 +166,19 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>
         }
     })?;
     Ok(EthercatHandle { stop, thread: Some(thread), saver: Some(saver), segment, counters })
+}
+
+/// Puts the calling thread at a real-time priority where the process may
+/// (root, or CAP_SYS_NICE; serving a raw interface needs CAP_NET_RAW
+/// anyway): a slave controller answers a frame as it passes, and a master
+/// gives up on a frame after a few milliseconds, so busy processes on the
+/// machine must not keep the frame waiting. The thread blocks on the
+/// socket between frames and works for microseconds per frame. Elsewhere
+/// it stays at the normal priority.
+fn realtime() {
+    let param = libc::sched_param { sched_priority: 10 };
+    // SAFETY: sets the scheduling of this thread with a valid parameter.
+    let _ = unsafe { libc::pthread_setschedparam(libc::pthread_self(), libc::SCHED_FIFO, &param) };
 }
 
 /// Saves each module's EEPROM writes to its file, the newest image of a
