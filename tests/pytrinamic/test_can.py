@@ -19,7 +19,11 @@ def test_two_modules_on_one_can_bus(serve, tmp_path):
             interface.set_axis_parameter(4, 0, 1000 + module_id)
             assert interface.get_axis_parameter(4, 0) == 1000 + module_id
             if module_id == 3:
-                # The TMCM-351 has three axes and 24-bit positions.
+                # The TMCM-351 has three axes and 24-bit positions. The
+                # motor is stopped first (MST: velocity mode at 0), as the
+                # manual asks before AP 1 is overwritten: in position mode
+                # it would head for the target at once.
+                interface.stop(2)
                 interface.set_axis_parameter(1, 2, -8388608)
                 assert interface.get_axis_parameter(1, 2, signed=True) == -8388608
 
