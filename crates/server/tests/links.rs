@@ -173,6 +173,9 @@ fn ascii_session_on_the_pty_in_every_echo_mode() {
     let config = ServerConfig { pty: Some(link.clone()), ..ServerConfig::default() };
     let server = start(Module::built_in("tmcm-1141").unwrap(), config).unwrap();
     let mut port = std::fs::OpenOptions::new().read(true).write(true).open(&link).unwrap();
+    // The motor is stopped before AP 1 is overwritten, as the manual asks:
+    // in position mode (the power-on mode) it would head for its target.
+    assert_eq!(ask(&mut port, "MST 0").status, 100);
     assert_eq!(ask(&mut port, "#139 0 0 0").status, 100);
     let mut session = |line: &str, expect: &str| {
         port.write_all(line.as_bytes()).unwrap();
