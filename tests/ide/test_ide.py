@@ -132,6 +132,33 @@ def test_direct_mode_answers_in_words(served, page):
     shot(page, "direct")
 
 
+def test_a_line_typed_while_a_command_is_on_its_way_is_kept(served, page):
+    open_app(page, served.url)
+    # The first command's reply is held back half a second (a slow link).
+    page.evaluate("""() => {
+      const fetch = window.fetch;
+      let first = true;
+      window.fetch = async (url, init) => {
+        if (first && String(url).endsWith("/command")) {
+          first = false;
+          await new Promise((r) => setTimeout(r, 500));
+        }
+        return fetch(url, init);
+      };
+    }""")
+    page.fill("[data-testid=direct-input]", "GAP 4, 0")
+    page.press("[data-testid=direct-input]", "Enter")
+    page.fill("[data-testid=direct-input]", "GGP 65, 0")
+    replies = page.locator("[data-testid=direct-reply]")
+    replies.nth(0).wait_for()
+    assert page.input_value("[data-testid=direct-input]") == "GGP 65, 0", "the reply did not clear the next line"
+    page.press("[data-testid=direct-input]", "Enter")
+    replies.nth(1).wait_for()
+    entries = page.locator("[data-testid=direct-entry]")
+    assert entries.nth(0).inner_text().startswith("> GAP 4, 0")
+    assert entries.nth(1).inner_text().startswith("> GGP 65, 0")
+
+
 def test_a_program_is_fixed_downloaded_and_stops_at_a_breakpoint(served, page):
     open_app(page, served.url)
     tab(page, "program")

@@ -86,16 +86,19 @@ export class DirectPanel {
     if (this.history[this.history.length - 1] !== line) this.history.push(line);
     localStorage.setItem("tmclsim-history", JSON.stringify(this.history.slice(-200)));
     this.at = this.history.length;
-    const r = await post(m(this.ctx.id, "command"), { line });
+    // The line leaves the input and takes its place in the log at once, so
+    // the next one can be typed while this one is on its way, and replies
+    // stand in the order of their commands.
+    this.input.value = "";
     const entry = el("div", { "data-testid": "direct-entry" });
     entry.append(el("div", { class: "req", text: `> ${line}` }));
+    this.log.append(entry);
+    const r = await post(m(this.ctx.id, "command"), { line });
     if (r.error) entry.append(el("div", { class: "err", "data-testid": "direct-reply", text: r.error }));
     else {
       entry.append(el("div", { class: r.status >= 100 ? "ok" : "err", "data-testid": "direct-reply", text: `${r.text}   [${r.status} ${r.status_text}]` }));
       entry.append(el("div", { class: "req", text: `  ${r.request}  →  ${r.reply}` }));
     }
-    this.log.append(entry);
     this.log.scrollTop = this.log.scrollHeight;
-    this.input.value = "";
   }
 }
