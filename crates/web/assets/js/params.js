@@ -87,9 +87,11 @@ export class ParamsPanel {
             input.classList.add("invalid");
             return;
           }
+          const typed = input.value;
           const a = await post(m(this.ctx.id, "write"), { kind, number: r.number, index, value: v });
           this.answer(r, a);
-          if (!a.error && a.status >= 100) input.value = "";
+          // Taken: the input empties, unless another value was typed meanwhile.
+          if (!a.error && a.status >= 100 && input.value === typed) input.value = "";
           this.poll();
         };
         set.addEventListener("click", doSet);
