@@ -12,11 +12,10 @@ manual has no such row (docs/modules.md: AP 141 on the TMCM-1141)."""
 import inspect
 import re
 import subprocess
-import time
 
 import pytest
 import pytrinamic.modules
-from pytrinamic.connections import ConnectionManager
+from pytrinamic_links import connect, wait_until
 from pytrinamic.tmcl import TMCLReplyStatusError
 from tmclsim_binary import tmclsim_binary
 
@@ -74,23 +73,6 @@ def enum(holder, name):
     """{NAME: number} of a class's parameter or IO enum."""
     e = getattr(holder, name, None)
     return {k: v for k, v in vars(e).items() if not k.startswith("_") and isinstance(v, int)} if e else {}
-
-
-def connect(served, link):
-    if link == "tcp":
-        args = f"--interface socket_serial_tmcl --port {served.tcp}"
-    else:
-        args = f"--interface serial_tmcl --port {served.pty_link} --data-rate 9600"
-    return ConnectionManager(args.split()).connect()
-
-
-def wait_until(predicate, timeout=20.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.01)
-    return False
 
 
 def probe(value, lo, hi):

@@ -2,7 +2,6 @@
 instruction, as the LoadTMCLBinary pattern reads it), verifies it by reading
 the program memory back and starts it."""
 
-import pathlib
 import subprocess
 import time
 

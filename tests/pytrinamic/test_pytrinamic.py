@@ -4,28 +4,9 @@ over TCP (socket_serial_tmcl) and over the pty (serial_tmcl)."""
 import time
 
 import pytest
-from pytrinamic.connections import ConnectionManager
+from pytrinamic_links import LINKS, connect, wait_until
 from pytrinamic.modules import TMCM1141
 from pytrinamic.tmcl import TMCLReplyStatusError
-
-LINKS = ["tcp", "pty"]
-
-
-def connect(served, link):
-    if link == "tcp":
-        args = f"--interface socket_serial_tmcl --port {served.tcp}"
-    else:
-        args = f"--interface serial_tmcl --port {served.pty_link} --data-rate 9600"
-    return ConnectionManager(args.split()).connect()
-
-
-def wait_until(predicate, timeout=10.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.01)
-    return False
 
 
 @pytest.mark.parametrize("link", LINKS)
