@@ -105,8 +105,8 @@ fn control_token() -> Result<String, String> {
 /// EtherCAT: TMCM-1310 slaves on a network interface.
 fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
     let profile = Profile::built_in(&args.module)?;
-    if !profile.features.ethercat {
-        return Err(format!("{} is no EtherCAT slave (its profile's features say ethercat = false)", profile.module.name));
+    if profile.features.ethercat.is_none() {
+        return Err(format!("{} is no EtherCAT slave (its profile has no [features.ethercat])", profile.module.name));
     }
     if args.slaves == 0 || args.slaves > 256 {
         return Err("--slaves takes 1…256".into());
@@ -131,8 +131,8 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
             Ok(Module::with_world(profile.clone(), image, world))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let handle = tmclsim_server::ethercat::serve(iface, tmclsim_ethercat::Segment::new(modules), eeproms)
-        .map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
+    let segment = tmclsim_ethercat::Segment::new(modules)?;
+    let handle = tmclsim_server::ethercat::serve(iface, segment, eeproms).map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
     println!("tmclsim: {} virtual {} EtherCAT slave(s) on {iface}", args.slaves, profile.module.name);
     println!("connect with: an EtherCAT master on {iface}'s peer, e.g. pysoem: master.open(\"<peer interface>\")");
     use std::io::Write;

@@ -70,3 +70,14 @@ fn log_frames_shows_the_traffic_decoded() {
     assert!(lines[3].contains("← 02 01 64 06 00 00 04 D2") && lines[3].ends_with("from 1: status 100 (ok), value 1234"), "{}", lines[3]);
     assert!(lines[0].starts_with("tmclsim: ") && lines[0].contains(" s tcp 127.0.0.1:"), "a time and the link: {}", lines[0]);
 }
+
+#[test]
+fn ethercat_needs_a_module_that_is_an_ethercat_slave() {
+    let out = common::tmclsim(&["serve", "--module", "tmcm-1141", "--ethercat", "lo"]);
+    assert!(!out.status.success());
+    assert!(
+        common::text(&out).contains("TMCM-1141 is no EtherCAT slave (its profile has no [features.ethercat])"),
+        "{}",
+        common::text(&out)
+    );
+}

@@ -1,9 +1,12 @@
-//! A software EtherCAT slave: the TMCM-1310's EtherCAT side.
+//! A software EtherCAT slave: the TMCM-1310's EtherCAT side. Its identity
+//! comes from the module's profile (`[features.ethercat]`); its process
+//! image and object dictionary are the TMCM-1310's.
 //!
 //! - `frame.rs`: Ethernet frames of EtherType 0x88A4 and their datagrams;
 //! - `esc.rs`: the EtherCAT slave controller: registers, station address,
 //!   DL status, SII EEPROM access, SyncManagers, FMMUs, the AL state
 //!   machine and the datagram commands with their working counters;
+//! - `identity.rs`: how a slave names itself, from its module's profile;
 //! - `sii.rs`: the SII EEPROM image (identity, mailbox, PDO description);
 //! - `mailbox.rs`: CoE SDO transfers, which carry TMCL (object 0x2000);
 //! - `slave.rs`: one TMCM-1310 behind an ESC: process data and mailbox;
@@ -15,10 +18,12 @@
 
 pub mod esc;
 pub mod frame;
+pub mod identity;
 pub mod mailbox;
 pub mod segment;
 pub mod sii;
 pub mod slave;
 
+pub use identity::Identity;
 pub use segment::Segment;
 pub use slave::Slave;

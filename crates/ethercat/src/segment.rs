@@ -4,6 +4,7 @@
 //! its effects, as on every other front end).
 
 use crate::frame;
+use crate::identity::Identity;
 use crate::slave::Slave;
 use tmclsim_firmware::{Bus, Module};
 
@@ -14,17 +15,23 @@ pub struct Segment {
 }
 
 impl Segment {
-    /// One slave per module, in line, with serial numbers 1, 2, …
-    pub fn new(modules: Vec<Module>) -> Segment {
+    /// One slave per module, in line, with serial numbers 1, 2, …; an
+    /// error names a module whose profile makes it no EtherCAT slave.
+    pub fn new(modules: Vec<Module>) -> Result<Segment, String> {
         let n = modules.len();
-        let slaves = (0..n)
-            .map(|i| {
-                let mut s = Slave::new(1 + i as u32);
+        let slaves = modules
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let p = m.profile();
+                let identity = Identity::of(p)
+                    .ok_or_else(|| format!("{} is no EtherCAT slave (its profile has no [features.ethercat])", p.module.name))?;
+                let mut s = Slave::new(identity, 1 + i as u32);
                 s.esc.next_port_open = i + 1 < n;
-                s
+                Ok(s)
             })
-            .collect();
-        Segment { slaves, bus: Bus::new(modules) }
+            .collect::<Result<_, String>>()?;
+        Ok(Segment { slaves, bus: Bus::new(modules) })
     }
 
     /// Processes a frame at the bus clock's now; `false` when it is not an

@@ -2,12 +2,7 @@
 //! categories a master reads to configure it (strings, general, FMMU,
 //! SyncManagers, PDOs). Word addressed, little endian.
 
-/// Trinamic's EtherCAT vendor identifier.
-pub const VENDOR_ID: u32 = 0x0000_0286;
-/// Product code: the module number.
-pub const PRODUCT_CODE: u32 = 1310;
-/// Revision: firmware 1.14.
-pub const REVISION: u32 = 0x0001_000E;
+use crate::identity::Identity;
 
 /// Process RAM layout (tmcm-1310.md): outputs at 0x1000 (8 bytes), inputs
 /// at 0x1078 (48 bytes); the standard mailboxes behind them, the bootstrap
@@ -67,19 +62,19 @@ fn category(w: &mut Vec<u16>, kind: u16, bytes: &[u8]) {
     w.extend(data);
 }
 
-/// The EEPROM image of a TMCM-1310 with a serial number.
-pub fn image(serial: u32) -> Vec<u16> {
+/// The EEPROM image of a slave named `id`, with a serial number.
+pub fn image(id: &Identity, serial: u32) -> Vec<u16> {
     let mut w = vec![0u16; 0x40];
     // 0x0000…0x0007: PDI control/configuration, alias 0, checksum.
     w[0] = 0x0080;
     w[1] = 0x0000;
     // 0x0008…0x000F: identity.
-    let mut id = Vec::new();
-    push_u32(&mut id, VENDOR_ID);
-    push_u32(&mut id, PRODUCT_CODE);
-    push_u32(&mut id, REVISION);
-    push_u32(&mut id, serial);
-    w[8..16].copy_from_slice(&id);
+    let mut words = Vec::new();
+    push_u32(&mut words, id.vendor_id);
+    push_u32(&mut words, id.product_code);
+    push_u32(&mut words, id.revision);
+    push_u32(&mut words, serial);
+    w[8..16].copy_from_slice(&words);
     // 0x0014…0x0017 bootstrap mailboxes, 0x0018…0x001B standard mailboxes.
     w[0x14] = BOOT_MAILBOX_OUT;
     w[0x15] = BOOT_MAILBOX_OUT_LEN;
@@ -94,8 +89,7 @@ pub fn image(serial: u32) -> Vec<u16> {
     w[0x3F] = 0x0001; // … version 1
     // Strings: 1 name, 2 group, 3 image, 4 order, 5 RxPDO, 6 TxPDO,
     // 7 "Controller mode", 8 "Set-point", 9… the input names.
-    let mut strings: Vec<&str> =
-        vec!["TMCM-1310", "Stepper", "TMCM-1310", "TMCM-1310-CL", "Outputs", "Inputs", "Controller mode", "Set-point"];
+    let mut strings: Vec<&str> = vec![&id.name, &id.group, &id.name, &id.order_code, "Outputs", "Inputs", "Controller mode", "Set-point"];
     strings.extend(INPUT_NAMES);
     let mut s = vec![strings.len() as u8];
     for t in &strings {
@@ -146,9 +140,10 @@ mod tests {
 
     #[test]
     fn identity_and_categories() {
-        let w = image(7);
-        assert_eq!((w[8] as u32) | (w[9] as u32) << 16, VENDOR_ID);
-        assert_eq!((w[10] as u32) | (w[11] as u32) << 16, 1310);
+        let id = Identity::of(&tmclsim_firmware::Profile::built_in("tmcm-1310").unwrap()).unwrap();
+        let w = image(&id, 7);
+        let u32_at = |i: usize| (w[i] as u32) | (w[i + 1] as u32) << 16;
+        assert_eq!((u32_at(8), u32_at(10), u32_at(12), u32_at(14)), (0x286, 1310, 0x0001_000E, 7));
         assert_eq!(w[0x18], MAILBOX_OUT);
         // Walk the categories.
         let mut at = 0x40;

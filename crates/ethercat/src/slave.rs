@@ -3,6 +3,7 @@
 //! mailbox, the process data watchdog.
 
 use crate::esc::{Esc, code, state};
+use crate::identity::Identity;
 use crate::mailbox::{self, Sdo};
 use crate::sii;
 use tmclsim_firmware::Module;
@@ -18,6 +19,7 @@ const PROTECTED_GLOBALS: [u8; 3] = [66, 76, 87];
 
 pub struct Slave {
     pub esc: Esc,
+    identity: Identity,
     tmcl_reply: [u8; 8],
     /// Valid outputs arrived since SafeOp was entered.
     outputs_valid: bool,
@@ -26,8 +28,9 @@ pub struct Slave {
 }
 
 impl Slave {
-    pub fn new(serial: u32) -> Slave {
-        Slave { esc: Esc::new(sii::image(serial)), tmcl_reply: [0; 8], outputs_valid: false, last_outputs_ns: 0, applied: None }
+    pub fn new(identity: Identity, serial: u32) -> Slave {
+        let esc = Esc::new(sii::image(&identity, serial));
+        Slave { esc, identity, tmcl_reply: [0; 8], outputs_valid: false, last_outputs_ns: 0, applied: None }
     }
 
     /// Before a frame passes: time moves on, inputs are fresh.
@@ -238,11 +241,11 @@ impl Slave {
         let missing = Err(abort::SUBINDEX_MISSING);
         Ok(match (index, subindex) {
             (0x1000, 0) => u32s(0),
-            (0x1008, 0) => b"TMCM-1310".to_vec(),
+            (0x1008, 0) => self.identity.name.as_bytes().to_vec(),
             (0x1018, 0) => vec![4],
-            (0x1018, 1) => u32s(sii::VENDOR_ID),
-            (0x1018, 2) => u32s(sii::PRODUCT_CODE),
-            (0x1018, 3) => u32s(sii::REVISION),
+            (0x1018, 1) => u32s(self.identity.vendor_id),
+            (0x1018, 2) => u32s(self.identity.product_code),
+            (0x1018, 3) => u32s(self.identity.revision),
             (0x1018, 4) => u32s(self.serial()),
             (0x1018, _) => return missing,
             // SyncManager communication types: mailbox out/in, outputs, inputs.

@@ -61,6 +61,22 @@ pub struct CanIds {
     pub secondary_id: u8,
 }
 
+/// How an EtherCAT slave names itself to a master (SII EEPROM and object
+/// 0x1018). The device name is the module's name and the revision its
+/// firmware version (major in the high word, minor in the low word).
+#[derive(Clone, Debug, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EthercatIdentity {
+    /// The vendor's EtherCAT identifier.
+    pub vendor_id: u32,
+    /// The product code.
+    pub product_code: u32,
+    /// The order code (the SII's order string).
+    pub order_code: String,
+    /// The device group (the SII's group string).
+    pub group: String,
+}
+
 /// A global parameter (bank 0) whose stored value says whether the EEPROM
 /// is initialised: any other value re-initialises it at power-up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -92,8 +108,9 @@ pub struct Features {
     pub motion_groups: bool,
     /// Closed-loop operation (position, velocity and torque mode).
     pub closed_loop: bool,
-    /// The module is an EtherCAT slave.
-    pub ethercat: bool,
+    /// The module is an EtherCAT slave, named so. `None`: it is not.
+    #[serde(default)]
+    pub ethercat: Option<EthercatIdentity>,
     /// Global parameter (bank 0) of a shutdown input's function: 0 off,
     /// 1 high active, 2 low active. `None`: no shutdown input.
     #[serde(default)]
@@ -157,7 +174,16 @@ impl Features {
             ("chopper_off_disables_driver", yes_no(self.chopper_off_disables_driver)),
             ("motion_groups", yes_no(self.motion_groups)),
             ("closed_loop", yes_no(self.closed_loop)),
-            ("ethercat", yes_no(self.ethercat)),
+            (
+                "ethercat",
+                match &self.ethercat {
+                    Some(e) => format!(
+                        "slave: vendor {:#X}, product code {}, order code {}, group {}",
+                        e.vendor_id, e.product_code, e.order_code, e.group
+                    ),
+                    None => "no".to_string(),
+                },
+            ),
             ("shutdown_pin", gp_or_none(self.shutdown_pin)),
             ("eeprom_lock", gp_or_none(self.eeprom_lock)),
             ("eeprom_magic", self.eeprom_magic.map_or("none".to_string(), |m| format!("GP {} = {:#X}", m.parameter, m.value))),
@@ -256,7 +282,7 @@ mod tests {
         assert_eq!(f.stall_detection, StallDetection::Stallguard2);
         assert!(f.coolstep);
         assert!(!f.closed_loop);
-        assert!(!f.ethercat);
+        assert_eq!(f.ethercat, None);
         assert_eq!(f.encoder, Encoder::None);
         assert_eq!(f.can, None, "CAN identifiers are the serial addresses");
         assert_eq!(f.eeprom_lock, None);
@@ -297,7 +323,8 @@ mod tests {
         let p = Profile::built_in("tmcm-1310").unwrap();
         let f = &p.features;
         assert!(f.closed_loop);
-        assert!(f.ethercat);
+        let e = f.ethercat.as_ref().expect("an EtherCAT slave");
+        assert_eq!((e.vendor_id, e.product_code, e.order_code.as_str(), e.group.as_str()), (0x286, 1310, "TMCM-1310-CL", "Stepper"));
         assert_eq!(f.encoder, Encoder::AbnSsi);
         assert_eq!(f.reference_search, ReferenceSearchFamily::Tmc429);
         assert_eq!(f.can, None);
@@ -311,7 +338,7 @@ mod tests {
     fn only_the_1310_is_an_ethercat_slave_or_runs_closed_loop() {
         for name in Profile::names() {
             let p = Profile::built_in(name).unwrap();
-            assert_eq!(p.features.ethercat, name == "tmcm-1310", "{name}");
+            assert_eq!(p.features.ethercat.is_some(), name == "tmcm-1310", "{name}");
             assert_eq!(p.features.closed_loop, name == "tmcm-1310", "{name}");
         }
     }
@@ -372,7 +399,7 @@ mod tests {
         let list = p.features.list();
         assert_eq!(list.len(), 15);
         for (key, value) in &list {
-            let row = if *key == "can" { "| `[features.can]` |".to_string() } else { format!("| `{key}` |") };
+            let row = if matches!(*key, "can" | "ethercat") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };
             assert!(readme.contains(&row), "{key} has no row in the README's features table");
             assert!(!value.is_empty(), "{key}");
         }

@@ -1,0 +1,45 @@
+//! How a slave names itself to a master (SII EEPROM, objects 0x1008 and
+//! 0x1018): from its module's profile, `[features.ethercat]`.
+
+use tmclsim_firmware::Profile;
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Identity {
+    /// The device name: the module's name.
+    pub name: String,
+    pub vendor_id: u32,
+    pub product_code: u32,
+    /// The firmware version: major in the high word, minor in the low.
+    pub revision: u32,
+    pub order_code: String,
+    pub group: String,
+}
+
+impl Identity {
+    /// The identity of a module whose profile makes it an EtherCAT slave;
+    /// `None` for any other module.
+    pub fn of(profile: &Profile) -> Option<Identity> {
+        let e = profile.features.ethercat.as_ref()?;
+        let [major, minor] = profile.module.firmware;
+        Some(Identity {
+            name: profile.module.name.clone(),
+            vendor_id: e.vendor_id,
+            product_code: e.product_code,
+            revision: (major as u32) << 16 | minor as u32,
+            order_code: e.order_code.clone(),
+            group: e.group.clone(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_1310_names_itself_from_its_profile() {
+        let id = Identity::of(&Profile::built_in("tmcm-1310").unwrap()).unwrap();
+        assert_eq!((id.name.as_str(), id.vendor_id, id.product_code, id.revision), ("TMCM-1310", 0x286, 1310, 0x0001_000E));
+        assert_eq!(Identity::of(&Profile::built_in("tmcm-1141").unwrap()), None, "no EtherCAT on the TMCM-1141");
+    }
+}
