@@ -105,9 +105,8 @@ fn control_token() -> Result<String, String> {
 /// EtherCAT: TMCM-1310 slaves on a network interface.
 fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
     let profile = Profile::built_in(&args.module)?;
-    if profile.features.ethercat.is_none() {
-        return Err(format!("{} is no EtherCAT slave (its profile has no [features.ethercat])", profile.module.name));
-    }
+    // Refused before any EEPROM file is opened.
+    tmclsim_ethercat::Identity::required(&profile)?;
     if args.slaves == 0 || args.slaves > 256 {
         return Err("--slaves takes 1…256".into());
     }

@@ -8,16 +8,25 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::process::{Command, Stdio};
 
-/// GET `path` from the app at `url` (`http://ADDR/`): the status line and
-/// the body.
-fn get(url: &str, path: &str) -> (String, String) {
+/// Sends one HTTP/1.1 request to the app at `url` (`http://ADDR/`): the
+/// status line and the body.
+fn http(url: &str, method: &str, path: &str, json: Option<&str>) -> (String, String) {
     let addr = url.trim_start_matches("http://").trim_end_matches('/');
     let mut s = TcpStream::connect(addr).unwrap();
-    write!(s, "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n").unwrap();
+    let headers = json.map_or(String::new(), |j| format!("Content-Type: application/json\r\nContent-Length: {}\r\n", j.len()));
+    write!(s, "{method} {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n{headers}\r\n{}", json.unwrap_or("")).unwrap();
     let mut all = String::new();
     s.read_to_string(&mut all).unwrap();
     let (head, body) = all.split_once("\r\n\r\n").unwrap();
     (head.lines().next().unwrap().to_string(), body.to_string())
+}
+
+fn get(url: &str, path: &str) -> (String, String) {
+    http(url, "GET", path, None)
+}
+
+fn post(url: &str, path: &str, json: &str) -> (String, String) {
+    http(url, "POST", path, Some(json))
 }
 
 #[test]
@@ -85,22 +94,6 @@ fn ethercat_slaves_are_not_served_to_the_ide() {
     let out = tmclsim(&["serve", "--module", "tmcm-1310", "--ethercat", "lo", "--web"]);
     assert!(!out.status.success());
     assert!(text(&out).contains("--web cannot serve EtherCAT slaves"), "{}", text(&out));
-}
-
-/// POST a JSON body to the app at `url`: the status line and the body.
-fn post(url: &str, path: &str, json: &str) -> (String, String) {
-    let addr = url.trim_start_matches("http://").trim_end_matches('/');
-    let mut s = TcpStream::connect(addr).unwrap();
-    write!(
-        s,
-        "POST {path} HTTP/1.1\r\nHost: {addr}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{json}",
-        json.len()
-    )
-    .unwrap();
-    let mut all = String::new();
-    s.read_to_string(&mut all).unwrap();
-    let (head, body) = all.split_once("\r\n\r\n").unwrap();
-    (head.lines().next().unwrap().to_string(), body.to_string())
 }
 
 #[test]

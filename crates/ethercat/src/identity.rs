@@ -30,6 +30,13 @@ impl Identity {
             group: e.group.clone(),
         })
     }
+
+    /// [`Identity::of`], or an error naming a module that is no EtherCAT
+    /// slave.
+    pub fn required(profile: &Profile) -> Result<Identity, String> {
+        Identity::of(profile)
+            .ok_or_else(|| format!("{} is no EtherCAT slave (its profile has no [features.ethercat])", profile.module.name))
+    }
 }
 
 #[cfg(test)]

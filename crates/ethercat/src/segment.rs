@@ -23,10 +23,7 @@ impl Segment {
             .iter()
             .enumerate()
             .map(|(i, m)| {
-                let p = m.profile();
-                let identity = Identity::of(p)
-                    .ok_or_else(|| format!("{} is no EtherCAT slave (its profile has no [features.ethercat])", p.module.name))?;
-                let mut s = Slave::new(identity, 1 + i as u32);
+                let mut s = Slave::new(Identity::required(m.profile())?, 1 + i as u32);
                 s.esc.next_port_open = i + 1 < n;
                 Ok(s)
             })

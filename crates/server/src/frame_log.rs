@@ -28,7 +28,7 @@ pub(crate) fn started() -> Instant {
 }
 
 /// The log line of one frame (without the `tmclsim:` prefix and time).
-pub fn describe(direction: Direction, frame: &[u8; FRAME_LEN]) -> String {
+pub(crate) fn describe(direction: Direction, frame: &[u8; FRAME_LEN]) -> String {
     let hex: Vec<String> = frame.iter().map(|b| format!("{b:02X}")).collect();
     let meaning = match direction {
         Direction::In => match Request::decode(frame) {
