@@ -155,6 +155,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
             pty: l.pty.clone(),
             inter_byte_timeout: crate::millis(args.inter_byte_timeout),
             max_connections: args.max_connections,
+            bad_frame_limit: args.bad_frame_limit,
             wire_timing: l.wire_timing,
             log_frames: args.log_frames,
             ..ServerConfig::default()

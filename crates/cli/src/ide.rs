@@ -48,7 +48,7 @@ pub fn run(args: IdeArgs) -> Result<ExitCode, String> {
 
 /// Starts the app over `target`, with the warning a public bind deserves.
 pub fn start(target: Arc<dyn tmclsim_web::Target>, addr: std::net::SocketAddr, public: bool) -> Result<tmclsim_web::WebHandle, String> {
-    let web = tmclsim_web::start(target, tmclsim_web::WebConfig { addr, public }).map_err(|e| e.to_string())?;
+    let web = tmclsim_web::start(target, tmclsim_web::WebConfig { addr, public, limits: Default::default() }).map_err(|e| e.to_string())?;
     if web.token().is_some() {
         eprintln!(
             "tmclsim: warning: the IDE listens on {}, reachable from other machines; requests need the token in the URL below",

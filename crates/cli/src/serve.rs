@@ -172,6 +172,7 @@ fn serve(
         eeprom,
         inter_byte_timeout: crate::millis(args.inter_byte_timeout),
         max_connections: args.max_connections,
+        bad_frame_limit: args.bad_frame_limit,
         control: Some(args.control),
         control_token: if args.control_public { Some(control_token()?) } else { None },
         wire_timing: args.wire_timing,

@@ -46,7 +46,7 @@ fn noise(seed: &mut u64, offset: u64, buf: &mut [u8], sum: &mut u8) -> u64 {
 #[test]
 fn a_hundred_megabytes_of_random_bytes() {
     // No partial frame is ever dropped on a pause: the stream stays aligned.
-    let server = start(&["--inter-byte-timeout", "600000"]);
+    let server = start(&["--inter-byte-timeout", "600000", "--bad-frame-limit", "0"]);
     server.check();
     let before = server.rss_kib();
     let mut s = TcpStream::connect(server.tcp()).unwrap();

@@ -127,9 +127,16 @@ impl Bus {
         self.modules.iter().filter_map(Module::next_deadline).min()
     }
 
-    /// One 9-byte frame on the link: every module sees it, the addressed
-    /// one answers.
+    /// One 9-byte frame on the link from an in-process caller: every
+    /// module sees it, the addressed one answers.
     pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Answer {
+        self.handle_frame_from(crate::IN_PROCESS, frame)
+    }
+
+    /// [`Bus::handle_frame`] for a frame that came on link `link` (a
+    /// download belongs to the link that started it, docs/behaviour.md
+    /// rule 90).
+    pub fn handle_frame_from(&mut self, link: crate::LinkId, frame: &[u8; FRAME_LEN]) -> Answer {
         let now = self.now_ns();
         self.now_ns = now;
         let mut answer = Answer::default();
@@ -160,11 +167,28 @@ impl Bus {
                 continue;
             }
             m.advance_to(now);
-            if let Some(r) = m.handle_frame(frame) {
+            if let Some(r) = m.handle_frame_from(link, frame) {
                 reply(&mut answer, m, r);
             }
         }
         answer
+    }
+
+    /// Link `link` is gone: downloads it owned pass to the next link that
+    /// speaks (docs/behaviour.md rule 90).
+    pub fn link_closed(&mut self, link: crate::LinkId) {
+        for m in &mut self.modules {
+            m.link_closed(link);
+        }
+    }
+
+    /// Reads of module `index` as an observer makes them: the replies
+    /// from the model, and nothing changed ([`Module::observe`],
+    /// docs/behaviour.md rule 86). The bus is brought to now first.
+    pub fn observe(&mut self, index: usize, all: &[tmclsim_protocol::Instruction]) -> Vec<Option<[u8; FRAME_LEN]>> {
+        self.catch_up();
+        let m = &self.modules[index];
+        all.iter().map(|ins| m.observe(*ins)).collect()
     }
 
     /// One CAN frame on the bus: every module sees it, those it is for

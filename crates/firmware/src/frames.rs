@@ -1,17 +1,44 @@
 //! The binary interface: 9-byte request frames in, 9-byte replies out
 //! (RS-232, RS-485, USB and the links a server offers) — address filter,
-//! checksum, download mode, reply suppression (GP 255).
+//! checksum, download mode and its owner, reply suppression (GP 255); and
+//! an observer's reads, which change nothing.
 
 use crate::module::Module;
-use crate::outcome::Special;
+use crate::outcome::{Outcome, Special};
 use crate::parameter_numbers::gp;
 use tmclsim_protocol::frame::version_string_reply;
-use tmclsim_protocol::{FRAME_LEN, Reply, Request, Status, opcode};
+use tmclsim_protocol::{Command, FRAME_LEN, Instruction, Reply, Request, Status, opcode};
+
+/// Who sent a frame: each TCP connection, the pty and in-process callers
+/// are links of their own (docs/behaviour.md rule 90).
+pub type LinkId = u64;
+
+/// The link of in-process callers (the Python package, the browser IDE's
+/// commands, tests).
+pub const IN_PROCESS: LinkId = 0;
+
+/// What download mode means for a frame from one link.
+enum Download {
+    /// No download is going on.
+    Off,
+    /// This link downloads: its words are stored.
+    Owner,
+    /// Another link downloads: this one talks to the module in direct mode.
+    Other,
+}
 
 impl Module {
     /// Handles one 9-byte frame from a serial-type link: address filter,
-    /// checksum, execution, reply (docs/behaviour.md rules 2–4, 11).
+    /// checksum, execution, reply (docs/behaviour.md rules 2–4, 11), from
+    /// an in-process caller.
     pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
+        self.handle_frame_from(IN_PROCESS, frame)
+    }
+
+    /// [`Module::handle_frame`] for a frame that came on link `link`: in
+    /// download mode only the link that entered it has its frames stored
+    /// (docs/behaviour.md rule 90).
+    pub fn handle_frame_from(&mut self, link: LinkId, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
         let (request, checksum_ok) = match Request::decode(frame) {
             Ok(r) => (r, true),
             Err(r) => (r, false),
@@ -29,8 +56,15 @@ impl Module {
             return Some(Reply::new(host, request.address, Status::WrongChecksum, 0, 0).encode());
         }
         let ins = request.instruction;
-        let outcome =
-            if self.program.download.is_some() && !opcode::is_control(ins.opcode) { self.download_word(ins) } else { self.execute(ins) };
+        let outcome = match self.download_role(link) {
+            Download::Owner if !opcode::is_control(ins.opcode) => self.download_word(ins),
+            // Another link's download is not started, ended or run over.
+            Download::Other if Self::changes_program_state(ins.opcode) => Outcome::error(Status::NotAvailable, ins.value),
+            _ => self.execute(ins),
+        };
+        if ins.opcode == opcode::ENTER_DOWNLOAD && outcome.status == Status::Ok {
+            self.program.download_owner = Some(link);
+        }
         let reply = match outcome.special {
             Special::Silent => return None,
             Special::Frame(f) => f,
@@ -45,6 +79,72 @@ impl Module {
             return None;
         }
         Some(reply)
+    }
+
+    /// Download mode as link `link` meets it; a download whose owner is
+    /// gone passes to the link that speaks next.
+    fn download_role(&mut self, link: LinkId) -> Download {
+        if self.program.download.is_none() {
+            return Download::Off;
+        }
+        match self.program.download_owner {
+            Some(owner) if owner != link => Download::Other,
+            _ => {
+                self.program.download_owner = Some(link);
+                Download::Owner
+            }
+        }
+    }
+
+    /// Opcodes a link other than the download's owner may not send while
+    /// it downloads: run, step, reset, and entering or leaving download
+    /// mode.
+    fn changes_program_state(op: u8) -> bool {
+        matches!(
+            op,
+            opcode::RUN_APPLICATION | opcode::STEP_APPLICATION | opcode::RESET_APPLICATION | opcode::ENTER_DOWNLOAD | opcode::EXIT_DOWNLOAD
+        )
+    }
+
+    /// Link `link` is gone: a download it owned waits for the next link
+    /// that speaks (docs/behaviour.md rule 90).
+    pub fn link_closed(&mut self, link: LinkId) {
+        if self.program.download_owner == Some(link) {
+            self.program.download_owner = None;
+        }
+    }
+
+    /// The reply a read would get, taken from the model without any of a
+    /// request's effects: no download word is stored, AP 207 is not
+    /// cleared, GP 133 does not move on, the heartbeat does not restart
+    /// (docs/behaviour.md rule 86). Reads are GAP, GGP, GIO, 134, 135 and
+    /// 136; anything else is `None`. The module's own address answers.
+    pub fn observe(&self, ins: Instruction) -> Option<[u8; FRAME_LEN]> {
+        let (host, address) = (self.host_address(), self.address());
+        let reply = |r: Result<i32, Status>| {
+            let (status, value) = match r {
+                Ok(v) => (Status::Ok, v),
+                Err(s) => (s, ins.value),
+            };
+            Some(Reply::new(host, address, status, ins.opcode, value).encode())
+        };
+        if !self.profile.has_opcode(ins.opcode) {
+            return reply(Err(Status::InvalidCommand));
+        }
+        match Command::decode(ins) {
+            Ok(Command::Gap { param, motor }) => reply(self.peek_axis_parameter(param, motor)),
+            Ok(Command::Ggp { param, bank }) => reply(self.peek_global_parameter(param, bank)),
+            Ok(Command::Gio { port, bank }) => reply(self.get_input(port, bank)),
+            Ok(Command::FirmwareVersion { binary: false }) => Some(self.special_version()),
+            Ok(Command::FirmwareVersion { binary: true }) => reply(Ok(self.profile.version_word())),
+            Ok(Command::ReadMemory { address: a }) => match self.read_memory(a) {
+                Ok(word) => Some(tmclsim_protocol::frame::memory_reply(host, word)),
+                Err(s) => reply(Err(s)),
+            },
+            Ok(Command::ApplicationStatus { kind }) => reply(Ok(self.application_status(kind))),
+            Ok(_) => None,
+            Err(e) => reply(Err(e.status())),
+        }
     }
 
     /// A resync frame on a point-to-point link (docs/behaviour.md rule 85):

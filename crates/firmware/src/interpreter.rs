@@ -36,8 +36,15 @@ impl Module {
     }
 
     /// Breakpoints: execution pauses (mode step) before these addresses.
+    /// Sets the program's breakpoints: the addresses inside program memory,
+    /// each once, in order (so at most one per word, and the interpreter
+    /// finds one by a binary search).
     pub fn set_breakpoints(&mut self, addresses: &[u16]) {
-        self.program.breakpoints = addresses.to_vec();
+        let words = self.program.memory.len();
+        let mut kept: Vec<u16> = addresses.iter().copied().filter(|&a| usize::from(a) < words).collect();
+        kept.sort_unstable();
+        kept.dedup();
+        self.program.breakpoints = kept;
     }
 
     /// Turns the instruction trace on or off.

@@ -4,6 +4,7 @@
 //! The interpreter itself lives in `interpreter.rs`; this file holds the
 //! data it works on, so that a reader sees the machine before the loop.
 
+use crate::frames::LinkId;
 use crate::state::registers::Registers;
 use tmclsim_protocol::{Instruction, WaitCondition};
 
@@ -80,6 +81,9 @@ pub struct Program {
     pub download: Option<u16>,
     /// Address after the last downloaded word (135 type 0).
     pub download_pointer: u16,
+    /// The link whose frames download mode stores (docs/behaviour.md
+    /// rule 90); `None`: the next link that speaks.
+    pub download_owner: Option<LinkId>,
     /// Next firing time of timers 0…2.
     pub timers: [Option<u64>; 3],
     pub breakpoints: Vec<u16>,
@@ -106,6 +110,7 @@ impl Program {
             instruction_ns: DEFAULT_INSTRUCTION_NS,
             download: None,
             download_pointer: 0,
+            download_owner: None,
             timers: [None; 3],
             breakpoints: Vec::new(),
             hit_breakpoint: None,

@@ -310,7 +310,10 @@ impl Module {
         loop {
             self.take_interrupt();
             let pc = self.program.pc;
-            if !self.program.breakpoints.is_empty() && self.program.breakpoints.contains(&pc) && self.program.hit_breakpoint != Some(pc) {
+            if !self.program.breakpoints.is_empty()
+                && self.program.breakpoints.binary_search(&pc).is_ok()
+                && self.program.hit_breakpoint != Some(pc)
+            {
                 self.program.hit_breakpoint = Some(pc);
                 self.program.mode = RunMode::Step;
                 return;

@@ -10,6 +10,7 @@ pub mod command;
 pub mod frame;
 pub mod mnemonic;
 pub mod opcode;
+pub mod preamble;
 pub mod serial;
 pub mod slcan;
 pub mod status;

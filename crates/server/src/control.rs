@@ -8,7 +8,8 @@ use crate::slots::{Activity, Slots, accept};
 use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_firmware::world_command::{Addressed, on_off};
-use tokio::io::{AsyncBufRead, AsyncBufReadExt, AsyncWriteExt, BufReader};
+use tmclsim_protocol::preamble::{Preamble, Verdict};
+use tokio::io::{AsyncBufRead, AsyncBufReadExt, AsyncRead, AsyncReadExt, AsyncWriteExt, BufReader};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::watch;
 
@@ -45,8 +46,21 @@ pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: S
 
 /// One control client: a line in, an answer line out.
 async fn session(stream: TcpStream, module: Arc<SharedBus>, token: Option<Arc<str>>, max_line: usize, activity: Arc<Activity>) {
-    let (r, mut w) = stream.into_split();
-    let mut r = BufReader::new(r);
+    let (mut r, mut w) = stream.into_split();
+    // A client that opens with another protocol (a web page's request) is
+    // closed before anything runs (docs/behaviour.md rule 89).
+    let first = match screen(&mut r).await {
+        Ok((Verdict::Tmcl, first)) => first,
+        Ok((foreign, _)) => {
+            eprintln!(
+                "tmclsim: closing control connection: it opened with {}, not control lines; nothing was executed",
+                foreign.describe()
+            );
+            return;
+        }
+        Err(_) => return,
+    };
+    let mut r = BufReader::new(std::io::Cursor::new(first).chain(r));
     let mut authenticated = token.is_none();
     let mut line = Vec::new();
     loop {
@@ -90,6 +104,25 @@ async fn session(stream: TcpStream, module: Arc<SharedBus>, token: Option<Arc<st
     }
 }
 
+/// Reads the connection's first bytes until they tell whether they are an
+/// HTTP request or a TLS hello (the control protocol's lines, lower-case
+/// words and `@ADDRESS`, never open like either); returns the verdict and
+/// the bytes read, which belong to the first line.
+async fn screen(r: &mut (impl AsyncRead + Unpin)) -> std::io::Result<(Verdict, Vec<u8>)> {
+    let mut preamble = Preamble::new();
+    let mut byte = [0u8; 1];
+    loop {
+        if r.read(&mut byte).await? == 0 {
+            return Ok((Verdict::Tmcl, preamble.held().to_vec()));
+        }
+        match preamble.push(byte[0]) {
+            Verdict::Undecided => continue,
+            Verdict::Tmcl => return Ok((Verdict::Tmcl, preamble.held().to_vec())),
+            foreign => return Ok((foreign, Vec::new())),
+        }
+    }
+}
+
 /// `auth TOKEN [COMMAND…]`: the command after the token (may be empty),
 /// or why the client is turned away.
 fn authenticate<'a>(line: &'a str, token: &str) -> Result<&'a str, &'static str> {
@@ -100,9 +133,15 @@ fn authenticate<'a>(line: &'a str, token: &str) -> Result<&'a str, &'static str>
         .ok_or("this control socket needs a token: send \"auth TOKEN\" first")?
         .trim_start();
     let (given, command) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
-    // Compared in a time that does not depend on where they differ.
-    let same = given.len() == token.len() && given.bytes().zip(token.bytes()).fold(0u8, |acc, (a, b)| acc | (a ^ b)) == 0;
-    if same { Ok(command) } else { Err("wrong token") }
+    if same_token(given, token) { Ok(command) } else { Err("wrong token") }
+}
+
+/// Whether a token a client gave is the secret one, compared in a time
+/// that does not depend on where they differ (only on the given length).
+pub fn same_token(given: &str, secret: &str) -> bool {
+    let (g, s) = (given.as_bytes(), secret.as_bytes());
+    let differ = (0..g.len()).fold(u8::from(g.len() != s.len()), |acc, i| acc | (g[i] ^ s.get(i).copied().unwrap_or(0)));
+    differ == 0
 }
 
 enum Line {

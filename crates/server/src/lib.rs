@@ -71,7 +71,15 @@ pub struct ServerConfig {
     /// Print every frame in and out on stderr, decoded, with the time and
     /// the link it came on.
     pub log_frames: bool,
+    /// A TCP connection that sends this many frames with a wrong checksum
+    /// in a row is closed (docs/behaviour.md rule 89; 0: never).
+    pub bad_frame_limit: u32,
 }
+
+/// Frames with a wrong checksum in a row after which a TCP connection is
+/// closed: far more than a host that lost a byte sends before it
+/// resynchronises, far fewer than a stream of another protocol makes.
+pub const BAD_FRAME_LIMIT: u32 = 16;
 
 impl Default for ServerConfig {
     fn default() -> Self {
@@ -90,6 +98,7 @@ impl Default for ServerConfig {
             wire_timing: false,
             slcan: None,
             log_frames: false,
+            bad_frame_limit: BAD_FRAME_LIMIT,
         }
     }
 }

@@ -8,6 +8,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::ascii::LineState;
 use tmclsim_protocol::FRAME_LEN;
+use tmclsim_protocol::preamble::{Preamble, Verdict};
 use tmclsim_protocol::serial::FrameAssembler;
 use tokio::io::{AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt};
 use tokio::sync::mpsc;
@@ -25,11 +26,65 @@ pub(crate) struct Options {
     pub inter_byte_timeout: Duration,
     pub log_frames: bool,
     pub name: String,
+    /// A network link (TCP): a connection that opens with another
+    /// protocol is closed unexecuted, and one that sends this many frames
+    /// with a wrong checksum in a row is closed (docs/behaviour.md rule 89).
+    /// `None`: a local link (the pty), which screens nothing; `Some(0)`:
+    /// no limit on bad frames.
+    pub network: Option<u32>,
 }
 
 impl Options {
-    pub fn of(config: &crate::ServerConfig, name: String) -> Options {
-        Options { inter_byte_timeout: config.inter_byte_timeout, log_frames: config.log_frames, name }
+    /// A local link (the pty).
+    pub fn local(config: &crate::ServerConfig, name: String) -> Options {
+        Options { inter_byte_timeout: config.inter_byte_timeout, log_frames: config.log_frames, name, network: None }
+    }
+
+    /// A connection from the network (TCP).
+    pub fn network(config: &crate::ServerConfig, name: String) -> Options {
+        Options { network: Some(config.bad_frame_limit), ..Options::local(config, name) }
+    }
+}
+
+/// What a link's bytes are allowed to do while a connection's preamble is
+/// looked at.
+enum Screened<'a> {
+    /// Not decided yet: nothing is executed.
+    Hold,
+    /// Another protocol: the connection is closed.
+    Foreign(Verdict),
+    /// TMCL: these bytes go on.
+    Pass(std::borrow::Cow<'a, [u8]>),
+}
+
+/// Screens bytes through the preamble (while there is one): the bytes that
+/// may go on, including those held back until the verdict.
+fn screen<'a>(preamble: &mut Option<Preamble>, bytes: &'a [u8]) -> Screened<'a> {
+    let Some(p) = preamble else { return Screened::Pass(bytes.into()) };
+    for (i, &b) in bytes.iter().enumerate() {
+        match p.push(b) {
+            Verdict::Undecided => continue,
+            Verdict::Tmcl => {
+                let mut all = p.held().to_vec();
+                all.extend_from_slice(&bytes[i + 1..]);
+                *preamble = None;
+                return Screened::Pass(all.into());
+            }
+            foreign => return Screened::Foreign(foreign),
+        }
+    }
+    Screened::Hold
+}
+
+/// Tells the bus that a link is gone, however its task ends.
+struct Closing<'a> {
+    module: &'a SharedBus,
+    link: u64,
+}
+
+impl Drop for Closing<'_> {
+    fn drop(&mut self) {
+        self.module.link_closed(self.link);
     }
 }
 
@@ -51,6 +106,9 @@ where
     W: AsyncWrite + Unpin,
 {
     let link = next_link_id();
+    let _closing = Closing { module: &module, link };
+    let mut preamble = options.network.map(|_| Preamble::new());
+    let mut bad_frames = 0u32;
     let (events_tx, mut events) = mpsc::unbounded_channel::<[u8; FRAME_LEN]>();
     let start = Instant::now();
     let mut assembler = FrameAssembler::new(options.inter_byte_timeout.as_nanos() as u64);
@@ -69,8 +127,16 @@ where
                     Err(e) => return Err(e),
                 };
                 let now = start.elapsed().as_nanos() as u64;
+                let bytes = match screen(&mut preamble, &buf[..n]) {
+                    Screened::Hold => continue,
+                    Screened::Foreign(what) => {
+                        eprintln!("tmclsim: closing connection {}: it opened with {}, not TMCL; nothing was executed", options.name, what.describe());
+                        return Ok(());
+                    }
+                    Screened::Pass(bytes) => bytes,
+                };
                 let mut text = Vec::new();
-                for &byte in &buf[..n] {
+                for &byte in bytes.iter() {
                     if module.ascii_active() {
                         // ASCII mode: text in, text out; the frame
                         // assembler starts afresh afterwards.
@@ -85,6 +151,8 @@ where
                         writer.write_all(&std::mem::take(&mut text)).await?;
                     }
                     let Some(frame) = assembler.push(byte, now) else { continue };
+                    let checksum_ok = tmclsim_protocol::checksum(&frame[..FRAME_LEN - 1]) == frame[FRAME_LEN - 1];
+                    bad_frames = if checksum_ok { 0 } else { bad_frames + 1 };
                     activity.touch();
                     log(crate::frame_log::Direction::In, &frame);
                     let (replies, pause) = module.handle(link, &events_tx, &frame);
@@ -98,6 +166,11 @@ where
                             log(crate::frame_log::Direction::Out, &reply);
                             writer.write_all(&reply).await?;
                         }
+                    }
+                    if options.network.is_some_and(|limit| limit > 0 && bad_frames >= limit) {
+                        writer.flush().await?;
+                        eprintln!("tmclsim: closing connection {}: {bad_frames} frames in a row with a wrong checksum", options.name);
+                        return Ok(());
                     }
                 }
                 if !text.is_empty() {

@@ -222,7 +222,7 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, config: ServerConfig, 
     // One line, as on the module's serial port (docs/behaviour.md rule 83).
     let mut lines = Default::default();
     let activity = crate::slots::Activity::new();
-    let options = crate::link::Options::of(&config, "pty".into());
+    let options = crate::link::Options::local(&config, "pty".into());
     loop {
         let served = crate::link::serve(master.clone(), master.clone(), module.clone(), &options, &mut lines, &activity);
         tokio::select! {

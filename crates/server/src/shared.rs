@@ -10,7 +10,7 @@ use tmclsim_firmware::can::CanFrame;
 use tmclsim_firmware::eeprom::EepromFile;
 use tmclsim_firmware::world_command::WorldCommand;
 use tmclsim_firmware::{Bus, Eeprom, Module};
-use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Request, Status};
+use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Status};
 use tokio::sync::{Notify, mpsc};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
@@ -249,7 +249,7 @@ impl SharedBus {
                 }
             }
         });
-        let mut answer = s.bus.handle_frame(frame);
+        let mut answer = s.bus.handle_frame_from(link, frame);
         let written = Self::written_since(&s, before);
         let failed = self.after_request(s, link, sink, !answer.replies.is_empty());
         if written.iter().any(|i| failed.contains(i)) {
@@ -289,19 +289,17 @@ impl SharedBus {
         answer.replies.into_iter().map(|r| if unsaved { Self::not_stored(r, frame[1]) } else { r }).collect()
     }
 
-    /// [`SharedBus::frame`] for several instructions to module `index` (in
-    /// bus order) at its address, under one lock (an observer's batch of
-    /// reads): the first reply of each, and the bus's time.
-    pub fn requests(&self, index: usize, all: &[Instruction]) -> (Vec<Option<[u8; FRAME_LEN]>>, u64) {
-        let ((replies, now), unsaved) = self.with_bus_saved(|bus| {
-            let address = bus.module(index).address();
-            let replies: Vec<_> =
-                all.iter().map(|ins| bus.handle_frame(&Request::new(address, *ins).encode()).replies.into_iter().next()).collect();
-            (replies, bus.now_ns())
-        });
-        let replies =
-            replies.into_iter().zip(all).map(|(r, ins)| r.map(|r| if unsaved { Self::not_stored(r, ins.opcode) } else { r })).collect();
-        (replies, now)
+    /// An observer's reads of module `index` (in bus order), under one
+    /// lock: the replies the module's model gives, with none of a
+    /// request's effects (`None` for what is not a read), and the bus's
+    /// time (docs/behaviour.md rule 86).
+    pub fn observe(&self, index: usize, all: &[Instruction]) -> (Vec<Option<[u8; FRAME_LEN]>>, u64) {
+        self.with_bus(|bus| (bus.observe(index, all), bus.now_ns()))
+    }
+
+    /// Link `link` is gone (docs/behaviour.md rule 90).
+    pub(crate) fn link_closed(&self, link: u64) {
+        self.lock().bus.link_closed(link);
     }
 
     /// Sends one frame to module `index` (in bus order) alone, from in

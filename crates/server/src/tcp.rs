@@ -21,7 +21,7 @@ pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: S
                 }
                 let _ = stream.set_nodelay(true);
                 let module = module.clone();
-                let options = crate::link::Options::of(&config, format!("tcp {peer}"));
+                let options = crate::link::Options::network(&config, format!("tcp {peer}"));
                 let activity = Arc::new(Activity::new());
                 let seen = activity.clone();
                 slots.spawn(peer, activity, async move {

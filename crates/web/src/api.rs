@@ -19,6 +19,10 @@ use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
 pub struct App {
     pub target: Arc<dyn Target>,
     pub token: Option<String>,
+    /// Refused tokens in a row (each waits longer).
+    pub failures: Arc<crate::security::Failures>,
+    /// Assemblies running at once (bounded: each may take a core).
+    pub assemblers: Arc<tokio::sync::Semaphore>,
     /// Per module: a download is under way. In download mode a module
     /// stores every command it receives as a program word, so the app
     /// sends nothing else to it meanwhile (its live stream pauses, other
@@ -38,7 +42,8 @@ impl Drop for Downloading {
 impl App {
     pub fn new(target: Arc<dyn Target>, token: Option<String>) -> App {
         let downloading = Arc::new(target.modules().iter().map(|_| AtomicBool::new(false)).collect());
-        App { target, token, downloading }
+        let assemblers = Arc::new(tokio::sync::Semaphore::new(crate::program::ASSEMBLERS));
+        App { target, token, downloading, failures: Default::default(), assemblers }
     }
 
     pub fn is_downloading(&self, id: usize) -> bool {
@@ -55,6 +60,12 @@ impl App {
             ));
         }
         Ok(())
+    }
+
+    /// The module exists and may be observed now: always on a target that
+    /// observes its model, otherwise while no download is under way.
+    pub fn observable(&self, id: usize) -> Result<(), ApiError> {
+        if self.target.observes_the_model() { self.address(id).map(|_| ()) } else { self.idle(id) }
     }
 
     /// Claims the module for a download; refused while another runs.
@@ -219,7 +230,7 @@ impl Read {
 /// the module's clock after them.
 pub fn read_all(target: &dyn Target, id: usize, reads: &[Read]) -> Result<(Vec<Option<i32>>, f64), TargetError> {
     let all: Vec<Instruction> = reads.iter().map(|r| r.instruction()).collect();
-    let (replies, t) = target.sample(id, &all)?;
+    let (replies, t) = target.observe(id, &all)?;
     Ok((replies.iter().map(|raw| (raw[2] >= 100).then(|| i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]))).collect(), t))
 }
 
@@ -229,7 +240,7 @@ struct ReadBody {
 }
 
 async fn read(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<ReadBody>) -> Result<Json<Value>, ApiError> {
-    app.idle(id)?;
+    app.observable(id)?;
     if body.reads.len() > 4096 {
         return Err(bad("at most 4096 reads at once"));
     }

@@ -10,10 +10,12 @@ mod live;
 mod profile_json;
 mod program;
 mod security;
+mod serve;
 pub mod target;
 pub mod virtual_target;
 
 pub use link_target::LinkTarget;
+pub use serve::Limits;
 pub use target::{ModuleEntry, Target, TargetError};
 pub use virtual_target::VirtualTarget;
 
@@ -30,6 +32,8 @@ pub struct WebConfig {
     pub addr: SocketAddr,
     /// Allow a non-loopback address; every request then needs the token.
     pub public: bool,
+    /// What a client may hold of the server (docs/robustness.md).
+    pub limits: Limits,
 }
 
 /// A running app; dropping it stops it.
@@ -99,7 +103,7 @@ pub fn start(target: Arc<dyn Target>, config: WebConfig) -> std::io::Result<WebH
     })?;
     listener.set_nonblocking(true)?;
     let addr = listener.local_addr()?;
-    let (stop, mut stopped) = watch::channel(false);
+    let (stop, stopped) = watch::channel(false);
     let state = api::App::new(target, token.clone());
     let thread = std::thread::Builder::new().name("tmclsim-web".into()).spawn(move || {
         // One thread: the app's requests are short; link targets' waits run
@@ -107,11 +111,7 @@ pub fn start(target: Arc<dyn Target>, config: WebConfig) -> std::io::Result<WebH
         let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().expect("a tokio runtime");
         rt.block_on(async move {
             let listener = tokio::net::TcpListener::from_std(listener).expect("a tokio listener");
-            let app = api::router(state);
-            tokio::select! {
-                _ = axum::serve(listener, app) => {}
-                _ = stopped.wait_for(|s| *s) => {}
-            }
+            serve::serve(listener, api::router(state), config.limits, stopped).await;
         });
         // Open WebSockets end with the runtime.
         rt.shutdown_timeout(std::time::Duration::from_millis(200));

@@ -12,6 +12,12 @@ use std::time::Duration;
 
 /// Most signals per subscription.
 const MAX_SIGNALS: usize = 64;
+/// Largest message (and frame) a client may send: a subscription of
+/// [`MAX_SIGNALS`] signals takes a few KiB.
+pub const MAX_MESSAGE: usize = 64 * 1024;
+/// Most messages a client may send in one second; the socket of a client
+/// that sends more is closed with a reason.
+pub const MAX_MESSAGES_PER_SECOND: u32 = 50;
 
 #[derive(Deserialize, Default)]
 struct Subscription {
@@ -23,7 +29,7 @@ struct Subscription {
 }
 
 pub async fn live(ws: WebSocketUpgrade, State(app): State<App>, Path(id): Path<usize>) -> Response {
-    ws.on_upgrade(move |socket| stream(socket, app, id))
+    ws.max_message_size(MAX_MESSAGE).max_frame_size(MAX_MESSAGE).on_upgrade(move |socket| stream(socket, app, id))
 }
 
 fn period(rate: Option<f64>) -> Duration {
@@ -39,10 +45,22 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
     let mut sub = Subscription::default();
     let mut tick = tokio::time::interval(period(None));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let (mut second, mut messages) = (tokio::time::Instant::now(), 0u32);
     loop {
         tokio::select! {
             msg = socket.recv() => {
                 let Some(Ok(msg)) = msg else { return };
+                if second.elapsed() >= Duration::from_secs(1) {
+                    (second, messages) = (tokio::time::Instant::now(), 0);
+                }
+                messages += 1;
+                if messages > MAX_MESSAGES_PER_SECOND {
+                    let reason = format!("more than {MAX_MESSAGES_PER_SECOND} messages in a second");
+                    let _ = socket.send(Message::Text(json!({"error": reason}).to_string().into())).await;
+                    let close = axum::extract::ws::CloseFrame { code: axum::extract::ws::close_code::POLICY, reason: reason.into() };
+                    let _ = socket.send(Message::Close(Some(close))).await;
+                    return;
+                }
                 let Message::Text(text) = msg else { continue };
                 match serde_json::from_str::<Subscription>(&text) {
                     Ok(s) if s.signals.len() <= MAX_SIGNALS => {
@@ -59,9 +77,9 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
                 }
             }
             _ = tick.tick() => {
-                if (sub.signals.is_empty() && !sub.program) || app.is_downloading(id) {
-                    // In download mode the module would store the reads as
-                    // program words: the stream pauses.
+                if (sub.signals.is_empty() && !sub.program) || app.observable(id).is_err() {
+                    // A module on a link in download mode would store the
+                    // reads as program words: the stream pauses.
                     continue;
                 }
                 let (a, signals, program) = (app.clone(), sub.signals.clone(), sub.program);

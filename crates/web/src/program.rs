@@ -18,6 +18,20 @@ use tmclsim_protocol::{Instruction, Status, opcode};
 
 /// Longest source the app sends (the assembler's own limit per file).
 const MAX_SOURCE: usize = 2 << 20;
+/// Assemblies at once (`/api/assemble` and downloads); another request
+/// meanwhile is answered 503 (docs/robustness.md).
+pub const ASSEMBLERS: usize = 2;
+
+/// Assembles on the blocking pool, at most [`ASSEMBLERS`] at once.
+async fn assemble_bounded(app: &App, source: String, profile: Option<std::sync::Arc<Profile>>) -> Result<Result<Program, Value>, ApiError> {
+    let Ok(_slot) = app.assemblers.clone().try_acquire_owned() else {
+        return Err(ApiError(
+            axum::http::StatusCode::SERVICE_UNAVAILABLE,
+            format!("the assembler is busy with {ASSEMBLERS} programs; try again when one is done"),
+        ));
+    };
+    blocking(move || assembled(&source, profile.as_deref())).await
+}
 /// User variables shown in the state.
 const SHOWN_VARIABLES: u8 = 16;
 
@@ -47,7 +61,7 @@ pub struct AssembleBody {
     profile: Option<String>,
 }
 
-pub async fn assemble(Json(b): Json<AssembleBody>) -> Result<Json<Value>, ApiError> {
+pub async fn assemble(State(app): State<App>, Json(b): Json<AssembleBody>) -> Result<Json<Value>, ApiError> {
     if b.source.len() > MAX_SOURCE {
         return Err(bad("a program is at most 2 MiB of source"));
     }
@@ -55,12 +69,10 @@ pub async fn assemble(Json(b): Json<AssembleBody>) -> Result<Json<Value>, ApiErr
         Some(name) => Some(Profile::built_in(&name.to_ascii_lowercase()).map_err(bad)?),
         None => None,
     };
-    let out = blocking(move || match assembled(&b.source, profile.as_deref()) {
+    Ok(Json(match assemble_bounded(&app, b.source, profile).await? {
         Ok(p) => program_json(&p),
         Err(v) => v,
-    })
-    .await?;
-    Ok(Json(out))
+    }))
 }
 
 #[derive(Deserialize)]
@@ -112,7 +124,7 @@ pub async fn download(State(app): State<App>, Path(id): Path<usize>, Json(b): Js
         return Err(bad("a program is at most 2 MiB of source"));
     }
     let profile = app.profile(id)?;
-    let program = match blocking(move || assembled(&b.source, profile.as_deref())).await? {
+    let program = match assemble_bounded(&app, b.source, profile).await? {
         Ok(p) => p,
         Err(diagnostics) => return Ok(Json(diagnostics).into_response()),
     };
@@ -140,25 +152,24 @@ fn word(raw: &[u8; 9]) -> i32 {
 /// module can add.
 pub fn state_of(app: &App, id: usize) -> Result<Value, ApiError> {
     let t = &app.target;
-    let get = |kind: u8| -> Result<i32, ApiError> {
-        let raw = t.request(id, Instruction::new(opcode::APPLICATION_STATUS, kind, 0, 0))?;
-        check(&raw)?;
-        Ok(word(&raw))
-    };
-    let status = get(1)? as u32;
-    let (accumulator, x) = (get(2)?, get(3)?);
+    let variables = app.profile(id)?.map_or(0, |p| p.module.user_variables.min(u16::from(SHOWN_VARIABLES)) as u8);
+    // One batch of reads, as an observer makes them (docs/behaviour.md
+    // rule 86): 135 types 1…3, then the user variables.
+    let mut reads: Vec<Instruction> = (1..=3).map(|kind| Instruction::new(opcode::APPLICATION_STATUS, kind, 0, 0)).collect();
+    reads.extend((0..variables).map(|n| Instruction::new(opcode::GGP, n, 2, 0)));
+    let (replies, _) = t.observe(id, &reads)?;
+    for raw in &replies[..3] {
+        check(raw)?;
+    }
+    let status = word(&replies[0]) as u32;
+    let (accumulator, x) = (word(&replies[1]), word(&replies[2]));
     let mode = match status >> 24 {
         0 => "stopped",
         1 => "running",
         2 => "step",
         _ => "reset",
     };
-    let variables = app.profile(id)?.map_or(0, |p| p.module.user_variables.min(u16::from(SHOWN_VARIABLES)) as u8);
-    let mut user = Vec::new();
-    for n in 0..variables {
-        let raw = t.request(id, Instruction::new(opcode::GGP, n, 2, 0))?;
-        user.push((raw[2] >= 100).then(|| word(&raw)));
-    }
+    let user: Vec<Option<i32>> = replies[3..].iter().map(|raw| (raw[2] >= 100).then(|| word(raw))).collect();
     let snap = t.snapshot(id);
     // The comparison flags JC tests (EQ/ZE, LT, GT) and the error flags.
     let flags = snap.as_ref().map(|s| {
@@ -187,7 +198,7 @@ pub fn state_of(app: &App, id: usize) -> Result<Value, ApiError> {
 }
 
 pub async fn state(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
-    app.idle(id)?;
+    app.observable(id)?;
     Ok(Json(blocking(move || state_of(&app, id)).await??))
 }
 
@@ -198,6 +209,16 @@ pub struct BreakpointsBody {
 
 pub async fn breakpoints(State(app): State<App>, Path(id): Path<usize>, Json(b): Json<BreakpointsBody>) -> Result<Json<Value>, ApiError> {
     app.idle(id)?;
+    // One breakpoint per word of program memory at most.
+    if let Some(p) = app.profile(id)? {
+        let words = usize::from(p.module.program_memory);
+        if let Some(a) = b.addresses.iter().find(|&&a| usize::from(a) >= words) {
+            return Err(bad(format!("breakpoint at {a}: the program memory has addresses 0…{}", words - 1)));
+        }
+        if b.addresses.len() > words {
+            return Err(bad(format!("at most {words} breakpoints (one per word of program memory)")));
+        }
+    }
     Ok(Json(
         blocking(move || {
             app.target.set_breakpoints(id, &b.addresses)?;

@@ -12,6 +12,29 @@ use std::io::Read;
 
 pub const COOKIE: &str = "tmclsim_token";
 
+/// Requests refused for a wrong or missing token, one after another: the
+/// n-th waits 2^n × 10 ms before its answer, at most [`MAX_PENALTY`], so
+/// that guessing the 128-bit token is slower still than it is hopeless.
+#[derive(Default)]
+pub struct Failures(std::sync::Mutex<u32>);
+
+/// The longest wait of a refused token.
+pub const MAX_PENALTY: std::time::Duration = std::time::Duration::from_secs(2);
+
+impl Failures {
+    /// Counts one more failure; the wait before it is answered.
+    pub fn penalty(&self) -> std::time::Duration {
+        let mut n = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        *n = n.saturating_add(1);
+        std::time::Duration::from_millis(10u64 << (*n).min(8)).min(MAX_PENALTY)
+    }
+
+    /// A request with the right token ends the run of failures.
+    pub fn clear(&self) {
+        *self.0.lock().unwrap_or_else(|p| p.into_inner()) = 0;
+    }
+}
+
 /// 128 random bits from the operating system, in hex.
 pub fn new_token() -> std::io::Result<String> {
     let mut b = [0u8; 16];
@@ -72,9 +95,12 @@ pub async fn guard(State(app): State<crate::api::App>, req: Request, next: Next)
         None => {}
         Some(token) => {
             let given = token_of(&req);
-            if given.as_deref() != Some(token.as_str()) {
+            if !given.as_deref().is_some_and(|g| tmclsim_server::control::same_token(g, token)) {
+                // Each failure in a row waits longer before its answer.
+                tokio::time::sleep(app.failures.penalty()).await;
                 return refuse("this IDE needs the token printed when it started (?token=…)");
             }
+            app.failures.clear();
             let set = req.uri().query().is_some_and(|q| q.contains("token="));
             let mut response = next.run(req).await;
             if set {

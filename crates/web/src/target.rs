@@ -49,12 +49,20 @@ pub trait Target: Send + Sync + 'static {
     /// One TMCL request to module `id` through the same request path as a
     /// frame from a link; the raw reply.
     fn request(&self, id: usize, ins: Instruction) -> Result<[u8; FRAME_LEN], TargetError>;
-    /// Several requests to module `id` in one go (the live stream's
-    /// samples), the same path as [`Target::request`], and the module's
-    /// clock after them.
-    fn sample(&self, id: usize, all: &[Instruction]) -> Result<(Vec<[u8; FRAME_LEN]>, f64), TargetError> {
+    /// An observer's reads of module `id` (the live stream's samples, the
+    /// parameter grid, the program's state): they must not change the
+    /// module (docs/behaviour.md rule 86). On a link they are TMCL
+    /// requests, which the app sends only while it does not download
+    /// ([`Target::observes_the_model`] is false); a virtual module answers
+    /// them from its model. The replies and the module's clock after them.
+    fn observe(&self, id: usize, all: &[Instruction]) -> Result<(Vec<[u8; FRAME_LEN]>, f64), TargetError> {
         let replies = all.iter().map(|ins| self.request(id, *ins)).collect::<Result<_, _>>()?;
         Ok((replies, self.time(id)))
+    }
+    /// [`Target::observe`] reads the model and never reaches the module's
+    /// request path, so observing is safe even during a download.
+    fn observes_the_model(&self) -> bool {
+        false
     }
     /// Requests wait on a link (run them off the async threads), or are
     /// answered in process within microseconds.

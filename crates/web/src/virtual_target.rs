@@ -1,7 +1,7 @@
 //! The modules this process serves (`tmclsim serve --web`): requests go
 //! through `SharedBus::frame`, the path of a frame from a link, so the app
-//! and a host on the link see each other's effects (docs/behaviour.md
-//! rule 86).
+//! and a host on the link see each other's effects; observations read the
+//! model and change nothing (docs/behaviour.md rule 86).
 
 use crate::target::{ModuleEntry, Target, TargetError};
 use std::sync::Arc;
@@ -98,14 +98,19 @@ impl Target for VirtualTarget {
         reply.ok_or_else(|| TargetError::Failed("no reply (replies suppressed by GP 255?)".into()))
     }
 
-    fn sample(&self, id: usize, all: &[Instruction]) -> Result<(Vec<[u8; FRAME_LEN]>, f64), TargetError> {
+    fn observe(&self, id: usize, all: &[Instruction]) -> Result<(Vec<[u8; FRAME_LEN]>, f64), TargetError> {
         let p = self.place(id)?;
-        let (replies, now) = p.bus.requests(p.index, all);
+        let (replies, now) = p.bus.observe(p.index, all);
         let replies = replies
             .into_iter()
-            .map(|r| r.ok_or_else(|| TargetError::Failed("no reply (replies suppressed by GP 255?)".into())))
+            .zip(all)
+            .map(|(r, ins)| r.ok_or_else(|| TargetError::Failed(format!("opcode {} is not a read", ins.opcode))))
             .collect::<Result<_, _>>()?;
         Ok((replies, now as f64 * 1e-9))
+    }
+
+    fn observes_the_model(&self) -> bool {
+        true
     }
 
     fn blocks(&self) -> bool {

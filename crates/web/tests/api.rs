@@ -205,7 +205,7 @@ fn foreign_origins_and_hosts_are_refused() {
 fn a_public_bind_needs_the_flag_and_then_the_token() {
     let s = Served::new();
     let target = std::sync::Arc::new(tmclsim_web::VirtualTarget::new(s.server.links()));
-    let cfg = |public| tmclsim_web::WebConfig { addr: "0.0.0.0:0".parse().unwrap(), public };
+    let cfg = |public| tmclsim_web::WebConfig { addr: "0.0.0.0:0".parse().unwrap(), public, limits: Default::default() };
     let e = tmclsim_web::start(target.clone(), cfg(false)).err().unwrap();
     assert!(e.to_string().contains("--web-public"), "{e}");
     let web = tmclsim_web::start(target, cfg(true)).unwrap();

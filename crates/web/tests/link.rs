@@ -14,7 +14,9 @@ fn a_served_module_over_tcp_lists_answers_and_stops_at_breakpoints() {
     let s = Served::new();
     let tcp = s.tcp().to_string();
     let target = LinkTarget::open(Some(&tcp), None, 9600, &[1], Duration::from_secs(1)).unwrap();
-    let web = tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false }).unwrap();
+    let web =
+        tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
+            .unwrap();
     let url = |p: &str| format!("http://{}{p}", web.addr());
     let (_, list) = get(&url("/api/modules"));
     assert_eq!(
@@ -57,7 +59,9 @@ fn a_module_on_a_serial_port_is_reached_as_a_real_one() {
     let config = tmclsim_server::ServerConfig { pty: Some(link.clone()), warn_exposure: false, ..Default::default() };
     let server = tmclsim_server::start(module, config).unwrap();
     let target = LinkTarget::open(None, Some(link.to_str().unwrap()), 9600, &[1], Duration::from_secs(1)).unwrap();
-    let web = tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false }).unwrap();
+    let web =
+        tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
+            .unwrap();
     let url = |p: &str| format!("http://{}{p}", web.addr());
     let (_, list) = get(&url("/api/modules"));
     assert_eq!(list[0]["profile"], "TMCM-3110");

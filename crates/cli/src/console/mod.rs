@@ -51,8 +51,15 @@ pub fn run(args: ConsoleArgs) -> Result<ExitCode, String> {
     if std::io::stdin().is_terminal() {
         session.interactive()?;
     } else {
-        for line in std::io::stdin().lock().lines() {
-            let line = line.map_err(|e| e.to_string())?;
+        let mut input = std::io::stdin().lock();
+        let mut number = 0;
+        while let Some(line) = read_line(&mut input, MAX_LINE).map_err(|e| e.to_string())? {
+            number += 1;
+            let Some(line) = line else {
+                eprintln!("error: line {number} is longer than {MAX_LINE} bytes; it was skipped");
+                session.failures += 1;
+                continue;
+            };
             if !line.trim().is_empty() {
                 println!("> {}", line.trim());
             }
@@ -62,6 +69,37 @@ pub fn run(args: ConsoleArgs) -> Result<ExitCode, String> {
         }
     }
     Ok(if session.failures == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// Longest line of a script (a TMCL command takes a few dozen bytes).
+pub const MAX_LINE: usize = 4096;
+
+/// Reads one line of at most `max` bytes: `None` at the end of the input,
+/// `Some(None)` for a longer line, which is read to its end and dropped
+/// without being held in memory.
+fn read_line(input: &mut impl BufRead, max: usize) -> std::io::Result<Option<Option<String>>> {
+    let mut line = Vec::new();
+    let mut too_long = false;
+    loop {
+        let chunk = input.fill_buf()?;
+        if chunk.is_empty() {
+            return Ok((too_long || !line.is_empty()).then(|| (!too_long).then(|| String::from_utf8_lossy(&line).into_owned())));
+        }
+        let (taken, ended) = match chunk.iter().position(|&b| b == b'\n') {
+            Some(i) => (i, true),
+            None => (chunk.len(), false),
+        };
+        if !too_long && line.len() + taken <= max {
+            line.extend_from_slice(&chunk[..taken]);
+        } else {
+            too_long = true;
+            line = Vec::new();
+        }
+        input.consume(taken + usize::from(ended));
+        if ended {
+            return Ok(Some((!too_long).then(|| String::from_utf8_lossy(&line).trim_end_matches('\r').to_string())));
+        }
+    }
 }
 
 /// The profile named, or the one of the type the module reports.

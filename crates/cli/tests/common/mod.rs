@@ -208,3 +208,24 @@ pub fn tmclsim(args: &[&str]) -> std::process::Output {
 pub fn text(o: &std::process::Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
+
+/// Sends one HTTP/1.1 request to the app at `url` (`http://ADDR/`): the
+/// status line and the body.
+pub fn http(url: &str, method: &str, path: &str, json: Option<&str>) -> (String, String) {
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut s = TcpStream::connect(addr).unwrap();
+    let headers = json.map_or(String::new(), |j| format!("Content-Type: application/json\r\nContent-Length: {}\r\n", j.len()));
+    write!(s, "{method} {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n{headers}\r\n{}", json.unwrap_or("")).unwrap();
+    let mut all = String::new();
+    s.read_to_string(&mut all).unwrap();
+    let (head, body) = all.split_once("\r\n\r\n").unwrap();
+    (head.lines().next().unwrap().to_string(), body.to_string())
+}
+
+pub fn get(url: &str, path: &str) -> (String, String) {
+    http(url, "GET", path, None)
+}
+
+pub fn post(url: &str, path: &str, json: &str) -> (String, String) {
+    http(url, "POST", path, Some(json))
+}

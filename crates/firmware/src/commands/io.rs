@@ -65,9 +65,8 @@ impl Module {
             .fold(0, |m, p| m | 1 << p.number)
     }
 
-    fn get_input(&mut self, port: u8, bank: u8) -> Exec {
-        let profile = self.profile.clone();
-        let mut in_bank = profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup);
+    pub(crate) fn get_input(&self, port: u8, bank: u8) -> Exec {
+        let mut in_bank = self.profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup);
         let Some(first) = in_bank.clone().next() else {
             return Err(Status::InvalidValue);
         };

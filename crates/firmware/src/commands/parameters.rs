@@ -82,6 +82,14 @@ impl Module {
         Ok(self.read_axis_parameter(m, param))
     }
 
+    /// What GAP would answer, without its effects (AP 207 is not cleared):
+    /// an observer's look (docs/behaviour.md rule 86).
+    pub fn peek_axis_parameter(&self, param: u8, motor: u8) -> Result<i32, Status> {
+        let m = self.motor(motor)?;
+        self.axis_spec(param, |a| a.read)?;
+        Ok(self.axis_parameter_value(m, param))
+    }
+
     fn axis_spec(&self, param: u8, need: impl Fn(Access) -> bool) -> Result<&Parameter, Status> {
         let spec = self.profile.axis_parameter(param).ok_or(Status::WrongType)?;
         if need(spec.access) { Ok(spec) } else { Err(Status::WrongType) }
@@ -133,8 +141,18 @@ impl Module {
         }
     }
 
-    /// Reads a parameter, computing the measured ones.
+    /// Reads a parameter, computing the measured ones, with the effects of
+    /// a read (AP 207 is cleared by reading, docs/behaviour.md rule 52).
     pub(crate) fn read_axis_parameter(&mut self, m: usize, param: u8) -> i32 {
+        let v = self.axis_parameter_value(m, param);
+        if param == ap::EXTENDED_ERROR_FLAGS {
+            self.axes[m].params[param as usize] = 0;
+        }
+        v
+    }
+
+    /// A parameter's value as a read finds it, computing the measured ones.
+    pub(crate) fn axis_parameter_value(&self, m: usize, param: u8) -> i32 {
         if let Some(v) = self.read_closed_loop(m, param) {
             return v;
         }
@@ -154,10 +172,6 @@ impl Module {
             ap::LOAD_VALUE => self.axes[m].driver.load_value,
             ap::ENCODER_POSITION if self.profile.features.encoder != tmclsim_profile::Encoder::None => self.encoder_position(m),
             ap::DRIVER_ERROR_FLAGS => self.driver_flags(m),
-            ap::EXTENDED_ERROR_FLAGS => {
-                // Cleared by reading.
-                std::mem::take(&mut self.axes[m].params[param as usize])
-            }
             _ => self.axes[m].params[param as usize],
         }
     }
@@ -216,13 +230,24 @@ impl Module {
     }
 
     pub fn get_global_parameter(&mut self, param: u8, bank: u8) -> Result<i32, Status> {
+        let v = self.peek_global_parameter(param, bank)?;
+        if (bank, param) == (0, gp::RANDOM) {
+            // Reading takes the number.
+            return Ok(self.globals.random());
+        }
+        Ok(v)
+    }
+
+    /// What GGP would answer, without its effects (GP 133 does not move to
+    /// its next number): an observer's look (docs/behaviour.md rule 86).
+    pub fn peek_global_parameter(&self, param: u8, bank: u8) -> Result<i32, Status> {
         self.global_spec(param, bank, |a| a.read)?;
         Ok(match (bank, param) {
             (0, gp::TICK_TIMER) => self.globals.tick_timer(self.now_ns),
             (0, gp::APPLICATION_STATUS) => self.program.mode as i32,
             (0, gp::DOWNLOAD_MODE) => self.program.download.is_some() as i32,
             (0, gp::PROGRAM_COUNTER) => self.program.counter() as i32,
-            (0, gp::RANDOM) => self.globals.random(),
+            (0, gp::RANDOM) => self.globals.peek_random(),
             _ => self.globals[bank as usize][param as usize],
         })
     }

@@ -67,26 +67,35 @@ impl Module {
                 Ok(ok(0))
             }
             Command::ReadMemory { address } => {
-                if !(0..memory).contains(&address) {
-                    return Err(Status::InvalidValue);
-                }
-                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 1 | 3) {
-                    return Err(Status::EepromLocked);
-                }
-                let stored = self.program.memory[address as usize];
+                let stored = self.read_memory(address)?;
                 Ok(Outcome { status: Status::Ok, value: address, special: Special::Frame(memory_reply(self.host_address(), stored)) })
             }
-            Command::ApplicationStatus { kind } => {
-                let p = &self.program;
-                let word = |address: u16| ((p.mode as i32) << 24) | ((p.wait.is_some() as i32) << 16) | address as i32;
-                Ok(ok(match kind {
-                    0 => word(p.download_pointer),
-                    1 => word(p.counter()),
-                    2 => self.registers.accumulator,
-                    _ => self.registers.x,
-                }))
-            }
+            Command::ApplicationStatus { kind } => Ok(ok(self.application_status(kind))),
             _ => Err(Status::InvalidCommand),
+        }
+    }
+
+    /// 134: the word at `address` of the program memory.
+    pub(crate) fn read_memory(&self, address: i32) -> Result<Instruction, Status> {
+        if !(0..self.program.memory.len() as i32).contains(&address) {
+            return Err(Status::InvalidValue);
+        }
+        if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 1 | 3) {
+            return Err(Status::EepromLocked);
+        }
+        Ok(self.program.memory[address as usize])
+    }
+
+    /// 135: the program's status word (types 0, 1), the accumulator (2)
+    /// or the X register (3).
+    pub(crate) fn application_status(&self, kind: u8) -> i32 {
+        let p = &self.program;
+        let word = |address: u16| ((p.mode as i32) << 24) | ((p.wait.is_some() as i32) << 16) | address as i32;
+        match kind {
+            0 => word(p.download_pointer),
+            1 => word(p.counter()),
+            2 => self.registers.accumulator,
+            _ => self.registers.x,
         }
     }
 

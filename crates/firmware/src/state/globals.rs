@@ -41,12 +41,21 @@ impl Globals {
 
     /// GP 133: the next random number (xorshift32, 31 bits).
     pub fn random(&mut self) -> i32 {
-        let mut x = self.rng;
+        self.rng = Self::next_random(self.rng);
+        (self.rng >> 1) as i32
+    }
+
+    /// The number GP 133 will read next, leaving the generator as it is
+    /// (an observer's look).
+    pub fn peek_random(&self) -> i32 {
+        (Self::next_random(self.rng) >> 1) as i32
+    }
+
+    fn next_random(mut x: u32) -> u32 {
         x ^= x << 13;
         x ^= x >> 17;
         x ^= x << 5;
-        self.rng = x;
-        (x >> 1) as i32
+        x
     }
 
     /// SGP 133: seeds the generator (never with 0).

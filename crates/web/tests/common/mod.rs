@@ -26,7 +26,8 @@ impl Served {
         let config = ServerConfig { tcp: Some("127.0.0.1:0".parse().unwrap()), warn_exposure: false, ..ServerConfig::default() };
         let server = tmclsim_server::start(module, config).unwrap();
         let target = Arc::new(VirtualTarget::new(server.links()));
-        let web = tmclsim_web::start(target, WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false }).unwrap();
+        let web = tmclsim_web::start(target, WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
+            .unwrap();
         Served { web, server }
     }
 
