@@ -127,3 +127,32 @@ fn on_a_terminal_tab_completes_names_and_history_is_kept() {
     assert!(history.contains("GAP actual_position, 0\n"), "{history}");
     server.stop();
 }
+
+#[test]
+fn a_line_past_4096_bytes_is_skipped_unheld_and_fails_the_script() {
+    let server = Server::start(&["--tcp", "127.0.0.1:0"]);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["console", "--tcp", &server.tcp()])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let mut stdin = child.stdin.take().unwrap();
+    // 256 MiB of one line, then a command.
+    let chunk = vec![b'A'; 1 << 20];
+    for _ in 0..256 {
+        stdin.write_all(&chunk).unwrap();
+    }
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    let peak: u64 = status.lines().find(|l| l.starts_with("VmHWM:")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(peak < 64 * 1024, "the line is not held: {peak} KiB at its peak");
+    stdin.write_all(b"\nGAP 4, 0\n").unwrap();
+    drop(stdin);
+    let o = child.wait_with_output().unwrap();
+    let out = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("error: line 1 is longer than 4096 bytes; it was skipped"), "{}", &out[..out.len().min(400)]);
+    assert!(out.contains("> GAP 4, 0\nMaximum positioning speed (4) = "), "the next line is served: {out}");
+    assert_eq!(o.status.code(), Some(1), "a skipped line fails the script");
+}

@@ -130,13 +130,13 @@ impl Bus {
     /// One 9-byte frame on the link from an in-process caller: every
     /// module sees it, the addressed one answers.
     pub fn handle_frame(&mut self, frame: &[u8; FRAME_LEN]) -> Answer {
-        self.handle_frame_from(crate::IN_PROCESS, frame)
+        self.handle_frame_from(crate::link_id::IN_PROCESS, frame)
     }
 
     /// [`Bus::handle_frame`] for a frame that came on link `link` (a
     /// download belongs to the link that started it, docs/behaviour.md
     /// rule 90).
-    pub fn handle_frame_from(&mut self, link: crate::LinkId, frame: &[u8; FRAME_LEN]) -> Answer {
+    pub fn handle_frame_from(&mut self, link: crate::link_id::LinkId, frame: &[u8; FRAME_LEN]) -> Answer {
         let now = self.now_ns();
         self.now_ns = now;
         let mut answer = Answer::default();
@@ -176,7 +176,7 @@ impl Bus {
 
     /// Link `link` is gone: downloads it owned pass to the next link that
     /// speaks (docs/behaviour.md rule 90).
-    pub fn link_closed(&mut self, link: crate::LinkId) {
+    pub fn link_closed(&mut self, link: crate::link_id::LinkId) {
         for m in &mut self.modules {
             m.link_closed(link);
         }

@@ -9,13 +9,7 @@ use crate::parameter_numbers::gp;
 use tmclsim_protocol::frame::version_string_reply;
 use tmclsim_protocol::{Command, FRAME_LEN, Instruction, Reply, Request, Status, opcode};
 
-/// Who sent a frame: each TCP connection, the pty and in-process callers
-/// are links of their own (docs/behaviour.md rule 90).
-pub type LinkId = u64;
-
-/// The link of in-process callers (the Python package, the browser IDE's
-/// commands, tests).
-pub const IN_PROCESS: LinkId = 0;
+use crate::link_id::{IN_PROCESS, LinkId};
 
 /// What download mode means for a frame from one link.
 enum Download {
@@ -174,5 +168,22 @@ impl Module {
     /// 136 type 0: the version text as a frame.
     pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
         version_string_reply(self.host_address(), &self.profile.version_text())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::test_support::{module, ok};
+    use tmclsim_protocol::Reply;
+    use tmclsim_protocol::mnemonic::parse_line;
+
+    #[test]
+    fn looking_at_ap_207_does_not_clear_it() {
+        let mut m = module("tmcm-1141");
+        m.axes[0].params[207] = 1;
+        let look = |m: &crate::Module| Reply::decode(&m.observe(parse_line("GAP 207, 0").unwrap()).unwrap()).unwrap().value;
+        assert_eq!((look(&m), look(&m)), (1, 1), "not cleared by looking");
+        assert_eq!(ok(&mut m, "GAP 207, 0"), 1);
+        assert_eq!(ok(&mut m, "GAP 207, 0"), 0, "a GAP clears it (docs/behaviour.md rule 52)");
     }
 }

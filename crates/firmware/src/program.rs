@@ -4,7 +4,7 @@
 //! The interpreter itself lives in `interpreter.rs`; this file holds the
 //! data it works on, so that a reader sees the machine before the loop.
 
-use crate::frames::LinkId;
+use crate::link_id::LinkId;
 use crate::state::registers::Registers;
 use tmclsim_protocol::{Instruction, WaitCondition};
 

@@ -22,12 +22,16 @@ pub struct Served {
 
 impl Served {
     pub fn new() -> Served {
+        Served::with_limits(Default::default())
+    }
+
+    /// [`Served::new`] with the app's server limits given.
+    pub fn with_limits(limits: tmclsim_web::Limits) -> Served {
         let module = Module::new(Profile::built_in("tmcm-1141").unwrap());
         let config = ServerConfig { tcp: Some("127.0.0.1:0".parse().unwrap()), warn_exposure: false, ..ServerConfig::default() };
         let server = tmclsim_server::start(module, config).unwrap();
         let target = Arc::new(VirtualTarget::new(server.links()));
-        let web = tmclsim_web::start(target, WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
-            .unwrap();
+        let web = tmclsim_web::start(target, WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits }).unwrap();
         Served { web, server }
     }
 
