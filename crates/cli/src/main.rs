@@ -99,7 +99,7 @@ pub struct ServeArgs {
     #[arg(long, value_name = "N", default_value_t = 64)]
     pub max_connections: usize,
     /// Close a TCP connection after this many frames in a row with a wrong
-    /// checksum (0: never), docs/behaviour.md rule 89.
+    /// checksum (0: never), docs/behaviour.md rule 90.
     #[arg(long, value_name = "N", default_value_t = tmclsim_server::BAD_FRAME_LIMIT)]
     pub bad_frame_limit: u32,
     /// The world around the module: a TOML file (docs/world.md), or

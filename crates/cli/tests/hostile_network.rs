@@ -2,7 +2,7 @@
 //! a browser) or a careless client can send: another protocol on a TMCL
 //! port, streams of bad frames, observers during a host's download, a
 //! flood of the IDE's port (docs/robustness.md, docs/behaviour.md rules
-//! 86, 89 and 90).
+//! 86, 90 and 91).
 
 mod common;
 

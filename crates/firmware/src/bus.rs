@@ -135,7 +135,7 @@ impl Bus {
 
     /// [`Bus::handle_frame`] for a frame that came on link `link` (a
     /// download belongs to the link that started it, docs/behaviour.md
-    /// rule 90).
+    /// rule 91).
     pub fn handle_frame_from(&mut self, link: crate::link_id::LinkId, frame: &[u8; FRAME_LEN]) -> Answer {
         let now = self.now_ns();
         self.now_ns = now;
@@ -175,7 +175,7 @@ impl Bus {
     }
 
     /// Link `link` is gone: downloads it owned pass to the next link that
-    /// speaks (docs/behaviour.md rule 90).
+    /// speaks (docs/behaviour.md rule 91).
     pub fn link_closed(&mut self, link: crate::link_id::LinkId) {
         for m in &mut self.modules {
             m.link_closed(link);

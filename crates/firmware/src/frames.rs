@@ -31,7 +31,7 @@ impl Module {
 
     /// [`Module::handle_frame`] for a frame that came on link `link`: in
     /// download mode only the link that entered it has its frames stored
-    /// (docs/behaviour.md rule 90).
+    /// (docs/behaviour.md rule 91).
     pub fn handle_frame_from(&mut self, link: LinkId, frame: &[u8; FRAME_LEN]) -> Option<[u8; FRAME_LEN]> {
         let (request, checksum_ok) = match Request::decode(frame) {
             Ok(r) => (r, true),
@@ -101,7 +101,7 @@ impl Module {
     }
 
     /// Link `link` is gone: a download it owned waits for the next link
-    /// that speaks (docs/behaviour.md rule 90).
+    /// that speaks (docs/behaviour.md rule 91).
     pub fn link_closed(&mut self, link: LinkId) {
         if self.program.download_owner == Some(link) {
             self.program.download_owner = None;

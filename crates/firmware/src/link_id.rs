@@ -1,5 +1,5 @@
 //! Who sent a frame: each TCP connection, the pty and in-process callers
-//! are links of their own (docs/behaviour.md rule 90).
+//! are links of their own (docs/behaviour.md rule 91).
 
 /// A link's number on a bus, given by whoever serves it.
 pub type LinkId = u64;

@@ -82,7 +82,7 @@ pub struct Program {
     /// Address after the last downloaded word (135 type 0).
     pub download_pointer: u16,
     /// The link whose frames download mode stores (docs/behaviour.md
-    /// rule 90); `None`: the next link that speaks.
+    /// rule 91); `None`: the next link that speaks.
     pub download_owner: Option<LinkId>,
     /// Next firing time of timers 0…2.
     pub timers: [Option<u64>; 3],

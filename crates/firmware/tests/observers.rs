@@ -1,6 +1,6 @@
 //! Observers and links: an observer's reads come from the model and change
 //! nothing (docs/behaviour.md rule 86); download mode belongs to the link
-//! that entered it (rule 90); breakpoints are bounded by program memory.
+//! that entered it (rule 91); breakpoints are bounded by program memory.
 
 use tmclsim_firmware::{Bus, IN_PROCESS, Module};
 use tmclsim_protocol::mnemonic::parse_line;

@@ -1,7 +1,7 @@
 //! What a stream connection opens with: TMCL (frames or ASCII lines), or
 //! another protocol that reached a TMCL port by mistake or on purpose — an
 //! HTTP request (a web page can make a browser send one to any loopback
-//! port) or a TLS client hello (docs/behaviour.md rule 89).
+//! port) or a TLS client hello (docs/behaviour.md rule 90).
 //!
 //! [`Preamble`] looks at a connection's first bytes, one at a time, and
 //! decides as soon as it can: at the first byte for almost all TMCL

@@ -48,7 +48,7 @@ pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: S
 async fn session(stream: TcpStream, module: Arc<SharedBus>, token: Option<Arc<str>>, max_line: usize, activity: Arc<Activity>) {
     let (mut r, mut w) = stream.into_split();
     // A client that opens with another protocol (a web page's request) is
-    // closed before anything runs (docs/behaviour.md rule 89).
+    // closed before anything runs (docs/behaviour.md rule 90).
     let first = match screen(&mut r).await {
         Ok((Verdict::Tmcl, first)) => first,
         Ok((foreign, _)) => {

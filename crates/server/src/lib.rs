@@ -72,7 +72,7 @@ pub struct ServerConfig {
     /// the link it came on.
     pub log_frames: bool,
     /// A TCP connection that sends this many frames with a wrong checksum
-    /// in a row is closed (docs/behaviour.md rule 89; 0: never).
+    /// in a row is closed (docs/behaviour.md rule 90; 0: never).
     pub bad_frame_limit: u32,
 }
 

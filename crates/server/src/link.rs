@@ -28,7 +28,7 @@ pub(crate) struct Options {
     pub name: String,
     /// A network link (TCP): a connection that opens with another
     /// protocol is closed unexecuted, and one that sends this many frames
-    /// with a wrong checksum in a row is closed (docs/behaviour.md rule 89).
+    /// with a wrong checksum in a row is closed (docs/behaviour.md rule 90).
     /// `None`: a local link (the pty), which screens nothing; `Some(0)`:
     /// no limit on bad frames.
     pub network: Option<u32>,

@@ -297,7 +297,7 @@ impl SharedBus {
         self.with_bus(|bus| (bus.observe(index, all), bus.now_ns()))
     }
 
-    /// Link `link` is gone (docs/behaviour.md rule 90).
+    /// Link `link` is gone (docs/behaviour.md rule 91).
     pub(crate) fn link_closed(&self, link: u64) {
         self.lock().bus.link_closed(link);
     }
