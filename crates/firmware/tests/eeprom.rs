@@ -177,3 +177,24 @@ fn an_image_from_rust_with_values_out_of_range_powers_up_with_the_defaults() {
     send(&mut m, "RSAP 4, 0");
     assert_eq!(send(&mut m, "GAP 4, 0"), profile.axis_parameter(4).unwrap().default as i32, "RSAP does not take it either");
 }
+
+#[test]
+fn a_file_with_a_value_out_of_range_is_refused_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.eeprom");
+    let profile = Profile::built_in("tmcm-1141").unwrap();
+    let mut image = Eeprom::new("TMCM-1141");
+    image.set_global(0, 75, i32::MAX);
+    tmclsim_firmware::eeprom::save_atomic(&path, &image).unwrap();
+    let e = tmclsim_firmware::eeprom::load_for(&path, &profile).unwrap_err();
+    assert!(matches!(e, tmclsim_firmware::eeprom::LoadError::Refused(_)), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: refused: an entry a TMCM-1141 never stores, so the file was edited or damaged: global \"0/75\" = 2147483647: \
+             GP 75 (Telegram pause time) of bank 0 takes 0…255; correct or remove it (or remove the file to start from factory \
+             defaults)",
+            path.display()
+        )
+    );
+}
