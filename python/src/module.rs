@@ -20,7 +20,8 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tmclsim_firmware::Bus;
-use tmclsim_firmware::eeprom::{EepromFile, resolve};
+use tmclsim_firmware::eeprom::{EepromFile, LoadError, resolve};
+use tmclsim_firmware::module::gp::SERIAL_ADDRESS;
 use tmclsim_firmware::profile::Parameter;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
@@ -38,7 +39,12 @@ use tmclsim_server::SharedBus;
 ///   and rewritten atomically on every EEPROM write, as ``tmclsim serve
 ///   --eeprom`` does; None starts from factory defaults and keeps nothing.
 ///   The file is the module's while it lives: a second module or server on
-///   it is refused (``OSError``).
+///   it is refused (``OSError``). A file that cannot be read raises
+///   ``OSError`` (only a missing one means factory defaults); one that
+///   holds what the module never stores (a value outside its parameter's
+///   range, a motor it lacks, …) raises ``ValueError`` naming the entries.
+///   A read-only file is used and never replaced: EEPROM writes are
+///   answered with status 5, with a ``UserWarning`` at the start.
 /// - ``world``: ``"stage"`` (the built-in linear stage, the default),
 ///   ``"free"`` (no switches, no end stops), the path of a TOML world file,
 ///   or the TOML text itself (a string with a line break).
@@ -239,15 +245,41 @@ fn float_column<'py>(py: Python<'py>, numpy: Option<&Bound<'py, PyModule>>, valu
 impl Module {
     #[new]
     #[pyo3(signature = (profile="tmcm-1141", address=None, eeprom=None, world=None))]
-    fn py_new(profile: &str, address: Option<u8>, eeprom: Option<PathBuf>, world: Option<&Bound<'_, PyAny>>) -> PyResult<Module> {
+    fn py_new(
+        py: Python<'_>,
+        profile: &str,
+        address: Option<u8>,
+        eeprom: Option<PathBuf>,
+        world: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Module> {
         let profile = Profile::built_in(profile).map_err(value_error)?;
+        // An address GP 66 does not take would be stored in the EEPROM
+        // file, and the file refused at the next start (rule 88).
+        if let (Some(a), Some(p)) = (address, profile.global_parameter(0, SERIAL_ADDRESS))
+            && !p.accepts(a as i32)
+        {
+            return Err(value_error(format!("address {a}: a {} takes {} (GP 66)", profile.module.name, p.range_text())));
+        }
         // The file is this module's while it lives: a second holder, in
         // this process or another, is refused.
         let file = eeprom.as_deref().map(EepromFile::open).transpose().map_err(os_error)?.map(Arc::new);
-        let image = match &file {
-            Some(f) => f.load_for(&profile.module.name).map_err(value_error)?.0,
-            None => Eeprom::new(&profile.module.name),
+        let (image, existed) = match &file {
+            Some(f) => f.load_for(&profile).map_err(|e| match e {
+                LoadError::Unreadable(m) => os_error(m),
+                LoadError::Refused(m) => value_error(m),
+            })?,
+            None => (Eeprom::new(&profile.module.name), false),
         };
+        let read_only = file.as_ref().and_then(|f| f.read_only());
+        if let (Some(f), Some(why)) = (&file, &read_only) {
+            // Served, never replaced (rule 89).
+            let message = format!(
+                "{}: {why}; EEPROM writes are answered with status 5 and the file is left as it is (make it writable to keep changes)",
+                f.named().display()
+            );
+            let message = std::ffi::CString::new(message).map_err(|e| value_error(e.to_string()))?;
+            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 1)?;
+        }
         let world = world_from(world, profile.module.axes as usize)?;
         let mut module = FwModule::with_world(profile.clone(), image, world);
         if let Some(a) = address
@@ -256,7 +288,7 @@ impl Module {
             module.set_address(a);
         }
         if let Some(f) = &file
-            && (!f.path().exists() || address.is_some())
+            && (!existed || (address.is_some() && read_only.is_none()))
         {
             f.save(module.eeprom()).map_err(|e| os_error(format!("cannot write the EEPROM file {}: {e}", f.named().display())))?;
         }

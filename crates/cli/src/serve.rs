@@ -49,12 +49,14 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
     // The file is this server's until it stops: a second one is refused.
     let file = args.eeprom.as_deref().map(EepromFile::open).transpose()?.map(Arc::new);
-    let (image, eeprom_note) = match &file {
-        Some(f) => match f.load_for(&profile.module.name)? {
-            (image, true) => (image, format!("restored from {}", f.named().display())),
-            (image, false) => (image, format!("factory defaults; changes are kept in {} (new)", f.named().display())),
+    // `existed`: the file was there (only a missing file means factory
+    // defaults; any other error reading it stops the start, rule 89).
+    let (image, existed, eeprom_note) = match &file {
+        Some(f) => match f.load_for(&profile)? {
+            (image, true) => (image, true, format!("restored from {}{}", f.named().display(), read_only_note(f))),
+            (image, false) => (image, false, format!("factory defaults; changes are kept in {} (new)", f.named().display())),
         },
-        None => (Eeprom::new(&profile.module.name), "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
+        None => (Eeprom::new(&profile.module.name), false, "factory defaults; changes are lost at exit (no --eeprom FILE)".to_string()),
     };
     let module = Module::with_world(profile.clone(), image, world);
     let mut module = module;
@@ -63,7 +65,7 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     }
     if let Some(f) = &file {
         // Write the file at once so a fresh one exists from the start.
-        if !f.path().exists() {
+        if !existed {
             f.save(module.eeprom()).map_err(|e| format!("{}: {e}", f.named().display()))?;
         }
     }
@@ -124,7 +126,12 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
         .map(|file| {
             let world = crate::load_world(&args.world, 1)?;
             let image = match file {
-                Some(f) => f.load_for(&profile.module.name)?.0,
+                Some(f) => {
+                    let image = f.load_for(&profile)?.0;
+                    // The warning; EtherCAT prints no EEPROM line to add the note to.
+                    let _ = read_only_note(f);
+                    image
+                }
                 None => Eeprom::new(&profile.module.name),
             };
             Ok(Module::with_world(profile.clone(), image, world))
@@ -140,6 +147,19 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
     println!("tmclsim: stopping");
     handle.stop();
     Ok(ExitCode::SUCCESS)
+}
+
+/// A read-only EEPROM file is served, never replaced (docs/behaviour.md
+/// rule 89): a warning on stderr, and a note for the banner ("" for a
+/// file tmclsim may write).
+fn read_only_note(file: &EepromFile) -> String {
+    let Some(why) = file.read_only() else { return String::new() };
+    eprintln!(
+        "tmclsim: warning: {}: {why}; EEPROM writes are answered with status 5 and the file is left as it is \
+         (make it writable to keep changes)",
+        file.named().display()
+    );
+    " (read-only: EEPROM writes answer status 5, the file stays as it is)".to_string()
 }
 
 /// The serial address, and on modules with their own CAN identifier

@@ -5,7 +5,8 @@
 //! for as long as it is held, so that one tmclsim at a time writes it, and
 //! saved so that a process killed at any moment leaves either the old or
 //! the new file, never a torn one (a new temporary file beside it, synced,
-//! renamed over the file, the directory synced).
+//! renamed over the file, the directory synced). A file its owner may not
+//! write is never replaced (docs/behaviour.md rule 89).
 
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -13,6 +14,7 @@ use std::fs::{File, OpenOptions, Permissions};
 use std::io::{Read, Write};
 use std::os::unix::fs::{OpenOptionsExt, PermissionsExt};
 use std::path::{Path, PathBuf};
+use tmclsim_profile::Profile;
 
 /// Format version of the EEPROM file.
 pub const FORMAT: u32 = 1;
@@ -94,26 +96,69 @@ impl Eeprom {
         Ok(e)
     }
 
-    /// Loads an EEPROM file; `Ok(None)` when it does not exist yet. A file
-    /// that is not a regular file (a device, a pipe) or is larger than
-    /// [`MAX_FILE_BYTES`] is refused without being read.
-    pub fn load(path: &Path) -> Result<Option<Eeprom>, String> {
+    /// Loads an EEPROM file; `Ok(None)` when it does not exist yet (and
+    /// only then: any other error reading it is reported, docs/behaviour.md
+    /// rule 89). A file that is not a regular file (a device, a pipe) or is
+    /// larger than [`MAX_FILE_BYTES`] is refused without being read. The
+    /// cells are not checked against a module ([`load_for`] does).
+    pub fn load(path: &Path) -> Result<Option<Eeprom>, LoadError> {
+        let shown = path.display();
         match read_limited(path) {
-            Ok(Some(text)) => Eeprom::from_json(&text).map(Some).map_err(|e| format!("{}: {e}", path.display())),
+            Ok(Some(text)) => Eeprom::from_json(&text).map(Some).map_err(|e| LoadError::Refused(format!("{shown}: {e}"))),
             Ok(None) => Ok(None),
-            Err(e) => Err(format!("{}: {e}", path.display())),
+            Err(LoadError::Unreadable(e)) => Err(LoadError::Unreadable(format!("{shown}: cannot read the EEPROM file: {e}"))),
+            Err(LoadError::Refused(e)) => Err(LoadError::Refused(format!("{shown}: {e}"))),
         }
     }
 }
 
+/// Why an EEPROM file is not loaded. Both carry the message, the file
+/// named first.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LoadError {
+    /// The file could not be read: an error of the system other than
+    /// "there is no such file" (no permission, a path through something
+    /// that is no directory, an I/O error).
+    Unreadable(String),
+    /// The file was read and is refused: not an EEPROM file, too large, not
+    /// a regular file, another module's, or holding what the module never
+    /// stores (docs/behaviour.md rule 88).
+    Refused(String),
+}
+
+impl LoadError {
+    pub fn message(&self) -> &str {
+        match self {
+            LoadError::Unreadable(m) | LoadError::Refused(m) => m,
+        }
+    }
+}
+
+impl std::fmt::Display for LoadError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.message())
+    }
+}
+
+impl std::error::Error for LoadError {}
+
+impl From<LoadError> for String {
+    fn from(e: LoadError) -> String {
+        e.message().to_string()
+    }
+}
+
 /// The text of an EEPROM file (`None`: there is none), within the limits.
-fn read_limited(path: &Path) -> Result<Option<String>, String> {
-    let regular = |m: &std::fs::Metadata| -> Result<(), String> {
+/// The errors name no file.
+fn read_limited(path: &Path) -> Result<Option<String>, LoadError> {
+    let refused = LoadError::Refused;
+    let unreadable = |e: std::io::Error| LoadError::Unreadable(e.to_string());
+    let regular = |m: &std::fs::Metadata| -> Result<(), LoadError> {
         if !m.is_file() {
-            return Err("not a regular file (an EEPROM file is a JSON file tmclsim writes)".into());
+            return Err(refused("not a regular file (an EEPROM file is a JSON file tmclsim writes)".into()));
         }
         if m.len() > MAX_FILE_BYTES {
-            return Err(format!("{} bytes, more than an EEPROM file can be ({MAX_FILE_BYTES} bytes)", m.len()));
+            return Err(refused(format!("{} bytes, more than an EEPROM file can be ({MAX_FILE_BYTES} bytes)", m.len())));
         }
         Ok(())
     };
@@ -121,33 +166,56 @@ fn read_limited(path: &Path) -> Result<Option<String>, String> {
     match std::fs::metadata(path) {
         Ok(m) => regular(&m)?,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(e.to_string()),
+        Err(e) => return Err(unreadable(e)),
     }
     let file = match File::open(path) {
         Ok(f) => f,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(e.to_string()),
+        Err(e) => return Err(unreadable(e)),
     };
-    regular(&file.metadata().map_err(|e| e.to_string())?)?;
+    regular(&file.metadata().map_err(unreadable)?)?;
     let mut bytes = Vec::new();
-    file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
+    file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(unreadable)?;
     if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(format!("grew beyond {MAX_FILE_BYTES} bytes while being read"));
+        return Err(refused(format!("grew beyond {MAX_FILE_BYTES} bytes while being read")));
     }
-    String::from_utf8(bytes).map(Some).map_err(|_| "EEPROM file is not readable: not UTF-8 text".into())
+    String::from_utf8(bytes).map(Some).map_err(|_| refused("EEPROM file is not readable: not UTF-8 text".into()))
 }
 
-/// The EEPROM a module of `module_name` powers up with from `path`: the
+/// The EEPROM a module of `profile` powers up with from `path`: the
 /// stored image (`true`), or an empty one when the file does not exist
-/// yet (`false`). A file of another module is refused.
-pub fn load_for(path: &Path, module_name: &str) -> Result<(Eeprom, bool), String> {
+/// yet (`false`). A file of another module, or one holding what the
+/// module never stores (docs/behaviour.md rule 88), is refused, naming
+/// the entries.
+pub fn load_for(path: &Path, profile: &Profile) -> Result<(Eeprom, bool), LoadError> {
     match Eeprom::load(path)? {
-        Some(image) if image.module != module_name => {
-            Err(format!("{} holds the EEPROM of a {}, not of a {module_name}", path.display(), image.module))
-        }
-        Some(image) => Ok((image, true)),
-        None => Ok((Eeprom::new(module_name), false)),
+        Some(image) => match image.check(profile) {
+            Ok(()) => Ok((image, true)),
+            Err(e) => Err(LoadError::Refused(format!("{}: {e}", path.display()))),
+        },
+        None => Ok((Eeprom::new(&profile.module.name), false)),
     }
+}
+
+/// Why the file at `path` is read-only for tmclsim, which then never
+/// replaces it (docs/behaviour.md rule 89): its owner may not write it
+/// (no `u+w` in its mode; this holds for every user, root included, who
+/// may write any file), or this process may not (access(2): another
+/// user's file, a read-only file system). `None`: no such file, or one
+/// tmclsim may replace.
+pub fn read_only(path: &Path) -> Option<String> {
+    let meta = std::fs::metadata(path).ok().filter(|m| m.is_file())?;
+    let mode = meta.permissions().mode() & 0o7777;
+    if mode & 0o200 == 0 {
+        return Some(format!("the file is read-only (mode {mode:04o}: no write permission for its owner)"));
+    }
+    let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).ok()?;
+    // SAFETY: a valid, NUL-terminated path.
+    if unsafe { libc::access(c.as_ptr(), libc::W_OK) } != 0 {
+        let e = std::io::Error::last_os_error();
+        return Some(format!("the file is read-only for this user ({e})"));
+    }
+    None
 }
 
 /// Writes the image to `path` atomically (a symbolic link is followed: its
@@ -196,6 +264,11 @@ const TEMP_RANDOM: usize = 6;
 
 fn write_atomic(path: &Path, image: &Eeprom) -> std::io::Result<()> {
     let (dir, name) = dir_and_name(path)?;
+    // A rename replaces a file whatever its mode: a read-only file is
+    // looked at before every save and left as it is (rule 89).
+    if let Some(why) = read_only(path) {
+        return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, format!("{why}; tmclsim leaves it as it is")));
+    }
     // The file keeps its permissions; a new one gets what a created file
     // gets (0666 less the umask).
     let mode = std::fs::metadata(path).ok().filter(|m| m.is_file()).map(|m| m.permissions().mode() & 0o7777);
@@ -240,6 +313,14 @@ impl EepromFile {
     pub fn open(path: &Path) -> Result<EepromFile, String> {
         let shown = path.display();
         let target = resolve(path).map_err(|e| format!("{shown}: {e}"))?;
+        // The file first: when it cannot be looked at, that is the error
+        // to report (the lock beside it would fail too, and say less).
+        // Only a file that does not exist yet is fine (rule 89).
+        if let Err(e) = std::fs::metadata(&target)
+            && e.kind() != std::io::ErrorKind::NotFound
+        {
+            return Err(format!("{shown}: cannot read the EEPROM file: {e}"));
+        }
         let (dir, name) = dir_and_name(&target).map_err(|e| format!("{shown}: {e}"))?;
         let lock_path = dir.join(format!(".{name}.lock"));
         let cannot = |e: std::io::Error| format!("{shown}: cannot lock the EEPROM file ({}): {e}", lock_path.display());
@@ -256,7 +337,18 @@ impl EepromFile {
         let (mut lock, writable) = match open(true) {
             Ok(f) => (f, true),
             // Another user's lock file can still be locked.
-            Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => (open(false).map_err(cannot)?, false),
+            Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => match open(false) {
+                Ok(f) => (f, false),
+                // There is none, and none may be made here: say why.
+                Err(none) if none.kind() == std::io::ErrorKind::NotFound => {
+                    return Err(format!(
+                        "{shown}: cannot lock the EEPROM file: cannot create {}: {e}; tmclsim needs to write in the EEPROM \
+                         file's directory (its lock file is there, and every save puts a new file there)",
+                        lock_path.display()
+                    ));
+                }
+                Err(other) => return Err(cannot(other)),
+            },
             Err(e) => return Err(cannot(e)),
         };
         if !lock.metadata().map_err(cannot)?.is_file() {
@@ -293,13 +385,20 @@ impl EepromFile {
         &self.path
     }
 
-    /// The EEPROM a module of `module_name` powers up with (see
+    /// The EEPROM a module of `profile` powers up with (see
     /// [`load_for`]).
-    pub fn load_for(&self, module_name: &str) -> Result<(Eeprom, bool), String> {
-        load_for(&self.path, module_name)
+    pub fn load_for(&self, profile: &Profile) -> Result<(Eeprom, bool), LoadError> {
+        load_for(&self.path, profile)
     }
 
-    /// Writes the image to the file atomically.
+    /// Why the file is read-only (see [`read_only`]): every save then
+    /// fails and leaves it as it is. Looked at anew on every call.
+    pub fn read_only(&self) -> Option<String> {
+        read_only(&self.path)
+    }
+
+    /// Writes the image to the file atomically; a read-only file is not
+    /// replaced (an error of kind `PermissionDenied`).
     pub fn save(&self, image: &Eeprom) -> std::io::Result<()> {
         write_atomic(&self.path, image)
     }
@@ -326,6 +425,10 @@ mod tests {
     use super::*;
     use std::os::unix::fs::symlink;
 
+    fn tmcm_1141() -> std::sync::Arc<Profile> {
+        Profile::built_in("tmcm-1141").unwrap()
+    }
+
     fn image() -> Eeprom {
         let mut e = Eeprom::new("TMCM-1141");
         e.set_axis(0, 4, 1234);
@@ -344,7 +447,7 @@ mod tests {
         save_atomic(&path, &e).unwrap();
         assert_eq!(Eeprom::load(&path).unwrap(), Some(e));
         std::fs::write(&path, "{ torn").unwrap();
-        assert!(Eeprom::load(&path).unwrap_err().contains("not readable"));
+        assert!(Eeprom::load(&path).unwrap_err().message().contains("not readable"));
     }
 
     #[test]
@@ -379,11 +482,11 @@ mod tests {
         let file = EepromFile::open(&link).unwrap();
         assert_eq!(file.path(), dir.path().join("store/real.eeprom"));
         assert_eq!(file.named(), link);
-        assert_eq!(file.load_for("TMCM-1141").unwrap(), (Eeprom::new("TMCM-1141"), false));
+        assert_eq!(file.load_for(&tmcm_1141()).unwrap(), (Eeprom::new("TMCM-1141"), false));
         file.save(&image()).unwrap();
         assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
         assert_eq!(Eeprom::load(&target).unwrap(), Some(image()));
-        assert_eq!(file.load_for("TMCM-1141").unwrap(), (image(), true));
+        assert_eq!(file.load_for(&tmcm_1141()).unwrap(), (image(), true));
         // The lock is beside the target: the target named directly is taken.
         let e = EepromFile::open(&target).unwrap_err();
         assert!(e.contains("in use by another tmclsim"), "{e}");
@@ -408,7 +511,7 @@ mod tests {
         drop(first);
         let again = EepromFile::open(&path).unwrap();
         again.save(&image()).unwrap();
-        assert_eq!(again.load_for("TMCM-1141").unwrap(), (image(), true));
+        assert_eq!(again.load_for(&tmcm_1141()).unwrap(), (image(), true));
     }
 
     #[test]
@@ -454,18 +557,18 @@ mod tests {
         let big = dir.path().join("big.eeprom");
         let f = File::create(&big).unwrap();
         f.set_len(MAX_FILE_BYTES + 1).unwrap();
-        let e = Eeprom::load(&big).unwrap_err();
+        let e = Eeprom::load(&big).unwrap_err().to_string();
         assert!(e.contains(&format!("{} bytes, more than an EEPROM file can be ({MAX_FILE_BYTES} bytes)", MAX_FILE_BYTES + 1)), "{e}");
         f.set_len(MAX_FILE_BYTES).unwrap();
-        assert!(Eeprom::load(&big).unwrap_err().contains("not readable"));
-        let e = Eeprom::load(Path::new("/dev/zero")).unwrap_err();
+        assert!(Eeprom::load(&big).unwrap_err().message().contains("not readable"));
+        let e = Eeprom::load(Path::new("/dev/zero")).unwrap_err().to_string();
         assert!(e.contains("/dev/zero: not a regular file"), "{e}");
         let fifo = dir.path().join("fifo");
         let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
         // SAFETY: a valid, NUL-terminated path.
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         // Refused at once, not waiting for a writer.
-        assert!(load_for(&fifo, "TMCM-1141").unwrap_err().contains("not a regular file"));
+        assert!(load_for(&fifo, &tmcm_1141()).unwrap_err().message().contains("not a regular file"));
     }
 
     #[test]

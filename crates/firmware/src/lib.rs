@@ -13,6 +13,7 @@ pub mod closed_loop;
 mod commands;
 pub mod driver;
 pub mod eeprom;
+pub mod eeprom_rules;
 pub mod executor;
 pub mod files;
 mod frames;

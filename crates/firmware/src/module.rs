@@ -207,7 +207,12 @@ impl Module {
         self.globals.clear();
         for bank in 0..4u8 {
             for p in profile.global_parameters(bank) {
+                // A stored value the parameter does not take is not taken:
+                // files are checked when they are loaded (docs/behaviour.md
+                // rule 88); an image handed over from Rust is not, and must
+                // not make the module unreachable either (GP 75, GP 66).
                 let stored = if p.access.auto || p.access.eeprom { ee.global(bank, p.number) } else { None };
+                let stored = stored.filter(|&v| p.accepts(v));
                 self.globals[bank as usize][p.number as usize] = stored.unwrap_or(p.default_word());
             }
         }
@@ -224,6 +229,7 @@ impl Module {
             let mut params = [0i32; 256];
             for p in profile.axis_parameters() {
                 let stored = if p.access.eeprom { ee.axis(motor, p.number) } else { None };
+                let stored = stored.filter(|&v| p.accepts(v));
                 params[p.number as usize] = stored.unwrap_or(p.default_word());
             }
             let mut coordinates = vec![0; profile.module.coordinates as usize + 1];

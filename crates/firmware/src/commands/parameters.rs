@@ -37,7 +37,8 @@ impl Module {
             Rsap { param, motor } => {
                 let m = self.motor(motor)?;
                 let spec = self.axis_spec(param, |a| a.eeprom)?;
-                let v = self.persistence.eeprom.axis(motor, param).unwrap_or(spec.default_word());
+                // As at power-up: a stored value out of range is not taken (rule 88).
+                let v = self.persistence.eeprom.axis(motor, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
                 self.write_axis_parameter(m, param, v);
                 Ok(echo)
             }
@@ -58,7 +59,7 @@ impl Module {
             }
             Rsgp { param, bank } => {
                 let spec = self.global_spec(param, bank, |a| a.eeprom)?;
-                let v = self.persistence.eeprom.global(bank, param).unwrap_or(spec.default_word());
+                let v = self.persistence.eeprom.global(bank, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
                 self.globals[bank as usize][param as usize] = v;
                 Ok(echo)
             }
