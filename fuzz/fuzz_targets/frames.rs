@@ -1,13 +1,16 @@
-//! The 9-byte frame path: the frame assembler, the frame and command
-//! decoders, and every module executing what they let through, with virtual
-//! time passing between frames. Properties: no panic; every reply but the
-//! version string is a whole frame with a good checksum; a decoded command
-//! encodes back to a command that decodes the same.
+//! The 9-byte frame path: a network link's preamble screen, the frame
+//! assembler, the frame and command decoders, and every module executing
+//! what they let through, with virtual time passing between frames.
+//! Properties: no panic; the screen decides within nine bytes, holds no
+//! more and never changes its mind; every reply but the version string is
+//! a whole frame with a good checksum; a decoded command encodes back to a
+//! command that decodes the same.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use tmclsim_firmware::Module;
 use tmclsim_protocol::frame::checksum;
+use tmclsim_protocol::preamble::{MAX_PREAMBLE, Preamble, Verdict};
 use tmclsim_protocol::serial::FrameAssembler;
 use tmclsim_protocol::{Command, Reply, Request};
 
@@ -15,6 +18,17 @@ const MODULES: [&str; 3] = ["tmcm-1141", "tmcm-351", "tmcm-1310"];
 
 fuzz_target!(|data: &[u8]| {
     let Some((&pick, data)) = data.split_first() else { return };
+    let mut preamble = Preamble::new();
+    let mut first = None;
+    for (i, &b) in data.iter().enumerate() {
+        let v = preamble.push(b);
+        assert!(preamble.held().len() <= MAX_PREAMBLE);
+        match (first, v) {
+            (None, Verdict::Undecided) => assert!(i + 1 < MAX_PREAMBLE, "undecided after {} bytes", i + 1),
+            (None, v) => first = Some(v),
+            (Some(f), v) => assert_eq!(f, v, "the verdict changed"),
+        }
+    }
     let mut module = Module::built_in(MODULES[pick as usize % 3]).unwrap();
     let mut assembler = FrameAssembler::new(5_000_000);
     let mut now = 0u64;
