@@ -19,6 +19,7 @@ mod run;
 mod send;
 mod serve;
 mod sweep;
+mod trace;
 mod upload;
 
 #[derive(Parser)]
@@ -56,6 +57,8 @@ enum Command {
     Ide(ide::IdeArgs),
     /// Run a TMCL program against every scenario of a matrix file, here or on a Dask cluster (docs/sweeps.md).
     Sweep(sweep::SweepArgs),
+    /// Record a host's session with a module through a proxy; check a recorded session against a virtual module.
+    Trace(trace::TraceArgs),
 }
 
 #[derive(Args)]
@@ -198,7 +201,9 @@ fn main() -> ExitCode {
         std::process::exit(101);
     }));
     let cli = Cli::parse();
-    if !matches!(cli.command, Command::Serve(_) | Command::Bench(_) | Command::FleetBench(_) | Command::Ide(_)) {
+    let server = matches!(cli.command, Command::Serve(_) | Command::Bench(_) | Command::FleetBench(_) | Command::Ide(_))
+        || matches!(&cli.command, Command::Trace(t) if matches!(t.command, trace::TraceCommand::Record(_)));
+    if !server {
         // A command whose output goes to a reader that stops early
         // (`tmclsim profile | head`) ends quietly, as other tools do.
         // Servers keep ignoring the signal: their links report a closed
@@ -222,6 +227,7 @@ fn main() -> ExitCode {
         Command::Upload(a) => upload::run(a),
         Command::World(a) => world(a),
         Command::FleetBench(a) => fleet::bench(a),
+        Command::Trace(a) => trace::run(a),
     };
     match result {
         Ok(code) => code,

@@ -32,16 +32,9 @@ pub struct Client {
 impl Client {
     /// Connects to `tcp` (HOST:PORT) or opens the serial port `port`.
     pub fn open(tcp: Option<&str>, port: Option<&str>, baud: u32, address: u8, timeout: Duration) -> Result<Client, String> {
-        let stream: Box<dyn Stream + Send> = match (tcp, port) {
-            (Some(addr), _) => {
-                let s = std::net::TcpStream::connect(addr).map_err(|e| format!("cannot connect to {addr}: {e}"))?;
-                s.set_nodelay(true).ok();
-                Box::new(s)
-            }
-            (None, Some(dev)) => {
-                Box::new(serialport::new(dev, baud).timeout(timeout).open().map_err(|e| format!("cannot open {dev}: {e}"))?)
-            }
-            _ => return Err("give --tcp HOST:PORT or --port DEVICE".into()),
+        let stream: Box<dyn Stream + Send> = match open_link(tcp, port, baud, timeout)? {
+            Link::Tcp(s) => Box::new(s),
+            Link::Serial(s) => Box::new(s),
         };
         Ok(Client { stream, address, timeout })
     }
@@ -80,6 +73,55 @@ impl Client {
             }
         }
         Ok(buf)
+    }
+}
+
+enum Link {
+    Tcp(std::net::TcpStream),
+    Serial(Box<dyn serialport::SerialPort>),
+}
+
+fn open_link(tcp: Option<&str>, port: Option<&str>, baud: u32, timeout: Duration) -> Result<Link, String> {
+    match (tcp, port) {
+        (Some(addr), _) => {
+            let s = std::net::TcpStream::connect(addr).map_err(|e| format!("cannot connect to {addr}: {e}"))?;
+            s.set_nodelay(true).ok();
+            Ok(Link::Tcp(s))
+        }
+        (None, Some(dev)) => {
+            Ok(Link::Serial(serialport::new(dev, baud).timeout(timeout).open().map_err(|e| format!("cannot open {dev}: {e}"))?))
+        }
+        _ => Err("give --tcp HOST:PORT or --port DEVICE".into()),
+    }
+}
+
+/// A link to modules with its two directions apart, for a proxy that
+/// forwards a host's frames to the module and the module's frames (replies
+/// and events of its own) back at any time.
+pub struct RawLink {
+    /// Reads wait at most the `poll` given to [`RawLink::open`] and then
+    /// fail with `WouldBlock` or `TimedOut`, so a reading thread can look
+    /// up now and then.
+    pub reader: Box<dyn Read + Send>,
+    pub writer: Box<dyn Write + Send>,
+}
+
+impl RawLink {
+    /// Connects to `tcp` (HOST:PORT) or opens the serial port `port`.
+    pub fn open(tcp: Option<&str>, port: Option<&str>, baud: u32, poll: Duration) -> Result<RawLink, String> {
+        let poll = poll.max(Duration::from_millis(1));
+        match open_link(tcp, port, baud, poll)? {
+            Link::Tcp(s) => {
+                s.set_read_timeout(Some(poll)).map_err(|e| e.to_string())?;
+                s.set_write_timeout(Some(Duration::from_secs(5))).map_err(|e| e.to_string())?;
+                let writer = s.try_clone().map_err(|e| e.to_string())?;
+                Ok(RawLink { reader: Box::new(s), writer: Box::new(writer) })
+            }
+            Link::Serial(s) => {
+                let writer = s.try_clone().map_err(|e| format!("cannot use the port in both directions: {e}"))?;
+                Ok(RawLink { reader: Box::new(s), writer: Box::new(writer) })
+            }
+        }
     }
 }
 
