@@ -64,14 +64,14 @@ impl Module {
 
     // ----- the interpreter ----------------------------------------------
 
-    /// Executes the instruction at the program counter now (130, the
-    /// debugger's step).
+    /// Executes the instruction at the program counter now (130). A WAIT
+    /// still waiting is the step's instruction: its condition is looked at
+    /// once, and the instruction after it waits for the next step
+    /// (docs/behaviour.md rule 31).
     pub fn step_program(&mut self) {
         if self.program.wait.is_some() {
             self.check_wait();
-            if self.program.wait.is_some() {
-                return;
-            }
+            return;
         }
         self.take_interrupt();
         self.execute_next();

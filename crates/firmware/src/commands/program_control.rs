@@ -210,6 +210,23 @@ mod tests {
     }
 
     #[test]
+    fn a_step_that_ends_a_wait_executes_nothing_more() {
+        let mut m = module("tmcm-1141");
+        m.load_program(&program(&["WAIT TICKS, 0, 2", "CALC LOAD, 7", "CALC ADD, 1", "STOP"])).unwrap();
+        ok(&mut m, "#130 0 0 0");
+        assert!(m.program.wait.is_some(), "the WAIT waits 20 ms");
+        assert_eq!(ok(&mut m, "#135 1 0 0") & 0xFFFF, 0, "the counter stands on the WAIT");
+        ok(&mut m, "#130 0 0 0");
+        assert!(m.program.wait.is_some(), "a step before its time executes nothing");
+        m.advance(30_000_000);
+        ok(&mut m, "#130 0 0 0");
+        assert!(m.program.wait.is_none(), "the step ends the WAIT");
+        assert_eq!((m.program.pc, m.registers.accumulator), (1, 0), "and stops on the instruction after it (rule 31)");
+        ok(&mut m, "#130 0 0 0");
+        assert_eq!((m.program.pc, m.registers.accumulator), (2, 7), "which the next step executes");
+    }
+
+    #[test]
     fn application_status_135() {
         let mut m = module("tmcm-1141");
         m.load_program(&program(&["WAIT TICKS, 0, 100", "STOP"])).unwrap();
