@@ -10,7 +10,7 @@ import copy
 from dataclasses import replace
 from typing import Any, Dict, List, Optional, Tuple
 
-from .matrix import Check, Condition, Matrix, MatrixError, Read
+from .matrix import MAX_WORLD_INDEX, Check, Condition, Matrix, MatrixError, Read
 
 
 class ScenarioError(Exception):
@@ -20,19 +20,20 @@ class ScenarioError(Exception):
 
 def set_world(doc: Dict[str, Any], path: str, value: Any) -> None:
     """Sets a dotted key of a world document (`axis.0.home_switch.from`;
-    numbers index lists, which grow as needed). `…switch.width` of the home
-    switch sets `to` from `from`."""
+    numbers index lists, which grow as needed, up to the largest entry a
+    world file has). `…switch.width` of the home switch sets `to` from
+    `from`."""
     parts = path.split(".")
     node: Any = doc
     for i, part in enumerate(parts[:-1]):
         nxt = parts[i + 1]
         # A list when the next part is a number; its entries are tables,
         # unless it is the last part (a list of numbers, `inputs.2`).
-        want = [] if nxt.isdigit() else {}
-        if part.isdigit():
+        want = [] if _index(nxt, path) is not None else {}
+        k = _index(part, path)
+        if k is not None:
             if not isinstance(node, list):
                 raise MatrixError(f"world key {path}: '{part}' indexes a list")
-            k = int(part)
             while len(node) <= k:
                 node.append(copy.deepcopy(want))
             node = node[k]
@@ -41,16 +42,26 @@ def set_world(doc: Dict[str, Any], path: str, value: Any) -> None:
                 raise MatrixError(f"world key {path}: '{part}' names a table")
             node = node.setdefault(part, want)
     last = parts[-1]
-    if last.isdigit():
+    k = _index(last, path)
+    if k is not None:
         # An entry of a list of numbers (`inputs.2`, `analog.0`).
         if not isinstance(node, list):
             raise MatrixError(f"world key {path}: '{last}' indexes a list")
-        k = int(last)
         while len(node) <= k:
             node.append(0)
         node[k] = value
     else:
         node[last] = value
+
+
+def _index(part: str, path: str) -> Optional[int]:
+    """A list entry's number (ASCII digits), at most the largest a world
+    file has; None for a table's key."""
+    if not (part.isascii() and part.isdigit()):
+        return None
+    if len(part) > 9 or int(part) > MAX_WORLD_INDEX:
+        raise MatrixError(f"world key {path}: list entry {part[:12]}; at most {MAX_WORLD_INDEX}")
+    return int(part)
 
 
 def world_document(mx: Matrix, values: Dict[str, Any]) -> Dict[str, Any]:
