@@ -527,3 +527,110 @@ def test_the_nesting_check_passes_every_toml_file_it_may_meet():
         text = tomli_w.dumps(doc, multiline_strings=r.random() < 0.5)
         check_toml_nesting(text)
         assert tomllib.loads(text) == doc
+
+
+def test_failure_files_never_follow_a_link(tmp_path):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    victim = outside / "victim.txt"
+    victim.write_text("mine")
+    d = tmp_path / "failures"
+    d.mkdir()
+    # Links planted where this sweep's failure 1 and an earlier sweep's
+    # failure 7 would be, pointing outside the directory.
+    (d / "failure-1.toml").symlink_to(victim)
+    (d / "failure-1.setup").symlink_to(outside / "new.setup")
+    (d / "failure-7.toml").symlink_to(victim)
+    m = {"duration": "60s", "world": {"axis": [{"home_switch": {"from": 0, "width": 2000}}]},
+         "vary": [{"name": "home", "world": "axis.0.home_switch.from", "values": [-400000, 800000]}],
+         "check": [{"name": "homed", "expr": "var 0 == 1"}]}
+    s = tmclsim.sweep(HOMING, m, workers=0, failures=d, details=True)
+    assert list(s.failures) == [1]
+    assert victim.read_text() == "mine" and sorted(p.name for p in outside.iterdir()) == ["victim.txt"]
+    assert sorted(p.name for p in d.iterdir()) == ["failure-1.setup", "failure-1.toml"]
+    world = d / "failure-1.toml"
+    assert not world.is_symlink() and world.read_text() == s.failures[1]["world"] and "800000" in world.read_text()
+    assert (d / "failure-1.setup").read_text() == s.failures[1]["setup"]
+
+
+def test_a_world_value_no_world_file_holds_is_a_setup_failure():
+    m = {"duration": "1s", "world": {"axis": [{"home_switch": {"from": 0}}]},
+         "vary": [{"name": "width", "world": "axis.0.home_switch.width", "values": [2000, "wide"]}]}
+    t = tmclsim.sweep(tmclsim.assemble("STOP\n"), m, workers=0)
+    assert t.passed.tolist() == [True, False]
+    assert t.failed_check[1] == "setup" and t.error[1].startswith("world: ")
+
+
+def test_a_sweep_keeps_no_row_and_no_failure_file(monkeypatch):
+    # The engine and the table alone (each scenario a row made up, a third
+    # of them failures): memory of the sweep in this process grows by the
+    # table's columns, not by a dict or a file per scenario.
+    import tracemalloc
+
+    from tmclsim.sweep import scenario
+
+    def made_up(mx, programs, index, values):
+        row = {"scenario": index, **values}
+        failed = index % 3 == 0
+        row.update(passed=not failed, failed_check="homed" if failed else "", error="", time=40.0 + index % 1000 * 1e-3, position=index * 7)
+        return row, {"world": f"[[axis]]\nstart = {index}\n", "setup": ""} if failed else None
+
+    monkeypatch.setattr(scenario, "run", made_up)
+    n = 200_000
+    m = {"duration": "1s", "metrics": ["time", "position"],
+         "vary": [{"name": "a", "world": "axis.0.start", "range": [0, 999, 1]}, {"name": "b", "world": "supply", "range": [1, n // 1000, 1]}]}
+    program = tmclsim.assemble("STOP\n")
+    tmclsim.sweep(program, {"duration": "1s"}, workers=0)  # what it imports is not the sweep's
+    tracemalloc.start()
+    try:
+        s = tmclsim.sweep(program, m, workers=0, details=True)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    t = s.table
+    assert len(t) == n and t.scenario.tolist() == list(range(n)) and t.a[1001] == 5 and t.b[1001] == 2
+    assert len(s.failures) == -(-n // 3) and 3 in s.failures and 4 not in s.failures
+    # Far below what rows as dicts take (over 800 bytes each).
+    assert peak < 100 * n, f"{peak / n:.0f} bytes per scenario"
+
+
+def test_the_table_is_the_one_pandas_makes_of_the_rows():
+    import math
+
+    import pandas as pd
+
+    from tmclsim.sweep.table import Table
+
+    mx = parse({"metrics": ["time", "position", "stalled", "var 0", "max ap 1 0", "gp 0 2", "min ap 1 0", "end_stop"],
+                "vary": [{"name": "a", "world": "axis.0.travel", "values": [[-5, 5], [-9, 9]]},
+                         {"name": "b", "world": "supply", "values": [1, 2.5, 3]},
+                         {"name": "c", "profile": True, "values": ["tmcm-1141", "tmcm-1140"]}]})
+    rows = []
+    for i, values in enumerate(mx.scenarios()):
+        setup = i % 5 == 3
+        row = {"scenario": i, **values, "passed": i % 2 == 0, "failed_check": "" if i % 2 == 0 else "setup" if setup else "homed",
+               "error": "no such thing" if setup else ""}
+        metrics = {"time": i * 0.5, "position": i * 1000, "stalled": i % 3 == 0, "var 0": [1, 2][i % 2],
+                   "max ap 1 0": 2**40 if i == 2 else i, "gp 0 2": 1.5 if i == 7 else i, "min ap 1 0": "x" if i == 4 else i,
+                   "end_stop": False}
+        row.update({k: None if setup else v for k, v in metrics.items()})
+        rows.append(row)
+    table = Table(mx, len(rows))
+    for row in reversed(rows):
+        table.add(row)
+    got, want = table.frame(), pd.DataFrame(rows)
+    assert list(got.columns) == list(want.columns) and got.dtypes.to_dict() == want.dtypes.to_dict()
+    def equal(x, y):
+        return x == y or (isinstance(x, float) and isinstance(y, float) and math.isnan(x) and math.isnan(y))
+
+    for g, w in zip(got.to_dict("records"), want.to_dict("records")):
+        assert g.keys() == w.keys() and all(equal(g[k], w[k]) for k in g), (g, w)
+
+
+def test_an_embedded_cluster_refills_its_tasks_as_they_finish():
+    # One worker, a task per scenario: more tasks than are in flight.
+    m = dict(SMALL, vary=[{"name": "home", "world": "axis.0.home_switch.from", "values": [-400000, 800000, -300000, 700000, -200000]},
+                          SMALL["vary"][1]])
+    serial = tmclsim.sweep(HOMING, m, workers=0)
+    parallel = tmclsim.sweep(HOMING, m, workers=1, batch=1)
+    assert len(serial) == 10 and same(serial, parallel)

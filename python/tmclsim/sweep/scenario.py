@@ -84,6 +84,43 @@ def world_toml(doc: Dict[str, Any]) -> str:
     return tomli_w.dumps(doc)
 
 
+def world_text(mx: Matrix, values: Dict[str, Any]) -> str:
+    """The scenario's world file; a value no world file can hold (a text
+    for a width) is the scenario's error."""
+    try:
+        return world_toml(world_document(mx, values))
+    except MatrixError:
+        raise
+    except (TypeError, ValueError) as e:
+        raise ScenarioError(f"world: {e}") from None
+
+
+def _setup_errors():
+    """What fails a scenario as `setup`, with its message in `error`."""
+    import tmclsim
+
+    return (ValueError, ScenarioError, MatrixError, tmclsim.TmclError)
+
+
+def _files(text: str, lines: List[str]) -> Dict[str, str]:
+    return {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
+
+
+def files(mx: Matrix, index: int) -> Dict[str, str]:
+    """The files that reproduce scenario `index`: its world file and its
+    setup lines, as `run` gives them for a failure."""
+    import tmclsim
+
+    values = mx.scenario(index)
+    text, lines = "", []
+    try:
+        text = world_text(mx, values)
+        lines = setup_lines(tmclsim.Module(profile_of(mx, values), world=text), mx, values)
+    except _setup_errors():
+        pass
+    return _files(text, lines)
+
+
 def _number(m, kind: str, what: Any, index: int) -> int:
     """A parameter's number from its number or its name."""
     if isinstance(what, int):
@@ -142,18 +179,18 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
 
     row: Dict[str, Any] = {"scenario": index, **values}
     profile = profile_of(mx, values)
-    doc = world_document(mx, values)
-    text = world_toml(doc)
     # Every value a stop condition, a check or a metric reads; those with
     # max/min are kept over the run.
     reads = list(mx.metric_reads) + [c.read for c in mx.stop_when] + [c.condition.read for c in mx.checks if c.condition]
     kept: Dict[Read, Optional[int]] = {r: None for r in reads if r.aggregate}
     plain = {r: replace(r, aggregate="") for r in kept}
-    lines: List[str] = []
+    text, lines = "", []
     try:
+        # (As `files` makes them: the world, the module, the setup lines.)
+        text = world_text(mx, values)
         m = tmclsim.Module(profile, world=text)
-        m.load_program(tmclsim.Program.from_binary(programs[profile]))
         lines = setup_lines(m, mx, values)
+        m.load_program(tmclsim.Program.from_binary(programs[profile]))
         for line in lines:
             r = m.send(line)
             if r is None or r.status < 100:
@@ -162,11 +199,11 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
             # A value the module does not have is the scenario's error,
             # found before the program runs.
             read(m, plain.get(r, r))
-    except (ValueError, ScenarioError, MatrixError, tmclsim.TmclError) as e:
+    except _setup_errors() as e:
         row.update(passed=False, failed_check="setup", error=str(e))
         for name in mx.metrics:
             row[name] = None
-        return row, {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
+        return row, _files(text, lines)
     m.run()
     axes = m.axes
     stalled = end_stop = limit_switch = False
@@ -194,6 +231,8 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
     t = 0.0
     while t < mx.duration - 1e-12:
         m.advance(min(mx.step, mx.duration - t))
+        if m.time <= t:
+            break  # a step below the clock's nanosecond (a Matrix made by hand): time stands
         t = m.time
         for a in range(axes) if watch_any else ():
             if watch_speed:
@@ -238,8 +277,7 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
         }.get(name, lambda: None)()
     for r in mx.metric_reads:
         row[r.label()] = value(r)
-    files = None if not failed else {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
-    return row, files
+    return row, _files(text, lines) if failed else None
 
 
 def _check(c: Check, value, ended_at, stalled, end_stop, limit_switch) -> bool:
@@ -259,6 +297,6 @@ def _check(c: Check, value, ended_at, stalled, end_stop, limit_switch) -> bool:
     raise AssertionError(c.kind)
 
 
-def run_batch(mx: Matrix, programs: Dict[str, bytes], batch: List[Tuple[int, Dict[str, Any]]]):
-    """A batch of scenarios in one process (one Dask task)."""
-    return [run(mx, programs, i, values) for i, values in batch]
+def run_batch(mx: Matrix, programs: Dict[str, bytes], start: int, stop: int):
+    """Scenarios `start` up to `stop` in one process (one Dask task)."""
+    return [run(mx, programs, i, values) for i, values in enumerate(mx.scenarios(start, stop), start)]
