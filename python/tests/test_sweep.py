@@ -529,6 +529,92 @@ def test_the_nesting_check_passes_every_toml_file_it_may_meet():
         assert tomllib.loads(text) == doc
 
 
+def test_options_are_checked_before_anything_runs(tmp_path):
+    program = tmclsim.assemble("STOP\n")
+    m = {"duration": "1s"}
+    (tmp_path / "file").write_text("")
+    cases = [
+        (dict(batch=-1), "batch: -1 is outside 1…100000"),
+        (dict(batch=0), "batch: 0 is outside 1…100000"),
+        (dict(batch=True), "batch: a whole number"),
+        (dict(batch=2.5), "batch: a whole number"),
+        (dict(workers=-1), "workers: -1 is outside 0…256"),
+        (dict(workers=10**6), "workers: 1000000 is outside 0…256"),
+        (dict(workers="2"), "workers: a whole number"),
+        (dict(scheduler=""), "scheduler: the address of a Dask scheduler"),
+        (dict(workers=0, out=tmp_path / "r.txt"), "out: "),
+        (dict(workers=0, out=tmp_path / "no" / "r.csv"), "is no directory"),
+        (dict(workers=0, failures=tmp_path / "file"), "failures: "),
+    ]
+    for options, message in cases:
+        with pytest.raises(ValueError) as e:
+            tmclsim.sweep(program, m, **options)
+        assert message in str(e.value), (options, str(e.value))
+    assert not (tmp_path / "r.txt").exists()
+
+
+def test_the_command_line_refuses_bad_options_in_one_line(tmp_path):
+    matrix = tmp_path / "m.toml"
+    matrix.write_text('duration = "1s"\n')
+    program = tmp_path / "p.tmc"
+    program.write_text("STOP\n")
+    (tmp_path / "file").write_text("")
+    cases = [
+        (["--batch", "-1"], "--batch: -1 is outside 1…100000"),
+        (["--batch", "0"], "--batch: 0 is outside 1…100000"),
+        (["--batch", "many"], "--batch: 'many' is not a whole number"),
+        (["--workers", "-1"], "--workers: -1 is outside 0…256"),
+        (["--workers", "1e9"], "--workers: '1e9' is not a whole number"),
+        (["--workers", "0", "--out", "r.txt"], "--out: r.txt: the table is written as .parquet or .csv"),
+        (["--workers", "0", "--failures", str(tmp_path / "file")], "--failures: "),
+        (["--workers", "0", "--matrix", str(tmp_path / "missing.toml")], "missing.toml"),
+    ]
+    for extra, message in cases:
+        args = [sys.executable, "-m", "tmclsim.sweep", str(program), "--matrix", str(matrix), *extra]
+        r = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path)
+        assert r.returncode == 2 and r.stderr.count("\n") == 1 and message in r.stderr, (extra, r.stderr)
+        assert "Traceback" not in r.stderr and r.stdout == ""
+    # The same through `tmclsim sweep`.
+    r = subprocess.run([tmclsim_bin(), "sweep", str(program), "--matrix", str(matrix), "--batch", "0"], capture_output=True, text=True,
+                       env=dict(os.environ, TMCLSIM_PYTHON=sys.executable), cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr == "tmclsim sweep: argument --batch: 0 is outside 1…100000\n", r.stderr
+    deep = tmp_path / "deep.toml"
+    deep.write_text("x = " + "[" * 100_000 + "]" * 100_000 + "\n")
+    r = subprocess.run([sys.executable, "-m", "tmclsim.sweep", str(program), "--matrix", str(deep)], capture_output=True, text=True)
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "nested more than 32 deep" in r.stderr, r.stderr
+
+
+def test_a_replay_command_is_always_one_that_runs(tmp_path):
+    import shlex
+
+    from tmclsim.sweep import reproduce_command
+
+    # One scenario the module refuses (no time: NaN in the table), one
+    # that fails its check; a failure directory with a space in its name.
+    program = tmp_path / "my prog.tmc"
+    program.write_text("STOP\n")
+    m = {"duration": "2s", "metrics": ["time"], "vary": [{"name": "speed", "ap": 4, "values": [5000, 1000]}],
+         "check": [{"name": "never", "expr": "var 0 == 1"}]}
+    d = tmp_path / "fail ures"
+    s = tmclsim.sweep(program, m, workers=0, failures=d, details=True)
+    t = s.table
+    assert t.failed_check.tolist() == ["setup", "never"] and t.time.isna().tolist() == [True, False]
+    mx = parse(m)
+    for row in t.to_dict("records"):
+        words = shlex.split(reproduce_command(program, mx, row, d))
+        assert words[:3] == ["tmclsim", "run", str(program)] and words[words.index("--world") + 1] == str(d / f"failure-{row['scenario']}.toml")
+        seconds = words[words.index("--for") + 1]
+        assert seconds.endswith("s") and "nan" not in seconds
+        if row["failed_check"] == "setup":
+            assert seconds == "2s"  # the matrix's duration
+        else:
+            out = subprocess.run([tmclsim_bin(), *words[1:]], capture_output=True, text=True)
+            assert out.returncode == 0, out.stderr
+    for t in [float("nan"), float("inf"), -1.0, None, True]:
+        assert shlex.split(reproduce_command("p.tmc", mx, {"scenario": 0, "speed": 1000, "time": t}, "f"))[-1] == "2s"
+    assert shlex.split(reproduce_command("p.tmc", mx, {"scenario": 0, "speed": 1000, "time": 1e-05}, "f"))[-1] == "0.00001s"
+
+
 def test_failure_files_never_follow_a_link(tmp_path):
     outside = tmp_path / "outside"
     outside.mkdir()
