@@ -10,7 +10,7 @@ import copy
 from dataclasses import replace
 from typing import Any, Dict, List, Optional, Tuple
 
-from .matrix import Check, Condition, Matrix, MatrixError, Read
+from .matrix import MAX_WORLD_INDEX, Check, Condition, Matrix, MatrixError, Read
 
 
 class ScenarioError(Exception):
@@ -20,19 +20,20 @@ class ScenarioError(Exception):
 
 def set_world(doc: Dict[str, Any], path: str, value: Any) -> None:
     """Sets a dotted key of a world document (`axis.0.home_switch.from`;
-    numbers index lists, which grow as needed). `…switch.width` of the home
-    switch sets `to` from `from`."""
+    numbers index lists, which grow as needed, up to the largest entry a
+    world file has). `…switch.width` of the home switch sets `to` from
+    `from`."""
     parts = path.split(".")
     node: Any = doc
     for i, part in enumerate(parts[:-1]):
         nxt = parts[i + 1]
         # A list when the next part is a number; its entries are tables,
         # unless it is the last part (a list of numbers, `inputs.2`).
-        want = [] if nxt.isdigit() else {}
-        if part.isdigit():
+        want = [] if _index(nxt, path) is not None else {}
+        k = _index(part, path)
+        if k is not None:
             if not isinstance(node, list):
                 raise MatrixError(f"world key {path}: '{part}' indexes a list")
-            k = int(part)
             while len(node) <= k:
                 node.append(copy.deepcopy(want))
             node = node[k]
@@ -41,16 +42,26 @@ def set_world(doc: Dict[str, Any], path: str, value: Any) -> None:
                 raise MatrixError(f"world key {path}: '{part}' names a table")
             node = node.setdefault(part, want)
     last = parts[-1]
-    if last.isdigit():
+    k = _index(last, path)
+    if k is not None:
         # An entry of a list of numbers (`inputs.2`, `analog.0`).
         if not isinstance(node, list):
             raise MatrixError(f"world key {path}: '{last}' indexes a list")
-        k = int(last)
         while len(node) <= k:
             node.append(0)
         node[k] = value
     else:
         node[last] = value
+
+
+def _index(part: str, path: str) -> Optional[int]:
+    """A list entry's number (ASCII digits), at most the largest a world
+    file has; None for a table's key."""
+    if not (part.isascii() and part.isdigit()):
+        return None
+    if len(part) > 9 or int(part) > MAX_WORLD_INDEX:
+        raise MatrixError(f"world key {path}: list entry {part[:12]}; at most {MAX_WORLD_INDEX}")
+    return int(part)
 
 
 def world_document(mx: Matrix, values: Dict[str, Any]) -> Dict[str, Any]:
@@ -71,6 +82,43 @@ def world_toml(doc: Dict[str, Any]) -> str:
     import tomli_w
 
     return tomli_w.dumps(doc)
+
+
+def world_text(mx: Matrix, values: Dict[str, Any]) -> str:
+    """The scenario's world file; a value no world file can hold (a text
+    for a width) is the scenario's error."""
+    try:
+        return world_toml(world_document(mx, values))
+    except MatrixError:
+        raise
+    except (TypeError, ValueError) as e:
+        raise ScenarioError(f"world: {e}") from None
+
+
+def _setup_errors():
+    """What fails a scenario as `setup`, with its message in `error`."""
+    import tmclsim
+
+    return (ValueError, ScenarioError, MatrixError, tmclsim.TmclError)
+
+
+def _files(text: str, lines: List[str]) -> Dict[str, str]:
+    return {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
+
+
+def files(mx: Matrix, index: int) -> Dict[str, str]:
+    """The files that reproduce scenario `index`: its world file and its
+    setup lines, as `run` gives them for a failure."""
+    import tmclsim
+
+    values = mx.scenario(index)
+    text, lines = "", []
+    try:
+        text = world_text(mx, values)
+        lines = setup_lines(tmclsim.Module(profile_of(mx, values), world=text), mx, values)
+    except _setup_errors():
+        pass
+    return _files(text, lines)
 
 
 def _number(m, kind: str, what: Any, index: int) -> int:
@@ -131,18 +179,18 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
 
     row: Dict[str, Any] = {"scenario": index, **values}
     profile = profile_of(mx, values)
-    doc = world_document(mx, values)
-    text = world_toml(doc)
     # Every value a stop condition, a check or a metric reads; those with
     # max/min are kept over the run.
     reads = list(mx.metric_reads) + [c.read for c in mx.stop_when] + [c.condition.read for c in mx.checks if c.condition]
     kept: Dict[Read, Optional[int]] = {r: None for r in reads if r.aggregate}
     plain = {r: replace(r, aggregate="") for r in kept}
-    lines: List[str] = []
+    text, lines = "", []
     try:
+        # (As `files` makes them: the world, the module, the setup lines.)
+        text = world_text(mx, values)
         m = tmclsim.Module(profile, world=text)
-        m.load_program(tmclsim.Program.from_binary(programs[profile]))
         lines = setup_lines(m, mx, values)
+        m.load_program(tmclsim.Program.from_binary(programs[profile]))
         for line in lines:
             r = m.send(line)
             if r is None or r.status < 100:
@@ -151,11 +199,11 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
             # A value the module does not have is the scenario's error,
             # found before the program runs.
             read(m, plain.get(r, r))
-    except (ValueError, ScenarioError, MatrixError, tmclsim.TmclError) as e:
+    except _setup_errors() as e:
         row.update(passed=False, failed_check="setup", error=str(e))
         for name in mx.metrics:
             row[name] = None
-        return row, {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
+        return row, _files(text, lines)
     m.run()
     axes = m.axes
     stalled = end_stop = limit_switch = False
@@ -183,6 +231,8 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
     t = 0.0
     while t < mx.duration - 1e-12:
         m.advance(min(mx.step, mx.duration - t))
+        if m.time <= t:
+            break  # a step below the clock's nanosecond (a Matrix made by hand): time stands
         t = m.time
         for a in range(axes) if watch_any else ():
             if watch_speed:
@@ -227,8 +277,7 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
         }.get(name, lambda: None)()
     for r in mx.metric_reads:
         row[r.label()] = value(r)
-    files = None if not failed else {"world": text, "setup": "\n".join(lines) + ("\n" if lines else "")}
-    return row, files
+    return row, _files(text, lines) if failed else None
 
 
 def _check(c: Check, value, ended_at, stalled, end_stop, limit_switch) -> bool:
@@ -248,6 +297,6 @@ def _check(c: Check, value, ended_at, stalled, end_stop, limit_switch) -> bool:
     raise AssertionError(c.kind)
 
 
-def run_batch(mx: Matrix, programs: Dict[str, bytes], batch: List[Tuple[int, Dict[str, Any]]]):
-    """A batch of scenarios in one process (one Dask task)."""
-    return [run(mx, programs, i, values) for i, values in batch]
+def run_batch(mx: Matrix, programs: Dict[str, bytes], start: int, stop: int):
+    """Scenarios `start` up to `stop` in one process (one Dask task)."""
+    return [run(mx, programs, i, values) for i, values in enumerate(mx.scenarios(start, stop), start)]
