@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{MS, send};
+use common::{MS, reply, send};
 
 use tmclsim_firmware::Module;
 use tmclsim_firmware::world::Load;
@@ -61,4 +61,25 @@ fn stored_user_variables_survive_a_power_cycle_and_the_others_do_not() {
         let mut third = Module::with_eeprom(again.profile().clone(), again.eeprom().clone());
         assert_eq!(read(&mut third, 17), 0, "{name}: GP 85 = 1");
     }
+}
+
+#[test]
+fn every_sibling_answers_the_supply_voltage_at_gio_8_bank_1() {
+    // An unchanged host driver reads the supply at GIO 8, 1 on each of them
+    // (the family's port, TMCM-1141 manual V1.46 section 3.7.15).
+    for (name, _) in SIBLINGS {
+        let mut m = Module::built_in(name).unwrap();
+        assert_eq!(send(&mut m, "GIO 8, 1"), 240, "{name}: 24.0 V supply");
+    }
+}
+
+#[test]
+fn the_tmcm_6110_downloads_2048_words() {
+    // TMCM-6110 manual V1.31, section 4: up to 2048 TMCL instructions.
+    let mut m = Module::built_in("tmcm-6110").unwrap();
+    assert_eq!(reply(&mut m, "#132 0 0 2047").status, 100);
+    assert_eq!(reply(&mut m, "MST 0").status, 101, "the last word is stored");
+    assert_eq!(reply(&mut m, "MST 0").status, 4, "past the end of memory");
+    reply(&mut m, "#133 0 0 0");
+    assert_eq!(reply(&mut m, "#132 0 0 2048").status, 4);
 }

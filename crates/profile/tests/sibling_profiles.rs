@@ -1,7 +1,7 @@
 //! The TMCM-1141's siblings (TMCM-1140, 3110, 6110): served from data like
 //! the other profiles, with what PyTrinamic's module classes name.
 
-use tmclsim_profile::{DefaultSource, InterruptSource, PortDirection, Profile};
+use tmclsim_profile::{DefaultSource, InterruptSource, PortDirection, PortRole, Profile};
 
 /// (profile, axes, version text, inputs, outputs).
 const SIBLINGS: [(&str, u8, &[u8; 8], u8, u8); 3] =
@@ -82,4 +82,33 @@ fn siblings_answer_on_can_with_their_own_identifiers() {
         assert_eq!((can.id, can.reply_id, can.secondary_id), (71, 70, 83), "{name}");
         assert_eq!(p.global_parameter(0, 71).unwrap().default, 1, "{name}");
     }
+}
+
+#[test]
+fn the_multi_axis_siblings_read_the_supply_at_gio_8_bank_1() {
+    // Host drivers of the TMCM-3110 and TMCM-6110 read the supply voltage
+    // at GIO 8, 1, as on the TMCM-1141 (its manual V1.46, section 3.7.15).
+    for name in ["tmcm-3110", "tmcm-6110"] {
+        let p = Profile::built_in(name).unwrap();
+        let supply = p.port(PortDirection::Input, 1, 8).unwrap_or_else(|| panic!("{name}: GIO 8, 1"));
+        assert_eq!(supply.role, Some(PortRole::Supply), "{name}");
+        assert_eq!(supply.unit.as_deref(), Some("0.1 V"), "{name}");
+        // 12…48 V (TMCM-3110 manual V1.11) and 9…28 V (TMCM-6110 manual V1.46) fit.
+        assert!(supply.max >= 480, "{name}");
+    }
+}
+
+#[test]
+fn the_tmcm_6110_follows_what_its_own_manuals_state() {
+    let p = Profile::built_in("tmcm-6110").unwrap();
+    // TMCM-6110 manual V1.31, section 4: up to 2048 TMCL instructions; the
+    // program counter (GP 130) spans them.
+    assert_eq!(p.module.program_memory, 2048);
+    assert_eq!(p.global_parameter(0, 130).unwrap().max, 2047);
+    // TMCM-6110 manual V1.19, 5.6.5: SAP 6, 2, 47 sets 200 mA (47/255 of the
+    // 1.1 A RMS of its V1.31 title page).
+    let ma = 47.0 * p.features.full_scale_current_ma as f64 / 255.0;
+    assert!((ma - 200.0).abs() < 5.0, "{ma} mA");
+    // 5.6.5, 5.6.6, 5.6.8: SAP, GAP and RSAP take motor 0…5.
+    assert_eq!(p.module.axes, 6);
 }
