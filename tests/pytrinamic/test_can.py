@@ -12,7 +12,7 @@ from pytrinamic.modules import TMCM1141
 def test_two_modules_on_one_can_bus(serve, tmp_path):
     slcan = tmp_path / "slcan"
     serve("--bus", "tmcm-1141@1,tmcm-351@3", "--slcan", str(slcan))
-    for module_id, version in [(1, "1141V146"), (3, "0351V400")]:
+    for module_id, version in [(1, "1141V146"), (3, "0351V445")]:
         args = f"--interface slcan_tmcl --port {slcan} --data-rate 1000000 --module-id {module_id} --timeout 2"
         with ConnectionManager(args.split()).connect() as interface:
             assert interface.get_version_string() == version

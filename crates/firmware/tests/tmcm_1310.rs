@@ -172,6 +172,17 @@ fn a_lost_encoder_signal_is_detectable() {
 }
 
 #[test]
+fn version_replies() {
+    // 136 as V1.11 6.8.39 lays it out: the type 1310 ($051E) in the high
+    // word of the binary form; the version is the V1.14 pages'.
+    let mut m = module();
+    assert_eq!(send(&mut m, "#136 1 0 0"), 0x051E_010E);
+    let mut string = [2; 9];
+    string[1..].copy_from_slice(b"1310V114");
+    assert_eq!(m.handle_frame(&common::hex("01 88 00 00 00 00 00 00 89")), Some(string));
+}
+
+#[test]
 fn commands_the_1310_lacks() {
     let mut m = module();
     for line in ["CALCVV ADD, 1, 2", "MVPA ABS, 0", "RST 0", "DJNZ 1, 0", "ROLA 0", "SIV 1", "CALL ZE, 0", "SAC 0, 1, 0"] {

@@ -55,6 +55,34 @@ fn golden_frames_of_the_351_manual() {
 }
 
 #[test]
+fn examples_of_the_v4_45_manual() {
+    // 4.6.15: GIO 0, 1 and its reply, the 10-bit value 506 (the world's
+    // 12-bit 2024 at the module's resolution).
+    let mut m = module();
+    assert_eq!(Request::new(1, parse_line("GIO 0, 1").unwrap()).encode(), hex("01 0F 00 01 00 00 00 00 11"));
+    m.world_mut().set_analog(0, 2024);
+    assert_eq!(m.handle_frame(&hex("01 0F 00 01 00 00 00 00 11")), Some(hex("02 01 64 0F 00 00 01 FA 71")));
+    // 4.6.5: SAP 6, 0, 128 (the manual prints the value byte as $12; 128 is
+    // $80, checksum $8C).
+    assert_eq!(Request::new(1, parse_line("SAP 6, 0, 128").unwrap()).encode(), hex("01 05 06 00 00 00 00 80 8C"));
+    assert_eq!(m.handle_frame(&hex("01 05 06 00 00 00 00 80 8C")), Some(hex("02 01 64 05 00 00 00 80 EC")));
+    assert_eq!(send(&mut m, "GAP 6, 0"), 128);
+    // 4.6.1: ROR/ROL take 0…2047 on motors 0…2.
+    assert_eq!(reply(&mut m, "ROR 2, 2047").status, 100);
+    assert_eq!(reply(&mut m, "ROR 2, 2048").status, 4);
+    assert_eq!(reply(&mut m, "ROR 3, 100").status, 4);
+    send(&mut m, "MST 2");
+    // Title page: firmware V4.45, in both forms of 136.
+    assert_eq!(send(&mut m, "#136 1 0 0"), 351 << 16 | 4 << 8 | 45);
+    let mut string = [2; 9];
+    string[1..].copy_from_slice(b"0351V445");
+    assert_eq!(m.handle_frame(&hex("01 88 00 00 00 00 00 00 89")), Some(string));
+    // No supply voltage port was found in either edition: GIO 8, 1 is a
+    // port the module lacks.
+    assert_eq!(reply(&mut m, "GIO 8, 1").status, 3);
+}
+
+#[test]
 fn commands_the_351_lacks_answer_status_2() {
     let mut m = module();
     for line in [
@@ -191,8 +219,11 @@ fn eight_inputs_four_analog_eight_outputs() {
     m.world_mut().set_digital(7, true);
     m.world_mut().set_digital(0, true);
     assert_eq!(send(&mut m, "GIO 255, 0"), 0x81);
+    // V4.45 4.6.15: a 10-bit ADC, 0…1023: the world's 12-bit 3000 reads 750.
     m.world_mut().set_analog(3, 3000);
-    assert_eq!(send(&mut m, "GIO 3, 1"), 3000);
+    assert_eq!(send(&mut m, "GIO 3, 1"), 750);
+    m.world_mut().set_analog(3, 4095);
+    assert_eq!(send(&mut m, "GIO 3, 1"), 1023, "full scale");
     assert_eq!(reply(&mut m, "GIO 4, 1").status, 3);
 }
 

@@ -83,7 +83,13 @@ impl Module {
             _ if p.max == 1 => self.world.digital(port) as i32,
             // The supply voltage channel is the one with a 0.1 V unit.
             _ if p.role == Some(tmclsim_profile::PortRole::Supply) => self.world.supply_decivolts as i32,
-            _ => self.world.analog_inputs.get(port as usize).copied().unwrap_or(0) as i32,
+            _ => {
+                let v = self.world.analog_inputs.get(port as usize).copied().unwrap_or(0) as i64;
+                // The world's ADC values are 12 bit (0…4095). A plain analog
+                // input (no unit) with a coarser ADC reads them at its own
+                // resolution: range 0…1023 reads a quarter.
+                if p.unit.is_none() && (1..4095).contains(&p.max) { (v * (p.max + 1) / 4096) as i32 } else { v as i32 }
+            }
         })
     }
 
@@ -131,7 +137,7 @@ mod tests {
         assert_eq!(ok(&mut m, "GIO 255, 0"), 0b1000_1001);
         assert_eq!([0, 1, 3].map(|p| ok(&mut m, &format!("GIO {p}, 0"))), [1, 0, 1]);
         m.world_mut().set_analog(2, 512);
-        assert_eq!(ok(&mut m, "GIO 2, 1"), 512);
+        assert_eq!(ok(&mut m, "GIO 2, 1"), 128, "a 10-bit ADC reads the world's 12-bit value at its resolution");
         assert_eq!(status(&mut m, "GIO 0, 7"), Status::InvalidValue, "no bank 7");
         assert_eq!(in_program(&mut m, "GIO 255, 0"), Ok(0b1000_1001));
         assert_eq!(m.registers.accumulator, 0b1000_1001, "a program's GIO loads the accumulator");
