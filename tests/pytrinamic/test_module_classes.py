@@ -66,7 +66,7 @@ CLASSES = served_classes()
 
 def test_every_sibling_module_has_its_class():
     names = {name for name, _ in CLASSES}
-    assert {"TMCM1140", "TMCM1141", "TMCM3110", "TMCM6110", "TMCM1311"} <= names, names
+    assert {"TMCM1110", "TMCM1140", "TMCM1141", "TMCM1160", "TMCM3110", "TMCM6110", "TMCM1311"} <= names, names
 
 
 def enum(holder, name):
