@@ -16,7 +16,7 @@ fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {
         let profile = Profile::built_in(name)?;
         let w = crate::load_world(world, profile.module.axes as usize)?;
         let mut m = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), w);
-        set_addresses(&mut m, address);
+        Module::set_address(&mut m, address);
         modules.push(m);
     }
     if modules.is_empty() {
@@ -61,7 +61,7 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     let module = Module::with_world(profile.clone(), image, world);
     let mut module = module;
     if let Some(a) = args.address {
-        set_addresses(&mut module, a);
+        Module::set_address(&mut module, a);
     }
     if let Some(f) = &file {
         // Write the file at once so a fresh one exists from the start.
@@ -160,15 +160,6 @@ fn read_only_note(file: &EepromFile) -> String {
         file.named().display()
     );
     " (read-only: EEPROM writes answer status 5, the file stays as it is)".to_string()
-}
-
-/// The serial address, and on modules with their own CAN identifier
-/// (features `[features.can]`, GP 71 on the TMCM-351) that too.
-fn set_addresses(m: &mut Module, address: u8) {
-    m.set_address(address);
-    if let Some(can) = m.profile().features.can {
-        let _ = m.set_global_parameter(can.id, 0, address as i32);
-    }
 }
 
 /// The links to serve: both defaults when neither is named.

@@ -81,3 +81,16 @@ fn ethercat_needs_a_module_that_is_an_ethercat_slave() {
         common::text(&out)
     );
 }
+
+#[test]
+fn a_link_the_module_has_no_interface_for_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let can = dir.path().join("can");
+    let out = common::tmclsim(&["serve", "--module", "tmcm-1310", "--tcp", "127.0.0.1:0", "--slcan", can.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", common::text(&out));
+    assert!(common::text(&out).contains("TMCM-1310 has no CAN interface (its interfaces: USB, EtherCAT)"), "{}", common::text(&out));
+    assert!(!can.exists(), "no adapter was left behind");
+    let out = common::tmclsim(&["serve", "--bus", "tmcm-1141@1,tmcm-1310@2", "--tcp", "127.0.0.1:0"]);
+    assert_eq!(out.status.code(), Some(2), "{}", common::text(&out));
+    assert!(common::text(&out).contains("TMCM-1310 has no RS-485 interface"), "{}", common::text(&out));
+}

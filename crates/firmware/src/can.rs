@@ -67,11 +67,13 @@ impl Module {
             return None;
         }
         self.link.restart_heartbeat(self.now_ns);
+        // A new reply identifier takes effect with the next frame, as a
+        // new serial address does (docs/behaviour.md rules 2 and 92).
+        let reply_id = self.can_reply_id();
         let d = frame.data;
         let ins = Instruction::new(d[0], d[1], d[2], i32::from_be_bytes([d[3], d[4], d[5], d[6]]));
         let outcome =
             if self.program.download.is_some() && !opcode::is_control(ins.opcode) { self.download_word(ins) } else { self.execute(ins) };
-        let reply_id = self.can_reply_id();
         let reply = match outcome.special {
             Special::Silent => return None,
             // 136 type 0: the 8 characters; 134: the instruction (the

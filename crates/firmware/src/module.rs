@@ -186,9 +186,17 @@ impl Module {
 
     /// Sets the module address (GP 66) the way SGP 66 would, without a
     /// frame (used by servers for `--address`).
+    /// Places the module at `address` on its link: the serial address
+    /// (GP 66) and, on a module with CAN identifier parameters, its CAN ID
+    /// too, so that modules placed at different addresses on one bus are
+    /// reached apart on every interface (docs/behaviour.md rule 92).
     pub fn set_address(&mut self, address: u8) {
         self.globals[0][gp::SERIAL_ADDRESS as usize] = address as i32;
         self.persistence.store_global(0, gp::SERIAL_ADDRESS, address as i32);
+        if let Some(can) = self.profile.features.can {
+            self.globals[0][can.id as usize] = address as i32;
+            self.persistence.store_global(0, can.id, address as i32);
+        }
     }
 
     /// Power cycle: RAM from factory defaults, then what the EEPROM holds.

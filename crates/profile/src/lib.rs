@@ -182,6 +182,40 @@ pub struct ModuleInfo {
     pub opcodes: Vec<u8>,
     #[serde(default)]
     pub ascii_opcodes: Vec<u8>,
+    /// The host interfaces the module has, as its manual lists them: a
+    /// link of another kind is refused (a CAN adapter, a multi-drop bus).
+    pub interfaces: Vec<Interface>,
+}
+
+/// A host interface of a module.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Interface {
+    Usb,
+    Rs232,
+    Rs485,
+    Can,
+    Ethercat,
+}
+
+impl Interface {
+    /// As manuals write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Interface::Usb => "USB",
+            Interface::Rs232 => "RS-232",
+            Interface::Rs485 => "RS-485",
+            Interface::Can => "CAN",
+            Interface::Ethercat => "EtherCAT",
+        }
+    }
+}
+
+impl ModuleInfo {
+    /// Whether the module has host interface `i`.
+    pub fn has_interface(&self, i: Interface) -> bool {
+        self.interfaces.contains(&i)
+    }
 }
 
 #[derive(Debug, Deserialize)]

@@ -310,6 +310,35 @@ pub fn exposure_warnings(endpoints: &[Endpoints]) -> Vec<String> {
     out
 }
 
+/// A link of a kind the modules on it do not have is refused
+/// (docs/behaviour.md rule 92): a CAN adapter needs modules with a CAN
+/// interface, a multi-drop bus of two or more modules needs RS-485.
+fn check_interfaces(bus: &SharedBus, config: &ServerConfig) -> std::io::Result<()> {
+    use tmclsim_firmware::profile::Interface;
+    let modules: Vec<(String, Vec<Interface>)> =
+        bus.with_bus(|b| b.modules().iter().map(|m| (m.profile().module.name.clone(), m.profile().module.interfaces.clone())).collect());
+    let lacking = |needed: Interface, what: &str| -> std::io::Result<()> {
+        match modules.iter().find(|(_, has)| !has.contains(&needed)) {
+            None => Ok(()),
+            Some((name, has)) => {
+                let has: Vec<&str> = has.iter().map(|i| i.name()).collect();
+                Err(std::io::Error::other(format!(
+                    "{name} has no {} interface (its interfaces: {}), so it cannot be served {what}",
+                    needed.name(),
+                    has.join(", ")
+                )))
+            }
+        }
+    };
+    if config.slcan.is_some() {
+        lacking(Interface::Can, "behind a CAN adapter (--slcan)")?;
+    }
+    if modules.len() > 1 {
+        lacking(Interface::Rs485, "on a multi-drop bus with other modules")?;
+    }
+    Ok(())
+}
+
 /// Starts serving many links (a fleet) from one thread: one event loop,
 /// a task per connection and per clock, nothing that polls.
 pub fn start_fleet(links: Vec<LinkSpec>) -> std::io::Result<ServerHandle> {
@@ -326,8 +355,9 @@ pub fn start_shared(bus: Arc<SharedBus>, config: ServerConfig) -> std::io::Resul
 }
 
 fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<ServerHandle> {
-    for (_, config) in &specs {
+    for (bus, config) in &specs {
         check(config)?;
+        check_interfaces(bus, config)?;
     }
     if specs.iter().any(|(_, c)| c.log_frames) {
         frame_log::started();
