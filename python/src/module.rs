@@ -20,13 +20,13 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tmclsim_firmware::Bus;
-use tmclsim_firmware::eeprom::{EepromFile, LoadError, resolve};
 use tmclsim_firmware::module::gp::SERIAL_ADDRESS;
 use tmclsim_firmware::profile::Parameter;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
 use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Request, Status, opcode};
 use tmclsim_server::SharedBus;
+use tmclsim_server::eeprom_file::{EepromFile, LoadError, resolve};
 
 /// A virtual TMCL module (a TMCM-1141 by default).
 ///

@@ -9,6 +9,7 @@
 
 mod clock;
 pub mod control;
+pub mod eeprom_file;
 pub mod ethercat;
 mod faults;
 pub mod frame_log;
@@ -23,12 +24,12 @@ pub use faults::LinkFaults;
 pub use shared::{SharedBus, Stats};
 pub use slots::ACCEPT_BACKOFF;
 
+use eeprom_file::EepromFile;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_firmware::Module;
-use tmclsim_firmware::eeprom::EepromFile;
 use tokio::sync::watch;
 
 /// What to serve and where.
