@@ -12,6 +12,7 @@ pub mod control;
 pub mod eeprom_file;
 pub mod ethercat;
 mod faults;
+pub mod files;
 pub mod frame_log;
 mod link;
 mod pty;
