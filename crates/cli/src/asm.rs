@@ -2,8 +2,9 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use tmclsim_asm::{Program, assemble_file, disassemble, render};
+use tmclsim_asm::{Program, disassemble, render};
 use tmclsim_firmware::Profile;
+use tmclsim_server::sources::assemble_file;
 
 #[derive(clap::Args)]
 pub struct AsmArgs {

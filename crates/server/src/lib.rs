@@ -6,6 +6,12 @@
 //! on the same link. Virtual time is paced by the wall clock; a clock task
 //! wakes only when the module has something to do on its own (a 138 event,
 //! a heartbeat stop), so an idle server uses no CPU.
+//!
+//! The files tmclsim reads and writes are here too, since the firmware
+//! and the assembler do no I/O: the crash-safe EEPROM file
+//! ([`eeprom_file`]), world, fleet and symbol files and program binaries
+//! with their size limits ([`files`]), and TMCL source files with their
+//! includes ([`sources`]).
 
 mod clock;
 pub mod control;
@@ -19,6 +25,7 @@ mod pty;
 mod shared;
 mod slcan;
 mod slots;
+pub mod sources;
 mod tcp;
 
 pub use faults::LinkFaults;
