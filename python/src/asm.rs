@@ -7,8 +7,9 @@ use pyo3::types::{PyByteArray, PyBytes, PyString};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
-use tmclsim_asm::{FileResolver, Program as AsmProgram};
+use tmclsim_asm::Program as AsmProgram;
 use tmclsim_firmware::Profile;
+use tmclsim_server::sources::FileResolver;
 
 /// An assembled TMCL program: its instructions (one per program memory
 /// word, from address 0), its labels and its constants.
@@ -62,7 +63,7 @@ pub fn program_from(obj: &Bound<'_, PyAny>, profile: Option<&Arc<Profile>>) -> P
     }
     if py.import("os")?.getattr("PathLike").and_then(|c| obj.is_instance(&c))? {
         let path: PathBuf = obj.extract()?;
-        return tmclsim_asm::assemble_file(&path, profile.map(|p| p.as_ref())).map_err(|d| assembly_error(py, &d));
+        return tmclsim_server::sources::assemble_file(&path, profile.map(|p| p.as_ref())).map_err(|d| assembly_error(py, &d));
     }
     Ok(AsmProgram { instructions: instructions_from(obj)?, ..AsmProgram::default() })
 }
@@ -208,7 +209,7 @@ pub fn assemble(
 pub fn assemble_file(py: Python<'_>, path: PathBuf, profile: Option<&str>, include_path: Option<Vec<PathBuf>>) -> PyResult<Program> {
     let profile = profile_by_name(profile)?;
     let name = path.display().to_string();
-    let source = tmclsim_asm::limits::read_source(&path).map_err(|e| crate::errors::os_error(format!("{name}: {e}")))?;
+    let source = tmclsim_server::sources::read_source(&path).map_err(|e| crate::errors::os_error(format!("{name}: {e}")))?;
     let inner = tmclsim_asm::assemble(&source, &name, &resolver(include_path), profile.as_deref()).map_err(|d| assembly_error(py, &d))?;
     Ok(Program { inner })
 }

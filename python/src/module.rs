@@ -20,13 +20,13 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tmclsim_firmware::Bus;
-use tmclsim_firmware::eeprom::{EepromFile, LoadError, resolve};
 use tmclsim_firmware::module::gp::SERIAL_ADDRESS;
 use tmclsim_firmware::profile::Parameter;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
 use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Request, Status, opcode};
 use tmclsim_server::SharedBus;
+use tmclsim_server::eeprom_file::{EepromFile, LoadError, resolve};
 
 /// A virtual TMCL module (a TMCM-1141 by default).
 ///
@@ -198,10 +198,10 @@ fn world_from(world: Option<&Bound<'_, PyAny>>, axes: usize) -> PyResult<World> 
         return Ok(World::stage(axes));
     }
     if let Ok(text) = world.cast::<PyString>() {
-        return World::named(&text.to_cow()?, axes).map_err(|e| value_error(format!("world: {e}")));
+        return tmclsim_server::files::world_named(&text.to_cow()?, axes).map_err(|e| value_error(format!("world: {e}")));
     }
     let path: PathBuf = world.extract().map_err(|_| value_error("world is \"stage\", \"free\", a path or TOML text"))?;
-    World::load_file(&path, axes).map_err(|e| value_error(format!("world: {e}")))
+    tmclsim_server::files::load_world(&path, axes).map_err(|e| value_error(format!("world: {e}")))
 }
 
 fn parameter_dict<'py>(py: Python<'py>, p: &Parameter, bank: Option<u8>) -> PyResult<Bound<'py, PyDict>> {

@@ -5,6 +5,9 @@
 //! file, the assembler falls back to the include files shipped with
 //! tmclsim (`include/Interrupts.inc`, `include/Parameters.inc`), so that
 //! `#include Interrupts.inc` works everywhere, as it does in the TMCL-IDE.
+//!
+//! The assembler reads no files: the resolver that reads them from disk is
+//! `tmclsim_server::sources::FileResolver`.
 
 use std::collections::BTreeMap;
 use std::path::{Component, Path, PathBuf};
@@ -50,54 +53,6 @@ pub fn built_in(name: &str) -> Option<IncludedFile> {
     })
 }
 
-/// Reads included files from disk, relative to the including file, then
-/// from extra search directories in order.
-#[derive(Clone, Debug, Default)]
-pub struct FileResolver {
-    pub search_path: Vec<PathBuf>,
-}
-
-impl FileResolver {
-    pub fn new() -> FileResolver {
-        FileResolver::default()
-    }
-
-    /// Adds a directory searched after the including file's directory.
-    pub fn with_search_dir(mut self, dir: impl Into<PathBuf>) -> FileResolver {
-        self.search_path.push(dir.into());
-        self
-    }
-}
-
-impl IncludeResolver for FileResolver {
-    fn key(&self, file: &str) -> String {
-        std::fs::canonicalize(file).map_or_else(|_| file.to_string(), |p| p.to_string_lossy().into_owned())
-    }
-
-    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, String> {
-        let base = Path::new(from).parent().unwrap_or(Path::new(""));
-        let written = Path::new(name);
-        let mut candidates = vec![base.join(written)];
-        if written.is_relative() {
-            candidates.extend(self.search_path.iter().map(|d| d.join(written)));
-        }
-        for path in &candidates {
-            if !path.is_file() {
-                continue;
-            }
-            let text = crate::limits::read_source(path).map_err(|e| format!("cannot read include file '{}': {e}", path.display()))?;
-            let key = std::fs::canonicalize(path).unwrap_or_else(|_| normalize(path));
-            return Ok(IncludedFile {
-                key: key.to_string_lossy().into_owned(),
-                name: normalize(path).to_string_lossy().into_owned(),
-                text,
-            });
-        }
-        let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
-        Err(format!("cannot find include file '{name}' (looked for {})", looked.join(", ")))
-    }
-}
-
 /// Include files held in memory: a map from path to text. Names are looked
 /// up relative to the including file's directory first, then as written.
 #[derive(Clone, Debug, Default)]
@@ -140,7 +95,7 @@ impl IncludeResolver for NoIncludes {
 }
 
 /// Removes `.` and resolves `..` textually.
-fn normalize(path: &Path) -> PathBuf {
+pub fn normalize(path: &Path) -> PathBuf {
     let mut out = PathBuf::new();
     for c in path.components() {
         match c {

@@ -8,12 +8,16 @@
 //! assembler also checks that the module has every instruction, parameter,
 //! motor, bank, port, coordinate and interrupt the program uses.
 //!
+//! The assembler reads no files: it takes source text, and `#include`s go
+//! through an [`IncludeResolver`] ([`MemoryResolver`] for text held in
+//! memory; files on disk are read by `tmclsim_server::sources`).
+//!
 //! The source files, by stage:
 //! - `lexer.rs`: comments out, lines into tokens;
 //! - `expr.rs`: integer expressions and their parser;
 //! - `parser.rs`: a line into labels and a body (instruction, constant,
 //!   raw word, include);
-//! - `include.rs`: finding `#include`d files;
+//! - `include.rs`: finding `#include`d files (the resolver trait);
 //! - `eval.rs`: labels, constants and the values of expressions;
 //! - `encoder.rs`: an instruction line into seven bytes;
 //! - `check.rs`: checks against a module profile;
@@ -40,12 +44,11 @@ pub mod source_map;
 pub mod symbol_file;
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
 pub use assembler::assemble;
 pub use diagnostic::{Diagnostic, render};
 pub use disasm::disassemble;
-pub use include::{FileResolver, IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
+pub use include::{IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
 pub use source_map::{LinePlace, SourceLine};
 pub use tmclsim_profile::Profile;
 pub use tmclsim_protocol::Instruction;
@@ -95,13 +98,4 @@ impl Program {
     pub fn disassemble(&self) -> String {
         disassemble(&self.instructions, Some(&self.symbols))
     }
-}
-
-/// Assembles a file from disk. Includes are found relative to the
-/// including file, then among the shipped include files.
-pub fn assemble_file(path: impl AsRef<Path>, profile: Option<&Profile>) -> Result<Program, Vec<Diagnostic>> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let text = limits::read_source(path).map_err(|e| vec![Diagnostic::new(name.clone(), 0, 0, format!("cannot read the file: {e}"))])?;
-    assemble(&text, &name, &FileResolver::new(), profile)
 }

@@ -1,11 +1,9 @@
 //! The assembler's limits: how much source it reads and how many errors it
 //! reports (docs/robustness.md lists them with what a user sees).
 
-use std::io::Read;
-use std::path::Path;
-
 /// Bytes of one source file (a module's whole program memory in source
-/// with comments is a few hundred KiB at most).
+/// with comments is a few hundred KiB at most), for whoever reads source
+/// files (`tmclsim_server::sources::read_source`).
 pub const MAX_SOURCE_BYTES: u64 = 2 << 20;
 /// Bytes of all the source one assembly reads, includes counted.
 pub const MAX_TOTAL_SOURCE_BYTES: usize = 4 << 20;
@@ -16,15 +14,3 @@ pub const MAX_LINE_BYTES: usize = 4096;
 pub const MAX_STATEMENTS: usize = 100_000;
 /// Errors reported by one assembly; the rest are counted in a last line.
 pub const MAX_ERRORS: usize = 100;
-
-/// Reads a source file, at most [`MAX_SOURCE_BYTES`]; the error is a
-/// message for the user.
-pub fn read_source(path: &Path) -> Result<String, String> {
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let mut bytes = Vec::new();
-    file.take(MAX_SOURCE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
-    if bytes.len() as u64 > MAX_SOURCE_BYTES {
-        return Err(format!("larger than {} MiB, the limit for a source file", MAX_SOURCE_BYTES >> 20));
-    }
-    Ok(String::from_utf8_lossy(&bytes).into_owned())
-}

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{asm_1141, errors, tmcm_1141};
-use tmclsim_asm::{MemoryResolver, assemble, assemble_file};
+use tmclsim_asm::{MemoryResolver, assemble};
 
 fn one(source: &str, profile: bool) -> String {
     let e = errors(source, profile);
@@ -211,13 +211,6 @@ fn diagnostics_of_included_files_name_them() {
     let files = MemoryResolver::new().with("lib/motion.inc", "Speed = 100\n  JA Nowhere\n");
     let e = assemble("#include lib/motion.inc\n", "main.tmc", &files, Some(&tmcm_1141())).unwrap_err();
     assert_eq!(e[0].to_string(), "lib/motion.inc:2:6: error: unknown label 'Nowhere'");
-}
-
-#[test]
-fn unreadable_file() {
-    let e = assemble_file("/nonexistent/prog.tmc", None).unwrap_err();
-    assert_eq!(e.len(), 1);
-    assert!(e[0].to_string().starts_with("/nonexistent/prog.tmc: error: cannot read the file:"), "{}", e[0]);
 }
 
 #[test]

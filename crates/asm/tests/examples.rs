@@ -4,8 +4,8 @@
 
 mod common;
 
-use common::{asm, errors, example_programs, tmcm_1141};
-use tmclsim_asm::{MemoryResolver, NoIncludes, assemble, assemble_file, render};
+use common::{asm, assemble_path, errors, example_programs, tmcm_1141};
+use tmclsim_asm::{MemoryResolver, NoIncludes, assemble, render};
 
 #[test]
 fn every_manual_example_assembles_for_the_tmcm_1141() {
@@ -13,14 +13,14 @@ fn every_manual_example_assembles_for_the_tmcm_1141() {
     let files = example_programs();
     assert!(files.len() >= 16, "{files:?}");
     for path in files {
-        let program = assemble_file(&path, Some(&profile)).unwrap_or_else(|d| panic!("{}:\n{}", path.display(), render(&d)));
+        let program = assemble_path(&path, Some(&profile)).unwrap_or_else(|d| panic!("{}:\n{}", path.display(), render(&d)));
         assert!(!program.instructions.is_empty(), "{}", path.display());
     }
 }
 
 #[test]
 fn first_steps_program_binary_checked_by_hand() {
-    let program = assemble_file(common::programs_dir().join("first_steps_2_4.tmc"), Some(&tmcm_1141())).unwrap();
+    let program = assemble_path(common::programs_dir().join("first_steps_2_4.tmc"), Some(&tmcm_1141())).unwrap();
     let bin = program.to_binary();
     assert_eq!(bin.len(), 13 * 8);
     let words: Vec<&[u8]> = bin.chunks(8).collect();
@@ -59,7 +59,7 @@ fn first_steps_program_binary_checked_by_hand() {
 fn every_example_round_trips_through_the_disassembler() {
     let profile = tmcm_1141();
     for path in example_programs() {
-        let program = assemble_file(&path, Some(&profile)).unwrap();
+        let program = assemble_path(&path, Some(&profile)).unwrap();
         for symbols in [Some(&program.symbols), None] {
             let text = tmclsim_asm::disassemble(&program.instructions, symbols);
             let again = assemble(&text, "disassembled.tmc", &NoIncludes, Some(&profile))
@@ -74,7 +74,7 @@ fn every_example_round_trips_through_the_disassembler() {
 
 #[test]
 fn disassembly_is_readable() {
-    let program = assemble_file(common::programs_dir().join("call_3_7_44.tmc"), Some(&tmcm_1141())).unwrap();
+    let program = assemble_path(common::programs_dir().join("call_3_7_44.tmc"), Some(&tmcm_1141())).unwrap();
     let text = program.disassemble();
     assert!(text.starts_with("// TMCL program disassembled by tmclsim-asm: 16 instruction(s)."), "{text}");
     for line in ["Loop:", "    CALL LT, RunLeft", "    CALL ZE, MotorStop", "    CALC SUB, 512", "RunRight:", "    JC ZE, MotorIsStopped"] {
@@ -86,7 +86,7 @@ fn disassembly_is_readable() {
 
 #[test]
 fn symbolic_constants_example_uses_the_shipped_parameters() {
-    let program = assemble_file(common::programs_dir().join("symbolic_constants_8_3.tmc"), Some(&tmcm_1141())).unwrap();
+    let program = assemble_path(common::programs_dir().join("symbolic_constants_8_3.tmc"), Some(&tmcm_1141())).unwrap();
     assert_eq!(program.constants["MaxSpeed"], 2047);
     assert_eq!(program.constants["AP_MaxPositioningSpeed"], 4);
     assert_eq!(program.constants["Motor0"], 0);
@@ -97,7 +97,7 @@ fn symbolic_constants_example_uses_the_shipped_parameters() {
 
 #[test]
 fn routines_example_symbol_file_gives_the_entry_addresses() {
-    let program = assemble_file(common::programs_dir().join("routines_8_6.tmc"), None).unwrap();
+    let program = assemble_path(common::programs_dir().join("routines_8_6.tmc"), None).unwrap();
     let symbols = program.symbol_file();
     assert!(symbols.starts_with("Func1 0\nFunc2 1\nFunc3 2\nFunc1Start 3\n"), "{symbols}");
     assert_eq!(tmclsim_asm::Program::parse_symbol_file(&symbols).unwrap(), program.symbols);
@@ -107,8 +107,8 @@ fn routines_example_symbol_file_gives_the_entry_addresses() {
 fn interrupt_example_with_include_equals_the_numeric_one() {
     let dir = common::programs_dir();
     let p = tmcm_1141();
-    let numeric = assemble_file(dir.join("timer_interrupt_3_6_6.tmc"), Some(&p)).unwrap();
-    let symbolic = assemble_file(dir.join("timer_interrupt_include_3_6_6.tmc"), Some(&p)).unwrap();
+    let numeric = assemble_path(dir.join("timer_interrupt_3_6_6.tmc"), Some(&p)).unwrap();
+    let symbolic = assemble_path(dir.join("timer_interrupt_include_3_6_6.tmc"), Some(&p)).unwrap();
     assert_eq!(numeric.to_binary(), symbolic.to_binary());
     assert_eq!(symbolic.constants["TI_GLOBAL"], 255);
 }

@@ -1,59 +1,17 @@
-//! `#include`: files on disk relative to the including file, the shipped
-//! include files, include-once, cycles.
+//! `#include`: the shipped include files, include-once. Files on disk
+//! relative to the including file and cycles through them are read by the
+//! server's file resolver and tested there (crates/server/tests/sources.rs).
 
 mod common;
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
-use common::tmcm_1141;
-use tmclsim_asm::{MemoryResolver, assemble, assemble_file, render};
-
-fn includes_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/includes")
-}
+use common::{assemble_path, tmcm_1141};
+use tmclsim_asm::{MemoryResolver, assemble, render};
 
 fn shipped(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../include").join(name)
-}
-
-#[test]
-fn relative_includes_on_disk_and_include_once() {
-    let program = assemble_file(includes_dir().join("main.tmc"), Some(&tmcm_1141())).unwrap_or_else(|d| panic!("{}", render(&d)));
-    assert_eq!(program.symbols["MoveHome"], 1);
-    assert_eq!(program.symbols["Start"], 4);
-    assert_eq!(program.constants["Home"], 0);
-    assert_eq!(program.constants["TI_GLOBAL"], 255);
-    assert_eq!(program.instructions.len(), 8);
-    assert_eq!(program.instructions[0], tmclsim_asm::Instruction::new(22, 0, 0, 4));
-    assert_eq!(program.instructions[4], tmclsim_asm::Instruction::new(5, 4, 0, 1000));
-}
-
-#[test]
-fn include_cycle_on_disk() {
-    let e = assemble_file(includes_dir().join("cycle_main.tmc"), None).unwrap_err();
-    assert_eq!(e.len(), 1, "{}", render(&e));
-    assert!(e[0].file.ends_with("cycle_b.inc"), "{}", e[0]);
-    assert_eq!((e[0].line, e[0].column), (2, 10));
-    assert!(e[0].message.starts_with("include cycle: "), "{}", e[0]);
-    assert!(e[0].message.ends_with("cycle_a.inc"), "{}", e[0]);
-    let e = assemble_file(includes_dir().join("self.tmc"), None).unwrap_err();
-    assert_eq!(e.len(), 1, "{}", render(&e));
-    assert_eq!((e[0].line, e[0].column), (2, 10));
-    assert!(e[0].message.ends_with("self.tmc' includes itself"), "{}", e[0]);
-}
-
-#[test]
-fn include_not_found_on_disk_names_where_it_looked() {
-    let dir = std::env::temp_dir().join(format!("tmclsim-asm-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("prog.tmc");
-    std::fs::write(&file, "STOP\n#include \"missing.inc\"\n").unwrap();
-    let e = assemble_file(&file, None).unwrap_err();
-    std::fs::remove_dir_all(&dir).unwrap();
-    assert_eq!(e.len(), 1);
-    assert_eq!((e[0].line, e[0].column), (2, 11));
-    assert!(e[0].message.starts_with("cannot find include file 'missing.inc' (looked for "), "{}", e[0]);
 }
 
 #[test]
@@ -67,13 +25,13 @@ fn a_file_included_twice_is_read_once() {
 #[test]
 fn shipped_include_files_assemble_and_match_the_profile() {
     let profile = tmcm_1141();
-    let interrupts = assemble_file(shipped("Interrupts.inc"), Some(&profile)).unwrap_or_else(|d| panic!("{}", render(&d)));
+    let interrupts = assemble_path(shipped("Interrupts.inc"), Some(&profile)).unwrap_or_else(|d| panic!("{}", render(&d)));
     assert!(interrupts.instructions.is_empty());
     let expected: BTreeSet<(String, i64)> = profile.interrupts.iter().map(|i| (i.symbol.clone(), i.number as i64)).collect();
     let found: BTreeSet<(String, i64)> = interrupts.constants.clone().into_iter().collect();
     assert_eq!(found, expected);
 
-    let parameters = assemble_file(shipped("Parameters.inc"), Some(&profile)).unwrap_or_else(|d| panic!("{}", render(&d)));
+    let parameters = assemble_path(shipped("Parameters.inc"), Some(&profile)).unwrap_or_else(|d| panic!("{}", render(&d)));
     assert!(parameters.instructions.is_empty());
     let with_prefix = |prefix: &str| -> Vec<i64> {
         let mut v: Vec<i64> = parameters.constants.iter().filter(|(n, _)| n.starts_with(prefix)).map(|(_, &v)| v).collect();

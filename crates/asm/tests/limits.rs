@@ -1,8 +1,10 @@
-//! The assembler's limits: long lines, huge or endless files and floods of
-//! errors get a clear answer in bounded memory (docs/robustness.md).
+//! The assembler's limits: long lines, huge sources and floods of errors
+//! get a clear answer in bounded memory (docs/robustness.md). Endless
+//! source files are refused where files are read
+//! (crates/server/tests/sources.rs).
 
 use tmclsim_asm::limits::{MAX_ERRORS, MAX_LINE_BYTES, MAX_TOTAL_SOURCE_BYTES};
-use tmclsim_asm::{MemoryResolver, NoIncludes, assemble, assemble_file};
+use tmclsim_asm::{MemoryResolver, NoIncludes, assemble};
 
 #[test]
 fn a_line_past_the_limit_is_an_error_and_the_rest_is_still_checked() {
@@ -39,13 +41,6 @@ fn the_kept_errors_are_the_earliest_even_when_found_late() {
     assert_eq!(d[0].line, 1, "{}", d[0]);
     assert!(d[0].message.contains("Nowhere"), "{}", d[0]);
     assert_eq!(d[MAX_ERRORS - 1].line, MAX_ERRORS);
-}
-
-#[test]
-fn an_endless_source_file_is_refused_unread() {
-    let d = assemble_file("/dev/zero", None).unwrap_err();
-    assert_eq!(d.len(), 1);
-    assert_eq!(d[0].to_string(), "/dev/zero: error: cannot read the file: larger than 2 MiB, the limit for a source file");
 }
 
 #[test]

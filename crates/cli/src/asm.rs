@@ -2,8 +2,9 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use tmclsim_asm::{Program, assemble_file, disassemble, render};
+use tmclsim_asm::{Program, disassemble, render};
 use tmclsim_firmware::Profile;
+use tmclsim_server::sources::assemble_file;
 
 #[derive(clap::Args)]
 pub struct AsmArgs {
@@ -76,7 +77,7 @@ pub fn asm(args: AsmArgs) -> Result<ExitCode, String> {
 }
 
 pub fn disasm(args: DisasmArgs) -> Result<ExitCode, String> {
-    use tmclsim_firmware::files::{MAX_BINARY_BYTES, MAX_CONFIG_BYTES, read_limited, read_text_limited};
+    use tmclsim_server::files::{MAX_BINARY_BYTES, MAX_CONFIG_BYTES, read_limited, read_text_limited};
     let bytes = read_limited(&args.binary, MAX_BINARY_BYTES, "a program binary")?;
     let words = Program::from_binary(&bytes).map_err(|e| format!("{}: {e}", args.binary.display()))?;
     let sym_path = args.symbols.clone().unwrap_or_else(|| args.binary.with_extension("sym"));

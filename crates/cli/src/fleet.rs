@@ -71,7 +71,7 @@ pub const MAX_MODULES: usize = 10_000;
 
 /// Reads a fleet file and expands counts and buses.
 pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
-    use tmclsim_firmware::files::{MAX_CONFIG_BYTES, read_text_limited};
+    use tmclsim_server::files::{MAX_CONFIG_BYTES, read_text_limited};
     let text = read_text_limited(path, MAX_CONFIG_BYTES, "a fleet file")?;
     let f: FleetFile = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut out = Vec::new();
@@ -144,7 +144,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
                     pr
                 }
             };
-            let world = tmclsim_firmware::World::named(&l.world, profile.module.axes as usize)?;
+            let world = tmclsim_server::files::world_named(&l.world, profile.module.axes as usize)?;
             let mut m = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), world);
             m.set_address(*a);
             modules.push((m, None));

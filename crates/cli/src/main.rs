@@ -277,7 +277,7 @@ fn profile(name: &str) -> Result<ExitCode, String> {
 
 /// The world named on the command line: `stage`, `free` or a file.
 pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::World, String> {
-    tmclsim_firmware::World::named(name, axes).map_err(|e| format!("--world {e}"))
+    tmclsim_server::files::world_named(name, axes).map_err(|e| format!("--world {e}"))
 }
 
 /// `HOST:PORT` with a host name or an IP address (IPv4 first when a name

@@ -66,7 +66,7 @@ pub struct RunArgs {
 /// Gives the module the commands of a setup file; a command the module
 /// refuses is an error naming its line.
 pub(crate) fn setup(module: &mut Module, path: &std::path::Path) -> Result<(), String> {
-    use tmclsim_firmware::files::{MAX_CONFIG_BYTES, read_text_limited};
+    use tmclsim_server::files::{MAX_CONFIG_BYTES, read_text_limited};
     let text = read_text_limited(path, MAX_CONFIG_BYTES, "a setup file")?;
     let profile = module.profile().clone();
     for (n, raw) in text.lines().enumerate() {

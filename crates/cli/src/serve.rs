@@ -3,9 +3,9 @@
 use crate::ServeArgs;
 use std::process::ExitCode;
 use std::sync::Arc;
-use tmclsim_firmware::eeprom::EepromFile;
 use tmclsim_firmware::{Eeprom, Module, Profile};
 use tmclsim_server::ServerConfig;
+use tmclsim_server::eeprom_file::EepromFile;
 
 /// `PROFILE@ADDRESS,…` → modules on one link, in the world given.
 fn bus(spec: &str, world: &str) -> Result<Vec<Module>, String> {

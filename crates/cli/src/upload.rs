@@ -29,7 +29,7 @@ pub struct UploadArgs {
 
 pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
     let words: Vec<Instruction> = if args.program.extension().is_some_and(|e| e == "bin") {
-        use tmclsim_firmware::files::{MAX_BINARY_BYTES, read_limited};
+        use tmclsim_server::files::{MAX_BINARY_BYTES, read_limited};
         let bytes = read_limited(&args.program, MAX_BINARY_BYTES, "a program binary")?;
         Program::from_binary(&bytes)?
     } else {

@@ -11,8 +11,8 @@ use common::ask;
 use std::net::TcpStream;
 use std::process::{Child, Stdio};
 use std::time::Duration;
-use tmclsim_firmware::Eeprom;
 use tmclsim_protocol::Instruction;
+use tmclsim_server::eeprom_file;
 
 fn spawn(eeprom: &std::path::Path) -> (Child, String) {
     common::serve(&["--eeprom", eeprom.to_str().unwrap()], Stdio::null())
@@ -116,7 +116,7 @@ fn killed_during_store_and_download_storms_leaves_old_or_new_values() {
             }
         }
         killer.join().unwrap();
-        let image = Eeprom::load(&path).unwrap_or_else(|e| panic!("round {round}: {e}")).expect("file exists");
+        let image = eeprom_file::load(&path).unwrap_or_else(|e| panic!("round {round}: {e}")).expect("file exists");
         cells.axis.settle(image.axis(0, 4), "AP 4", round);
         cells.global.settle(image.global(2, 10), "GP 10", round);
         for (w, cell) in cells.word.iter_mut().enumerate() {

@@ -16,6 +16,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::Eeprom;
+use tmclsim_server::eeprom_file;
 
 /// A served module keeping its EEPROM in `eeprom`, its stderr collected.
 fn start(eeprom: &Path) -> Server {
@@ -78,7 +79,7 @@ fn a_second_server_on_the_same_file_is_refused_naming_it() {
     // The first server was not disturbed: it serves, its file holds its write.
     assert_eq!(ask(&mut s, "SAP 5, 0, 700").unwrap().status, 100);
     assert_eq!(ask(&mut s, "STAP 5, 0").unwrap().status, 100);
-    let image = Eeprom::load(&path).unwrap().unwrap();
+    let image = eeprom_file::load(&path).unwrap().unwrap();
     assert_eq!((image.axis(0, 4), image.axis(0, 5)), (Some(1500), Some(700)));
     drop(s);
     drop(first);
@@ -125,7 +126,7 @@ fn a_write_the_file_cannot_take_is_answered_with_status_5_and_serving_goes_on() 
     assert_eq!(ask(&mut s, "SAP 4, 0, 2000").unwrap().status, 100);
     assert_eq!(ask(&mut s, "SAP 5, 0, 300").unwrap().status, 100);
     assert_eq!(ask(&mut s, "STAP 5, 0").unwrap().status, 100);
-    let image = Eeprom::load(&path).unwrap().unwrap();
+    let image = eeprom_file::load(&path).unwrap().unwrap();
     assert_eq!((image.axis(0, 4), image.axis(0, 5)), (Some(1000), Some(300)));
     // A reset powers up from the same EEPROM.
     assert_eq!(ask(&mut s, "#255 0 0 1234").unwrap().status, 100);
@@ -168,7 +169,7 @@ fn a_read_only_file_is_served_and_never_replaced() {
     let path = dir.path().join("m.eeprom");
     let mut image = Eeprom::new("TMCM-1141");
     image.set_axis(0, 4, 1500);
-    tmclsim_firmware::eeprom::save_atomic(&path, &image).unwrap();
+    eeprom_file::save_atomic(&path, &image).unwrap();
     std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o444)).unwrap();
     let before = (std::fs::read(&path).unwrap(), std::fs::metadata(&path).unwrap().ino());
 
@@ -199,7 +200,7 @@ fn a_read_only_file_is_served_and_never_replaced() {
     std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o644)).unwrap();
     assert_eq!(ask(&mut s, "SAP 4, 0, 1800").unwrap().status, 100);
     assert_eq!(ask(&mut s, "STAP 4, 0").unwrap().status, 100);
-    assert_eq!(Eeprom::load(&path).unwrap().unwrap().axis(0, 4), Some(1800));
+    assert_eq!(eeprom_file::load(&path).unwrap().unwrap().axis(0, 4), Some(1800));
 }
 
 /// The user a test runs a server as to meet permission errors: root may
@@ -229,7 +230,7 @@ fn a_file_that_cannot_be_read_is_reported_with_the_error_of_the_system() {
     let read_only = dir.path().join("read-only");
     for d in [&closed, &read_only] {
         std::fs::create_dir(d).unwrap();
-        tmclsim_firmware::eeprom::save_atomic(&d.join("m.eeprom"), &Eeprom::new("TMCM-1141")).unwrap();
+        eeprom_file::save_atomic(&d.join("m.eeprom"), &Eeprom::new("TMCM-1141")).unwrap();
         std::fs::set_permissions(d.join("m.eeprom"), std::fs::Permissions::from_mode(0o644)).unwrap();
     }
     std::fs::set_permissions(&closed, std::fs::Permissions::from_mode(0o000)).unwrap();
@@ -255,5 +256,5 @@ fn a_file_that_cannot_be_read_is_reported_with_the_error_of_the_system() {
     for d in [&closed, &read_only] {
         std::fs::set_permissions(d, std::fs::Permissions::from_mode(0o755)).unwrap();
     }
-    assert_eq!(Eeprom::load(&path).unwrap(), Some(Eeprom::new("TMCM-1141")), "nothing was written");
+    assert_eq!(eeprom_file::load(&path).unwrap(), Some(Eeprom::new("TMCM-1141")), "nothing was written");
 }

@@ -1,5 +1,10 @@
 //! How virtual time relates to the wall clock: an explicit value, held by
 //! the [`Bus`](crate::bus::Bus).
+//!
+//! The wall clock is `std::time::Instant`, the one thing of the system the
+//! firmware uses. On `wasm32-unknown-unknown` it compiles but panics when
+//! read ([`Clock::wall_from`], and [`Clock::now_ns`] of a wall clock): there
+//! only a stepped clock runs.
 
 use std::time::{Duration, Instant};
 

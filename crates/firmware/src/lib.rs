@@ -15,7 +15,6 @@ pub mod driver;
 pub mod eeprom;
 pub mod eeprom_rules;
 pub mod executor;
-pub mod files;
 mod frames;
 mod interpreter;
 pub mod link_id;

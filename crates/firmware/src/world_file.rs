@@ -72,18 +72,14 @@ struct AxisFile {
 }
 
 impl World {
-    /// The world a front end names: `stage` (the built-in linear stage),
-    /// `free` (no switches, no end stops), TOML text (anything with a line
-    /// break) or the path of a TOML file.
-    pub fn named(spec: &str, axes: usize) -> Result<World, String> {
-        match spec {
-            "stage" => Ok(World::stage(axes)),
-            "free" => Ok(World::free(axes)),
-            text if text.contains('\n') => World::from_toml(text, axes),
-            path if !std::path::Path::new(path).exists() => {
-                Err(format!("{path}: no such world file; the built-in worlds are stage (the default) and free"))
-            }
-            path => World::load_file(std::path::Path::new(path), axes),
+    /// A built-in world by name: `stage` (the built-in linear stage) or
+    /// `free` (no switches, no end stops). World files are read by the
+    /// front ends (`tmclsim_server::files::world_named`).
+    pub fn built_in(name: &str, axes: usize) -> Option<World> {
+        match name {
+            "stage" => Some(World::stage(axes)),
+            "free" => Some(World::free(axes)),
+            _ => None,
         }
     }
 
@@ -162,11 +158,6 @@ impl World {
         // Every value by the one rule set (docs/behaviour.md rule 84).
         w.validate()?;
         Ok(w)
-    }
-
-    pub fn load_file(path: &std::path::Path, axes: usize) -> Result<World, String> {
-        let text = crate::files::read_text_limited(path, crate::files::MAX_CONFIG_BYTES, "a world file")?;
-        World::from_toml(&text, axes).map_err(|e| format!("{}: {e}", path.display()))
     }
 }
 

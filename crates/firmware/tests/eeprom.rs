@@ -1,5 +1,6 @@
 //! EEPROM behaviour across power cycles: STAP/RSAP, STGP/RSGP, auto-stored
-//! bank 0, user variables and GP 85, and persistence through the file.
+//! bank 0, user variables and GP 85, and the check of every image a module
+//! stores (the EEPROM file is the server's: crates/server/tests/eeprom_file.rs).
 
 mod common;
 
@@ -69,25 +70,6 @@ fn restart_keeps_the_carriage_where_it_is() {
     send(&mut m, "MVP ABS, 0, 500");
     m.advance(5_000_000_000);
     assert_eq!(send(&mut m, "GAP 1, 0"), 200, "but the switch is still 200 steps away");
-}
-
-#[test]
-fn eeprom_file_round_trip_and_atomic_writes() {
-    let dir = std::env::temp_dir().join(format!("tmclsim-ee-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("1141.eeprom");
-    let profile = Profile::built_in("tmcm-1141").unwrap();
-    let mut m = Module::new(profile.clone());
-    send(&mut m, "SAP 4, 0, 321");
-    send(&mut m, "STAP 4, 0");
-    tmclsim_firmware::eeprom::save_atomic(&path, m.eeprom()).unwrap();
-    let image = Eeprom::load(&path).unwrap().unwrap();
-    let mut m = Module::with_eeprom(profile, image);
-    assert_eq!(send(&mut m, "GAP 4, 0"), 321);
-    // No temporary files are left behind.
-    let names: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
-    assert_eq!(names.len(), 1, "{names:?}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `execute` a command, whatever the module's address; its status.
@@ -176,25 +158,4 @@ fn an_image_from_rust_with_values_out_of_range_powers_up_with_the_defaults() {
     send(&mut m, "SAP 4, 0, 99");
     send(&mut m, "RSAP 4, 0");
     assert_eq!(send(&mut m, "GAP 4, 0"), profile.axis_parameter(4).unwrap().default as i32, "RSAP does not take it either");
-}
-
-#[test]
-fn a_file_with_a_value_out_of_range_is_refused_naming_it() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("m.eeprom");
-    let profile = Profile::built_in("tmcm-1141").unwrap();
-    let mut image = Eeprom::new("TMCM-1141");
-    image.set_global(0, 75, i32::MAX);
-    tmclsim_firmware::eeprom::save_atomic(&path, &image).unwrap();
-    let e = tmclsim_firmware::eeprom::load_for(&path, &profile).unwrap_err();
-    assert!(matches!(e, tmclsim_firmware::eeprom::LoadError::Refused(_)), "{e:?}");
-    assert_eq!(
-        e.to_string(),
-        format!(
-            "{}: refused: an entry a TMCM-1141 never stores, so the file was edited or damaged: global \"0/75\" = 2147483647: \
-             GP 75 (Telegram pause time) of bank 0 takes 0…255; correct or remove it (or remove the file to start from factory \
-             defaults)",
-            path.display()
-        )
-    );
 }

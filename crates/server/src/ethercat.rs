@@ -2,12 +2,13 @@
 //! EtherType 0x88A4 go through the slaves of a segment and back out of
 //! the same interface, as from the last slave of a line.
 
+use crate::eeprom_file::EepromFile;
 use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::sync::{Arc, Mutex};
 use tmclsim_ethercat::Segment;
-use tmclsim_firmware::eeprom::{Eeprom, EepromFile};
+use tmclsim_firmware::Eeprom;
 
 const ETH_P_ALL: u16 = 0x0003;
 const PACKET_OUTGOING: u8 = 4;

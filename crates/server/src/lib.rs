@@ -6,29 +6,38 @@
 //! on the same link. Virtual time is paced by the wall clock; a clock task
 //! wakes only when the module has something to do on its own (a 138 event,
 //! a heartbeat stop), so an idle server uses no CPU.
+//!
+//! The files tmclsim reads and writes are here too, since the firmware
+//! and the assembler do no I/O: the crash-safe EEPROM file
+//! ([`eeprom_file`]), world, fleet and symbol files and program binaries
+//! with their size limits ([`files`]), and TMCL source files with their
+//! includes ([`sources`]).
 
 mod clock;
 pub mod control;
+pub mod eeprom_file;
 pub mod ethercat;
 mod faults;
+pub mod files;
 pub mod frame_log;
 mod link;
 mod pty;
 mod shared;
 mod slcan;
 mod slots;
+pub mod sources;
 mod tcp;
 
 pub use faults::LinkFaults;
 pub use shared::{SharedBus, Stats};
 pub use slots::ACCEPT_BACKOFF;
 
+use eeprom_file::EepromFile;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_firmware::Module;
-use tmclsim_firmware::eeprom::EepromFile;
 use tokio::sync::watch;
 
 /// What to serve and where.

@@ -3,11 +3,11 @@
 //! behind a lock, plus what only a server has — EEPROM files, the link
 //! that receives events, link faults and counters.
 
+use crate::eeprom_file::EepromFile;
 use crate::faults::LinkFaults;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::can::CanFrame;
-use tmclsim_firmware::eeprom::EepromFile;
 use tmclsim_firmware::world_command::WorldCommand;
 use tmclsim_firmware::{Bus, Eeprom, Module};
 use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Status};
@@ -481,7 +481,7 @@ mod tests {
         std::fs::rename(&away, &store).unwrap();
         assert_eq!(ask(&bus, opcode::SAP, 5, 300), (100, opcode::SAP));
         assert_eq!(ask(&bus, opcode::STAP, 5, 0), (100, opcode::STAP));
-        let image = Eeprom::load(&path).unwrap().unwrap();
+        let image = crate::eeprom_file::load(&path).unwrap().unwrap();
         assert_eq!((image.axis(0, 4), image.axis(0, 5)), (Some(1000), Some(300)));
         assert!(image.program.is_empty());
     }

@@ -126,14 +126,14 @@ fn eeprom_file_is_written_on_store() {
     let dir = std::env::temp_dir().join(format!("tmclsim-srv-ee-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("m.eeprom");
-    let file = std::sync::Arc::new(tmclsim_firmware::eeprom::EepromFile::open(&path).unwrap());
+    let file = std::sync::Arc::new(tmclsim_server::eeprom_file::EepromFile::open(&path).unwrap());
     let config = ServerConfig { tcp: Some("127.0.0.1:0".parse().unwrap()), eeprom: Some(file), ..ServerConfig::default() };
     let server = start(Module::built_in("tmcm-1141").unwrap(), config).unwrap();
     let mut s = connect(&server);
     ask(&mut s, "SAP 4, 0, 1999");
     ask(&mut s, "STAP 4, 0");
     // The file is written before the reply is sent.
-    let image = tmclsim_firmware::Eeprom::load(&path).unwrap().unwrap();
+    let image = tmclsim_server::eeprom_file::load(&path).unwrap().unwrap();
     assert_eq!(image.axis(0, 4), Some(1999));
     server.stop();
     std::fs::remove_dir_all(&dir).unwrap();

@@ -1,10 +1,10 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use tmclsim_asm::{MemoryResolver, Profile, Program, assemble};
+use tmclsim_asm::{Diagnostic, MemoryResolver, NoIncludes, Profile, Program, assemble};
 use tmclsim_firmware::Module;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
@@ -29,6 +29,16 @@ pub fn example_programs() -> Vec<PathBuf> {
         .collect();
     files.sort();
     files
+}
+
+/// Assembles a source file of the tests, named by its path. The test reads
+/// it (the assembler reads no files); its includes are the shipped ones.
+/// Includes from disk are tested with the file resolver, in the server's
+/// tests (crates/server/tests/sources.rs).
+pub fn assemble_path(path: impl AsRef<Path>, profile: Option<&Profile>) -> Result<Program, Vec<Diagnostic>> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assemble(&text, &path.display().to_string(), &NoIncludes, profile)
 }
 
 /// Assembles a source text without includes; panics with the diagnostics.
