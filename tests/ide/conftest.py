@@ -17,7 +17,14 @@ from tmclsim_binary import ROOT, stop, tmclsim_binary  # noqa: E402
 CHROMIUM = os.environ.get("TMCLSIM_CHROMIUM", "/usr/bin/chromium")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
-SHOTS = ROOT / "docs" / "ide"
+# The screenshots the tests take go outside the source tree (into
+# TMCLSIM_SCREENSHOTS, or target/ide-screenshots); with
+# TMCLSIM_REFRESH_SCREENSHOTS=1 they replace the tracked ones docs/ide.md shows.
+if os.environ.get("TMCLSIM_REFRESH_SCREENSHOTS") == "1":
+    SHOTS = ROOT / "docs" / "ide"
+else:
+    SHOTS = pathlib.Path(os.environ.get("TMCLSIM_SCREENSHOTS") or ROOT / "target" / "ide-screenshots").resolve()
+TAKEN = []
 
 
 class Process:
@@ -103,6 +110,13 @@ def tab(page, name):
 
 
 def shot(page, name):
-    """A screenshot for docs/ide.md, taken by the tests so it stays current."""
+    """A screenshot for docs/ide.md, taken by the tests so that it can be
+    refreshed (TMCLSIM_REFRESH_SCREENSHOTS=1) and compared."""
     SHOTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SHOTS / f"{name}.png"))
+    TAKEN.append(name)
+
+
+def pytest_terminal_summary(terminalreporter):
+    if TAKEN:
+        terminalreporter.write_line(f"screenshots: {len(TAKEN)} in {SHOTS}")

@@ -34,3 +34,10 @@ impl LinkArgs {
         Client::open(l.tcp.as_deref(), l.port.as_deref(), l.baud, self.address, timeout)
     }
 }
+
+/// Whether a link's error says the module did not answer (in time, in
+/// full, or with a right checksum): a command that failed, as a refused
+/// one did, not a link that failed.
+pub fn unanswered(error: &str) -> bool {
+    error.starts_with("no reply") || error.starts_with("only ") || error.ends_with("has a wrong checksum")
+}

@@ -1,6 +1,6 @@
 //! `tmclsim`: serve virtual TMCL modules, talk to real or virtual ones.
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, Parser, Subcommand};
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -22,8 +22,29 @@ mod sweep;
 mod trace;
 mod upload;
 
+/// The version `--version` prints: the package's and the git revision the
+/// binary was built from (crates/cli/build.rs).
+const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), " (git ", env!("TMCLSIM_GIT"), ")");
+
+/// Exit statuses, the same for every command (README.md, "Exit status").
+const EXIT_STATUSES: [(&str, &str); 4] = [
+    ("0", "the command did its work and every check passed; a server (serve, ide, trace record) stopped by SIGINT, SIGTERM or SIGHUP"),
+    (
+        "1",
+        "a check failed: a command the module refused or did not answer (send, upload, console scripts), \
+         a world command refused, differences in a recorded session (trace check), failed scenarios (sweep)",
+    ),
+    (
+        "2",
+        "the command could not do its work: a usage error, an input file that cannot be read or is invalid \
+         (program, world, fleet, trace, EEPROM, setup), a link that cannot be opened or fails",
+    ),
+    ("101", "an internal error (a panic): a bug in tmclsim"),
+];
+
 #[derive(Parser)]
-#[command(name = "tmclsim", version, about = "Virtual Trinamic TMCL modules and the open TMCL toolchain")]
+#[command(name = "tmclsim", version = VERSION, about = "Virtual Trinamic TMCL modules and the open TMCL toolchain")]
+#[command(after_long_help = exit_status_help())]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -59,6 +80,24 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Record a host's session with a module through a proxy; check a recorded session against a virtual module.
     Trace(trace::TraceArgs),
+    /// Print a shell's completion script for tmclsim on standard output.
+    Completions(CompletionsArgs),
+    /// Print the manual page of tmclsim (or of one of its commands) as roff on standard output.
+    Man(ManArgs),
+}
+
+#[derive(Args)]
+struct CompletionsArgs {
+    /// The shell, e.g. `tmclsim completions bash > ~/.local/share/bash-completion/completions/tmclsim`.
+    shell: clap_complete::Shell,
+}
+
+#[derive(Args)]
+struct ManArgs {
+    /// A command whose own page to print, e.g. `serve` or `trace check`;
+    /// without it, the page of tmclsim, e.g. `tmclsim man | man -l -`.
+    #[arg(value_name = "COMMAND")]
+    command: Vec<String>,
 }
 
 #[derive(Args)]
@@ -228,6 +267,8 @@ fn main() -> ExitCode {
         Command::World(a) => world(a),
         Command::FleetBench(a) => fleet::bench(a),
         Command::Trace(a) => trace::run(a),
+        Command::Completions(a) => completions(a.shell),
+        Command::Man(a) => man(&a.command),
     };
     match result {
         Ok(code) => code,
@@ -273,6 +314,61 @@ fn profile(name: &str) -> Result<ExitCode, String> {
         rows.into_iter().for_each(row);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The exit statuses as `tmclsim --help` lists them.
+fn exit_status_help() -> String {
+    let mut text = String::from("Exit status:\n");
+    for (code, meaning) in EXIT_STATUSES {
+        text += &format!("  {code:<5}{meaning}\n");
+    }
+    text
+}
+
+fn completions(shell: clap_complete::Shell) -> Result<ExitCode, String> {
+    clap_complete::generate(shell, &mut Cli::command(), "tmclsim", &mut std::io::stdout());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The manual page, made from the same definitions as `--help`.
+fn man(path: &[String]) -> Result<ExitCode, String> {
+    use std::io::Write;
+    let mut cli = Cli::command();
+    // Built, the commands know their full names (`tmclsim-trace-check`).
+    cli.build();
+    let mut page = &cli;
+    for (n, name) in path.iter().enumerate() {
+        page = page.find_subcommand(name).ok_or_else(|| {
+            let names: Vec<&str> = page.get_subcommands().map(|c| c.get_name()).filter(|n| *n != "help").collect();
+            let parent = ["tmclsim".to_string()].into_iter().chain(path[..n].iter().cloned()).collect::<Vec<_>>().join(" ");
+            if names.is_empty() {
+                format!("'{parent}' has no commands")
+            } else {
+                format!("'{parent}' has no command '{name}'; its commands are {}", names.join(", "))
+            }
+        })?;
+    }
+    let title = page.get_display_name().unwrap_or(page.get_name()).to_uppercase();
+    // The --help text after the options is the exit statuses, which the
+    // page has as a section of its own, before VERSION.
+    let page = page.clone().after_long_help(None::<&str>);
+    let mut out = Vec::new();
+    clap_mangen::Man::new(page).title(title).source(format!("tmclsim {VERSION}")).render(&mut out).map_err(|e| e.to_string())?;
+    let mut exit = roff::Roff::new();
+    exit.control("SH", ["EXIT STATUS"]);
+    for (code, meaning) in EXIT_STATUSES {
+        exit.control("TP", []).text([roff::bold(code)]).text([roff::roman(format!("{}.", capitalised(meaning)))]);
+    }
+    let mut out = String::from_utf8(out).map_err(|e| e.to_string())?;
+    let at = out.find("\n.SH VERSION").map_or(out.len(), |i| i + 1);
+    out.insert_str(at, &exit.to_roff());
+    std::io::stdout().write_all(out.as_bytes()).map_err(|e| format!("standard output: {e}"))?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    chars.next().map(|c| c.to_uppercase().chain(chars).collect()).unwrap_or_default()
 }
 
 /// The world named on the command line: `stage`, `free` or a file.

@@ -1,6 +1,7 @@
 //! Progress of long work on a terminal: a bar on standard error that shows
 //! only when standard error is a terminal (quiet in pipes, logs and CI),
-//! and only once the work has taken a second.
+//! and only once the work has taken a second. The bars have no colours
+//! (their templates name none), so NO_COLOR leaves them as they are.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::time::{Duration, Instant};

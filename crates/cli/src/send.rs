@@ -15,7 +15,16 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
         println!("(137 sends no reply)");
         return Ok(ExitCode::SUCCESS);
     }
-    let reply = client.exchange(ins)?;
+    // A module that does not answer failed the command, as one that
+    // answers an error does: exit status 1 (README.md, "Exit status").
+    let reply = match client.exchange(ins) {
+        Ok(reply) => reply,
+        Err(e) if crate::client::unanswered(&e) => {
+            println!("{e}");
+            return Ok(ExitCode::from(1));
+        }
+        Err(e) => return Err(e),
+    };
     println!("reply:   {}", hex(&reply));
     if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
         println!("version: {}", String::from_utf8_lossy(&reply[1..]));

@@ -27,7 +27,33 @@ pub struct UploadArgs {
     pub timeout: u64,
 }
 
+/// Why an upload stopped: the module refused or did not answer a command,
+/// or holds other words than were sent (exit status 1, as `send` when a
+/// command fails), or the upload could not be made at all (the program,
+/// the link: exit status 2).
+enum Stop {
+    Failed(String),
+    Error(String),
+}
+
+impl From<String> for Stop {
+    fn from(e: String) -> Stop {
+        if crate::client::unanswered(&e) { Stop::Failed(e) } else { Stop::Error(e) }
+    }
+}
+
 pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
+    match upload(args) {
+        Ok(()) => Ok(ExitCode::SUCCESS),
+        Err(Stop::Failed(e)) => {
+            eprintln!("tmclsim: {e}");
+            Ok(ExitCode::from(1))
+        }
+        Err(Stop::Error(e)) => Err(e),
+    }
+}
+
+fn upload(args: UploadArgs) -> Result<(), Stop> {
     let words: Vec<Instruction> = if args.program.extension().is_some_and(|e| e == "bin") {
         use tmclsim_server::files::{MAX_BINARY_BYTES, read_limited};
         let bytes = read_limited(&args.program, MAX_BINARY_BYTES, "a program binary")?;
@@ -36,10 +62,10 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
         crate::asm::assemble(&args.program, &args.module)?.0.instructions
     };
     let mut c = args.link.open(crate::millis(args.timeout))?;
-    let ok = |r: tmclsim_protocol::Reply, what: &str| -> Result<(), String> {
+    let ok = |r: tmclsim_protocol::Reply, what: &str| -> Result<(), Stop> {
         if r.status < 100 {
             let s = Status::from_code(r.status).map_or(r.status.to_string(), |s| s.to_string());
-            return Err(format!("{what}: the module answered status {s}"));
+            return Err(Stop::Failed(format!("{what}: the module answered status {s}")));
         }
         Ok(())
     };
@@ -51,7 +77,7 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
         let r = c.request(*w)?;
         if r.status != Status::Loaded.code() {
             let _ = c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
-            return Err(format!("word {a} ({}) was not stored: status {}", tmclsim_protocol::mnemonic::format(*w), r.status));
+            return Err(Stop::Failed(format!("word {a} ({}) was not stored: status {}", tmclsim_protocol::mnemonic::format(*w), r.status)));
         }
     }
     ok(c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0))?, "exit download mode")?;
@@ -60,16 +86,16 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
         progress.set((words.len() + a) as u64);
         let raw = c.exchange(Instruction::new(opcode::READ_MEMORY, 0, 0, a as i32))?;
         if raw[1] == args.link.address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
-            return Err(format!("read-back of word {a}: status {} (code protection?)", raw[2]));
+            return Err(Stop::Failed(format!("read-back of word {a}: status {} (code protection?)", raw[2])));
         }
         let stored = Instruction::from_bytes(raw[1..8].try_into().unwrap());
         if stored != *w {
-            return Err(format!(
+            return Err(Stop::Failed(format!(
                 "word {a} reads back as {} ({}), not {}",
                 tmclsim_protocol::mnemonic::format(stored),
                 hex(&raw),
                 tmclsim_protocol::mnemonic::format(*w)
-            ));
+            )));
         }
     }
     progress.finish();
@@ -82,5 +108,5 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
         ok(c.request(Instruction::new(opcode::RUN_APPLICATION, 1, 0, 0))?, "run")?;
         println!("running");
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }

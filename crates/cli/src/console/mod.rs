@@ -191,7 +191,7 @@ impl Session {
                 }
                 println!("{line}");
             }
-            Err(e) if e.starts_with("no reply") || e.starts_with("only") => {
+            Err(e) if crate::client::unanswered(&e) => {
                 self.failures += 1;
                 println!("{e}");
             }
