@@ -10,7 +10,8 @@
 //! - `world.rs`: the control protocol of docs/world.md on any module;
 //! - `names.rs`: parameters by name;
 //! - `advance.rs`: moving virtual time on (checked durations, Ctrl-C);
-//! - `errors.rs`: raising the package's Python exceptions, panics caught.
+//! - `errors.rs`: raising the package's Python exceptions, panics caught;
+//! - `cli_main`: the `tmclsim` command itself, for the console script.
 //!
 //! The pure-Python part (`tmclsim/__init__.py`) subclasses `Module` and
 //! `Server` to add the world convenience methods and PyTrinamic helpers.
@@ -27,6 +28,18 @@ mod world;
 
 use pyo3::prelude::*;
 
+/// cli_main(argv) -> int
+/// --
+///
+/// Runs the `tmclsim` command with `argv` (the program name first) and
+/// returns its exit status; the package's `tmclsim` console script and
+/// `python -m tmclsim` call it. Usage errors, `--help` and `--version`
+/// end the process, as the command does.
+#[pyfunction]
+fn cli_main(py: Python<'_>, argv: Vec<String>) -> u8 {
+    py.detach(|| tmclsim_cli::run(argv))
+}
+
 #[pymodule]
 fn _tmclsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<module::Module>()?;
@@ -40,6 +53,7 @@ fn _tmclsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(asm::assemble_file, m)?)?;
     m.add_function(wrap_pyfunction!(asm::disassemble, m)?)?;
     m.add_function(wrap_pyfunction!(profiles, m)?)?;
+    m.add_function(wrap_pyfunction!(cli_main, m)?)?;
     m.add_function(wrap_pyfunction!(module::_time_core, m)?)?;
     m.add_function(wrap_pyfunction!(status_text, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_inside_guard, m)?)?;

@@ -12,6 +12,10 @@ _ProgramLike = Union["Program", str, bytes, bytearray, "os.PathLike[str]", Seque
 _Param = Union[int, str]
 _Endpoint = Union[str, _Path, bool, None]
 
+def cli_main(argv: List[str]) -> int:
+    """Runs the `tmclsim` command with `argv` (program name first); its exit status."""
+    ...
+
 def profiles() -> List[str]:
     """The names of the built-in module profiles."""
 
