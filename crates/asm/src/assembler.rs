@@ -224,7 +224,7 @@ pub fn assemble(
         }
         instructions.push(word);
         source_map.push(SourceLine {
-            file: reporter.files.get(st.loc.file).cloned().unwrap_or_default(),
+            file: reporter.files.get(st.loc.file).cloned().unwrap_or_else(|| "".into()),
             line: st.loc.line as u32,
             column: first_column(&st.body) as u32,
             text: st.text.clone(),

@@ -2,6 +2,7 @@
 //! suggestions they carry (made by `tmclsim_protocol::suggest`).
 
 use std::fmt;
+use std::sync::Arc;
 
 /// One error found while assembling: where it is and what is wrong.
 ///
@@ -69,7 +70,8 @@ pub(crate) struct Loc {
 /// there were in all.
 #[derive(Debug, Default)]
 pub(crate) struct Reporter {
-    pub files: Vec<String>,
+    /// File names, shared with the source map.
+    pub files: Vec<Arc<str>>,
     /// The earliest errors so far, the latest of them on top.
     items: std::collections::BinaryHeap<Ranked>,
     total: usize,
@@ -99,7 +101,7 @@ impl PartialOrd for Ranked {
 
 impl Reporter {
     pub fn add_file(&mut self, name: &str) -> usize {
-        self.files.push(name.to_string());
+        self.files.push(Arc::from(name));
         self.files.len() - 1
     }
 
@@ -110,7 +112,7 @@ impl Reporter {
         if self.items.len() == limit && self.items.peek().is_some_and(|top| (top.seq, top.column) <= (at.seq, column)) {
             return;
         }
-        let file = self.files.get(at.file).cloned().unwrap_or_default();
+        let file = self.files.get(at.file).map(|f| f.to_string()).unwrap_or_default();
         self.items.push(ranked(Diagnostic::new(file, at.line, column, message), self.total));
         if self.items.len() > limit {
             self.items.pop();
@@ -119,7 +121,7 @@ impl Reporter {
 
     /// `file:line:column` of a place, for "first defined at …".
     pub fn place(&self, at: Loc, column: usize) -> String {
-        format!("{}:{}:{column}", self.files.get(at.file).map_or("", String::as_str), at.line)
+        format!("{}:{}:{column}", self.files.get(at.file).map_or("", |f| &**f), at.line)
     }
 
     pub fn is_empty(&self) -> bool {
@@ -132,7 +134,7 @@ impl Reporter {
         let shown = self.items.len();
         let mut out: Vec<Diagnostic> = self.items.into_sorted_vec().into_iter().map(|r| r.diagnostic).collect();
         if self.total > shown {
-            let file = self.files.first().cloned().unwrap_or_default();
+            let file = self.files.first().map(|f| f.to_string()).unwrap_or_default();
             out.push(Diagnostic::new(file, 0, 0, format!("{} more errors not shown (the first {shown} are)", self.total - shown)));
         }
         out
