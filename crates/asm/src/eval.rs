@@ -154,12 +154,20 @@ impl Evaluator {
             }
             return self.constant(name, reporter);
         }
-        let candidates: Vec<&str> = self.labels.keys().chain(self.constants.keys()).map(String::as_str).collect();
         let what = match expect {
             Expect::Label => "label",
             Expect::Number => "constant or label",
         };
-        reporter.error(loc, column, format!("unknown {what} '{name}'{}", suggestion(name, candidates)));
+        let (labels, constants) = (&self.labels, &self.constants);
+        reporter.error_with(loc, column, |budget| {
+            // Of equally close names, labels come first, each by name.
+            let mut label_names: Vec<&str> = labels.keys().map(String::as_str).collect();
+            let mut constant_names: Vec<&str> = constants.keys().map(String::as_str).collect();
+            label_names.sort_unstable();
+            constant_names.sort_unstable();
+            let candidates = label_names.into_iter().chain(constant_names);
+            format!("unknown {what} '{name}'{}", suggestion(name, candidates, budget))
+        });
         Err(Reported)
     }
 
