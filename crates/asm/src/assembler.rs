@@ -184,6 +184,9 @@ pub fn assemble(
 
     // Pass 2: values of constants, then the instructions.
     evaluator.evaluate_constants(&mut reporter);
+    if reporter.is_empty() {
+        evaluator.finish_definitions();
+    }
     let mut instructions = Vec::new();
     let mut source_map = Vec::new();
     for st in &statements {
@@ -234,7 +237,8 @@ pub fn assemble(
     if !reporter.is_empty() {
         return Err(reporter.finish());
     }
-    Ok(Program { instructions, symbols: evaluator.label_addresses(), constants: evaluator.constant_values(), source_map })
+    let (symbols, constants) = evaluator.into_maps();
+    Ok(Program { instructions, symbols, constants, source_map })
 }
 
 fn first_column(body: &Body) -> usize {

@@ -162,11 +162,6 @@ impl Reporter {
         }
     }
 
-    /// `file:line:column` of a place, for "first defined at …".
-    pub fn place(&self, at: Loc, column: usize) -> String {
-        format!("{}:{}:{column}", self.files.get(at.file).map_or("", |f| &**f), at.line)
-    }
-
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
     }
