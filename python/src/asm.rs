@@ -118,7 +118,7 @@ impl Program {
     /// (file, line, column, text); empty for a program not assembled here.
     #[getter]
     fn source_map(&self) -> Vec<(String, u32, u32, String)> {
-        self.inner.source_map.iter().map(|s| (s.file.clone(), s.line, s.column, s.text.clone())).collect()
+        self.inner.source_map.iter().map(|s| (s.file.to_string(), s.line, s.column, s.text.clone())).collect()
     }
 
     /// to_binary() -> bytes

@@ -1,7 +1,16 @@
 //! Error messages with their place in the source, and the "did you mean"
-//! suggestions they carry (made by `tmclsim_protocol::suggest`).
+//! suggestions they carry (made by `tmclsim_protocol::suggest`, only for
+//! errors that are kept, and within
+//! [`MAX_SUGGESTION_WORK`](crate::limits::MAX_SUGGESTION_WORK) for one
+//! assembly).
 
 use std::fmt;
+use std::sync::Arc;
+
+use tmclsim_protocol::opcode as op;
+use tmclsim_protocol::suggest::closest_within;
+
+use crate::limits::MAX_SUGGESTION_WORK;
 
 /// One error found while assembling: where it is and what is wrong.
 ///
@@ -40,8 +49,6 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
     diagnostics.iter().map(|d| format!("{d}\n")).collect()
 }
 
-pub use tmclsim_protocol::suggest::suggestion;
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -64,25 +71,51 @@ pub(crate) struct Loc {
     pub line: usize,
 }
 
+/// `unknown instruction 'MVPP' (did you mean 'MVP'?)`, or, for a word
+/// that stands alone on its line (`nothing_follows`) and resembles no
+/// mnemonic, the hint that a label needs a colon.
+pub(crate) fn unknown_instruction(name: &str, nothing_follows: bool, budget: &mut u64) -> String {
+    let hint = suggestion(name, (0..=255u8).filter_map(op::mnemonic), budget);
+    if hint.is_empty() && nothing_follows {
+        return format!("unknown instruction '{name}' (a label needs a colon: '{name}:')");
+    }
+    format!("unknown instruction '{name}'{hint}")
+}
+
+/// ` (did you mean 'Loop'?)` or nothing, within what is left of `budget`.
+pub(crate) fn suggestion<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>, budget: &mut u64) -> String {
+    closest_within(name, candidates, budget).map_or(String::new(), |c| format!(" (did you mean '{c}'?)"))
+}
+
 /// Collects the diagnostics of one assembly: the first
 /// [`MAX_ERRORS`](crate::limits::MAX_ERRORS) in source order, and how many
 /// there were in all.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub(crate) struct Reporter {
-    pub files: Vec<String>,
+    pub files: Vec<Arc<str>>,
     /// The earliest errors so far, the latest of them on top.
     items: std::collections::BinaryHeap<Ranked>,
     total: usize,
+    /// What the "did you mean" searches may still take.
+    budget: u64,
 }
 
-/// A diagnostic ordered by its place in the source.
+impl Default for Reporter {
+    fn default() -> Reporter {
+        Reporter { files: Vec::new(), items: Default::default(), total: 0, budget: MAX_SUGGESTION_WORK }
+    }
+}
+
+/// An error ordered by its place in the source.
 #[derive(Debug, PartialEq, Eq)]
 struct Ranked {
     seq: usize,
     column: usize,
     /// Order of arrival: equal places keep it.
     arrival: usize,
-    diagnostic: Diagnostic,
+    file: usize,
+    line: usize,
+    message: String,
 }
 
 impl Ord for Ranked {
@@ -99,27 +132,34 @@ impl PartialOrd for Ranked {
 
 impl Reporter {
     pub fn add_file(&mut self, name: &str) -> usize {
-        self.files.push(name.to_string());
+        self.files.push(Arc::from(name));
         self.files.len() - 1
     }
 
-    pub fn error(&mut self, at: Loc, column: usize, message: impl Into<String>) {
-        let limit = crate::limits::MAX_ERRORS;
-        let ranked = |diagnostic, arrival| Ranked { seq: at.seq, column, arrival, diagnostic };
-        self.total += 1;
-        if self.items.len() == limit && self.items.peek().is_some_and(|top| (top.seq, top.column) <= (at.seq, column)) {
-            return;
-        }
-        let file = self.files.get(at.file).cloned().unwrap_or_default();
-        self.items.push(ranked(Diagnostic::new(file, at.line, column, message), self.total));
-        if self.items.len() > limit {
-            self.items.pop();
-        }
+    /// Whether an error at this place would be kept now (it is among the
+    /// earliest so far).
+    pub fn keeps(&self, at: Loc, column: usize) -> bool {
+        self.items.len() < crate::limits::MAX_ERRORS || self.items.peek().is_some_and(|top| (top.seq, top.column) > (at.seq, column))
     }
 
-    /// `file:line:column` of a place, for "first defined at …".
-    pub fn place(&self, at: Loc, column: usize) -> String {
-        format!("{}:{}:{column}", self.files.get(at.file).map_or("", String::as_str), at.line)
+    pub fn error(&mut self, at: Loc, column: usize, message: impl Into<String>) {
+        self.error_with(at, column, |_| message.into());
+    }
+
+    /// An error whose message is written only if the error is kept, so
+    /// that errors past the limit cost no work: suggestions, chains of
+    /// names. The message gets what is left of the suggestions' budget.
+    pub fn error_with(&mut self, at: Loc, column: usize, message: impl FnOnce(&mut u64) -> String) {
+        self.total += 1;
+        if !self.keeps(at, column) {
+            return;
+        }
+        let message = message(&mut self.budget);
+        let ranked = Ranked { seq: at.seq, column, arrival: self.total, file: at.file, line: at.line, message };
+        self.items.push(ranked);
+        if self.items.len() > crate::limits::MAX_ERRORS {
+            self.items.pop();
+        }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -130,10 +170,12 @@ impl Reporter {
     /// how many more there were.
     pub fn finish(self) -> Vec<Diagnostic> {
         let shown = self.items.len();
-        let mut out: Vec<Diagnostic> = self.items.into_sorted_vec().into_iter().map(|r| r.diagnostic).collect();
+        let files = &self.files;
+        let file = |index: usize| files.get(index).map_or_else(String::new, |f| f.to_string());
+        let mut out: Vec<Diagnostic> =
+            self.items.into_sorted_vec().into_iter().map(|r| Diagnostic::new(file(r.file), r.line, r.column, r.message)).collect();
         if self.total > shown {
-            let file = self.files.first().cloned().unwrap_or_default();
-            out.push(Diagnostic::new(file, 0, 0, format!("{} more errors not shown (the first {shown} are)", self.total - shown)));
+            out.push(Diagnostic::new(file(0), 0, 0, format!("{} more errors not shown (the first {shown} are)", self.total - shown)));
         }
         out
     }

@@ -10,7 +10,7 @@
 use tmclsim_protocol::mnemonic::{CALC_OPS, CONDITIONS, ERROR_FLAGS, MOVE_MODES, Operand, RFS_ACTIONS, WAIT_CONDITIONS, layout};
 use tmclsim_protocol::{Command, Instruction, opcode as op};
 
-use crate::diagnostic::{Loc, Reporter, suggestion};
+use crate::diagnostic::{Loc, Reporter, suggestion, unknown_instruction};
 use crate::eval::{Evaluator, Expect, Reported};
 use crate::expr::Expr;
 
@@ -75,16 +75,10 @@ pub fn operand_summary(opcode: u8) -> String {
 }
 
 /// The instruction number of a mnemonic, or the reason there is none.
+#[cfg(test)]
 pub fn opcode_of(mnemonic: &str, nothing_follows: bool) -> Result<u8, String> {
-    if let Some(code) = op::from_mnemonic(mnemonic) {
-        return Ok(code);
-    }
-    let known: Vec<&str> = (0..=255u8).filter_map(op::mnemonic).collect();
-    let hint = suggestion(mnemonic, known.iter().copied());
-    if hint.is_empty() && nothing_follows {
-        return Err(format!("unknown instruction '{mnemonic}' (a label needs a colon: '{mnemonic}:')"));
-    }
-    Err(format!("unknown instruction '{mnemonic}'{hint}"))
+    let mut unlimited = u64::MAX;
+    op::from_mnemonic(mnemonic).ok_or_else(|| unknown_instruction(mnemonic, nothing_follows, &mut unlimited))
 }
 
 /// Fits a value into a byte field.
@@ -113,12 +107,9 @@ pub fn encode(
     evaluator: &mut Evaluator,
     reporter: &mut Reporter,
 ) -> Result<Encoded, Reported> {
-    let opcode = match opcode_of(mnemonic, operands.is_empty()) {
-        Ok(code) => code,
-        Err(message) => {
-            reporter.error(loc, column, message);
-            return Err(Reported);
-        }
+    let Some(opcode) = op::from_mnemonic(mnemonic) else {
+        reporter.error_with(loc, column, |budget| unknown_instruction(mnemonic, operands.is_empty(), budget));
+        return Err(Reported);
     };
     let slots = layout(opcode).unwrap_or(&[]);
     let name = op::mnemonic(opcode).unwrap_or(mnemonic);
@@ -188,9 +179,9 @@ fn operand(
             return Ok(i as i64);
         }
         if !evaluator.is_defined(word) {
-            let message =
-                format!("'{word}' is not a {} ({}){}", table_name(table), table.join(", "), suggestion(word, table.iter().copied()));
-            reporter.error(loc, expr.column, message);
+            reporter.error_with(loc, expr.column, |budget| {
+                format!("'{word}' is not a {} ({}){}", table_name(table), table.join(", "), suggestion(word, table.iter().copied(), budget))
+            });
             return Err(Reported);
         }
     }

@@ -22,6 +22,20 @@ pub enum BinaryOp {
 }
 
 impl BinaryOp {
+    /// Every operator, in the order of their discriminants (`op as u8`).
+    pub const ALL: [BinaryOp; 10] = [
+        BinaryOp::Or,
+        BinaryOp::Xor,
+        BinaryOp::And,
+        BinaryOp::ShiftLeft,
+        BinaryOp::ShiftRight,
+        BinaryOp::Add,
+        BinaryOp::Sub,
+        BinaryOp::Mul,
+        BinaryOp::Div,
+        BinaryOp::Rem,
+    ];
+
     fn of(p: Punct) -> Option<(BinaryOp, u8)> {
         Some(match p {
             Punct::Pipe => (BinaryOp::Or, 1),
@@ -290,6 +304,13 @@ mod tests {
         assert!(parse(&deep).unwrap_err().1.contains("nested too deeply"));
         let long = vec!["1"; 2000].join("+");
         assert!(parse(&long).unwrap_err().1.contains("too long"));
+    }
+
+    #[test]
+    fn operators_by_number() {
+        for (i, op) in BinaryOp::ALL.iter().enumerate() {
+            assert_eq!(*op as usize, i);
+        }
     }
 
     #[test]

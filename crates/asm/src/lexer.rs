@@ -78,49 +78,94 @@ pub struct Unterminated {
     pub column: usize,
 }
 
-/// Splits a source text into lines with comments blanked out. A `/*`
-/// without `*/` blanks the rest of the file and is reported. A line longer
-/// than `max_line` bytes is left empty; its number is in the third part.
-pub fn strip_comments(source: &str, max_line: usize) -> (Vec<String>, Option<Unterminated>, Vec<usize>) {
-    let mut lines = Vec::new();
-    let mut open: Option<Unterminated> = None;
-    let mut too_long = Vec::new();
-    for (index, raw) in source.split('\n').enumerate() {
+/// The lines of a source text with comments blanked out, one at a time
+/// (only one line is held at once). A `/*` without `*/` blanks the rest of
+/// the text; [`Lines::unterminated`] tells where it started. A line longer
+/// than `max_line` bytes is not read: it comes as `None`.
+pub struct Lines<'t> {
+    rest: Option<&'t str>,
+    number: usize,
+    max_line: usize,
+    open: Option<Unterminated>,
+    line: String,
+}
+
+impl<'t> Lines<'t> {
+    pub fn new(source: &'t str, max_line: usize) -> Lines<'t> {
+        Lines { rest: Some(source), number: 0, max_line, open: None, line: String::new() }
+    }
+
+    /// The next line: its 1-based number and its text (`None`: too long).
+    pub fn next_line(&mut self) -> Option<(usize, Option<&str>)> {
+        let rest = self.rest?;
+        let (raw, rest) = match rest.split_once('\n') {
+            Some((raw, rest)) => (raw, Some(rest)),
+            None => (rest, None),
+        };
+        self.rest = rest;
+        self.number += 1;
         let raw = raw.strip_suffix('\r').unwrap_or(raw);
-        if raw.len() > max_line {
-            too_long.push(index + 1);
-            lines.push(String::new());
-            continue;
+        if raw.len() > self.max_line {
+            return Some((self.number, None));
         }
-        let chars: Vec<char> = raw.chars().collect();
-        let mut out = String::with_capacity(raw.len());
-        let mut i = 0;
-        while i < chars.len() {
-            let next = chars.get(i + 1).copied();
-            if open.is_some() {
-                if chars[i] == '*' && next == Some('/') {
-                    open = None;
-                    out.push_str("  ");
-                    i += 2;
+        self.line.clear();
+        // Most lines hold no comment: taken as they are.
+        if self.open.is_none() && !raw.contains('/') {
+            self.line.push_str(raw);
+            return Some((self.number, Some(&self.line)));
+        }
+        let mut chars = raw.chars().peekable();
+        let mut column = 0;
+        while let Some(c) = chars.next() {
+            let next = chars.peek().copied();
+            column += 1;
+            if self.open.is_some() {
+                if c == '*' && next == Some('/') {
+                    self.open = None;
+                    self.line.push_str("  ");
+                    chars.next();
+                    column += 1;
                 } else {
-                    out.push(' ');
-                    i += 1;
+                    self.line.push(' ');
                 }
-            } else if chars[i] == '/' && next == Some('/') {
-                out.extend(std::iter::repeat_n(' ', chars.len() - i));
+            } else if c == '/' && next == Some('/') {
+                self.line.extend(std::iter::repeat_n(' ', 1 + chars.count()));
                 break;
-            } else if chars[i] == '/' && next == Some('*') {
-                open = Some(Unterminated { line: index + 1, column: i + 1 });
-                out.push_str("  ");
-                i += 2;
+            } else if c == '/' && next == Some('*') {
+                self.open = Some(Unterminated { line: self.number, column });
+                self.line.push_str("  ");
+                chars.next();
+                column += 1;
             } else {
-                out.push(chars[i]);
-                i += 1;
+                self.line.push(c);
             }
         }
-        lines.push(out);
+        Some((self.number, Some(&self.line)))
     }
-    (lines, open, too_long)
+
+    /// Where a `/*` that is still open started.
+    pub fn unterminated(&self) -> Option<Unterminated> {
+        self.open
+    }
+}
+
+/// Splits a source text into lines with comments blanked out (all of
+/// [`Lines`] at once). A line longer than `max_line` bytes is left empty;
+/// its number is in the third part.
+#[cfg(test)]
+pub fn strip_comments(source: &str, max_line: usize) -> (Vec<String>, Option<Unterminated>, Vec<usize>) {
+    let mut lines = Lines::new(source, max_line);
+    let (mut out, mut too_long) = (Vec::new(), Vec::new());
+    while let Some((number, line)) = lines.next_line() {
+        match line {
+            Some(text) => out.push(text.to_string()),
+            None => {
+                too_long.push(number);
+                out.push(String::new());
+            }
+        }
+    }
+    (out, lines.unterminated(), too_long)
 }
 
 fn is_name_start(c: char) -> bool {

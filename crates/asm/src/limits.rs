@@ -14,3 +14,10 @@ pub const MAX_LINE_BYTES: usize = 4096;
 pub const MAX_STATEMENTS: usize = 100_000;
 /// Errors reported by one assembly; the rest are counted in a last line.
 pub const MAX_ERRORS: usize = 100;
+/// Work the "did you mean" suggestions of one assembly may take, in cells
+/// of the edit distance tables they fill
+/// (`tmclsim_protocol::suggest::closest_within`): about a tenth of a
+/// second. A hundred typos in a program of a few thousand names take a
+/// small part of it; once it is spent, errors come without suggestion.
+pub const MAX_SUGGESTION_WORK: u64 = 20_000_000;
+

@@ -3,13 +3,14 @@
 //! source lines with it and take breakpoints as `file:line`.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// Where one instruction comes from.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SourceLine {
     /// The file as the assembler named it (the path given, or the name in
-    /// `#include`).
-    pub file: String,
+    /// `#include`); the instructions of a file share one copy.
+    pub file: Arc<str>,
     /// 1-based line.
     pub line: u32,
     /// 1-based column of the mnemonic (characters).
@@ -51,7 +52,7 @@ impl LinePlace {
 pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, String> {
     let file = match &place.file {
         Some(f) => {
-            let names: BTreeMap<&str, ()> = map.iter().map(|s| (s.file.as_str(), ())).collect();
+            let names: BTreeMap<&str, ()> = map.iter().map(|s| (&*s.file, ())).collect();
             let matching: Vec<&str> = names.keys().copied().filter(|n| *n == f || n.ends_with(&format!("/{f}"))).collect();
             match matching.as_slice() {
                 [one] => one.to_string(),
@@ -63,13 +64,13 @@ pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, String> 
             }
         }
         None => match map.first() {
-            Some(s) => s.file.clone(),
+            Some(s) => s.file.to_string(),
             None => return Err("the program has no source map (it was not assembled from source)".into()),
         },
     };
     map.iter()
         .enumerate()
-        .filter(|(_, s)| s.file == file && s.line >= place.line)
+        .filter(|(_, s)| *s.file == *file && s.line >= place.line)
         .min_by_key(|(a, s)| (s.line, *a))
         .map(|(a, _)| a as u32)
         .ok_or_else(|| format!("{file}: no instruction at or after line {}", place.line))

@@ -21,6 +21,7 @@
 //! ```
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use tmclsim_protocol::mnemonic::parse_number;
 
@@ -57,8 +58,9 @@ pub fn parse(text: &str) -> Result<BTreeMap<String, u32>, String> {
     parse_all(text).map(|(labels, _)| labels)
 }
 
-/// Reads a source map line: `@address\tfile\tline\tcolumn\ttext`.
-fn parse_source_line(line: &str, number: usize, expected: usize) -> Result<SourceLine, String> {
+/// Reads a source map line: `@address\tfile\tline\tcolumn\ttext`; its file
+/// shares the `previous` line's copy of the name when they are the same.
+fn parse_source_line(line: &str, number: usize, expected: usize, previous: Option<&SourceLine>) -> Result<SourceLine, String> {
     let fields: Vec<&str> = line.splitn(5, '\t').collect();
     let &[address, file, at, column, text] = fields.as_slice() else {
         return Err(format!("line {number}: a source map line has five tab-separated fields (@address, file, line, column, text)"));
@@ -68,7 +70,7 @@ fn parse_source_line(line: &str, number: usize, expected: usize) -> Result<Sourc
     }
     let number_field = |what: &str, v: &str| v.parse::<u32>().map_err(|_| format!("line {number}: '{v}' is not a {what}"));
     Ok(SourceLine {
-        file: file.to_string(),
+        file: previous.filter(|p| *p.file == *file).map_or_else(|| Arc::from(file), |p| p.file.clone()),
         line: number_field("line number", at)?,
         column: number_field("column", column)?,
         text: text.trim_end_matches('\r').to_string(),
@@ -83,7 +85,8 @@ pub fn parse_all(text: &str) -> Result<(BTreeMap<String, u32>, Vec<SourceLine>),
     for (index, raw) in text.lines().enumerate() {
         let number = index + 1;
         if raw.starts_with('@') {
-            source_map.push(parse_source_line(raw, number, source_map.len())?);
+            let line = parse_source_line(raw, number, source_map.len(), source_map.last())?;
+            source_map.push(line);
             continue;
         }
         let line = raw.split("//").next().unwrap_or("").trim();

@@ -68,3 +68,19 @@ fn statements_past_the_limit_end_the_assembly_with_one_error() {
     let fits = (0..MAX_STATEMENTS).map(|i| format!("L{i}:\n")).collect::<String>();
     assert!(assemble(&fits, "labels.tmc", &NoIncludes, None).is_ok());
 }
+
+#[test]
+fn suggestions_stop_when_their_work_is_spent() {
+    use tmclsim_asm::limits::MAX_SUGGESTION_WORK;
+    // Each jump's "did you mean" compares its name with 20 000 labels of
+    // about its length; the work allowed pays for the first few searches.
+    let jumps: String = (0..30).map(|i| format!("JA Label{i:05}x\n")).collect();
+    let labels: String = (0..20_000).map(|i| format!("Label{i:05}: STOP\n")).collect();
+    let d = assemble(&format!("{jumps}{labels}"), "many.tmc", &NoIncludes, None).unwrap_err();
+    assert_eq!(d.len(), 30, "{:?}", &d[..3]);
+    assert_eq!(d[0].message, "unknown label 'Label00000x' (did you mean 'Label00000'?)");
+    let suggested = d.iter().take_while(|d| d.message.contains("did you mean")).count();
+    assert!((1..30).contains(&suggested), "{suggested} of 30 errors have a suggestion with {MAX_SUGGESTION_WORK} cells of work");
+    assert!(d[suggested..].iter().all(|d| !d.message.contains("did you mean")), "none after the work is spent");
+    assert_eq!(d[29].message, "unknown label 'Label00029x'");
+}

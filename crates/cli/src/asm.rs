@@ -58,9 +58,9 @@ pub fn asm(args: AsmArgs) -> Result<ExitCode, String> {
             let b = ins.to_bytes();
             // The source line beside the bytes: its number, with the file
             // named when it is an included one.
-            let main = program.source_map.first().map(|s| s.file.as_str());
+            let main = program.source_map.first().map(|s| &*s.file);
             let source = match program.source_of(a as u32) {
-                Some(s) if Some(s.file.as_str()) == main => format!("{:>5}  {}", s.line, s.text),
+                Some(s) if Some(&*s.file) == main => format!("{:>5}  {}", s.line, s.text),
                 Some(s) => format!("{:>5}  {}  ({}:{})", s.line, s.text, s.file, s.line),
                 None => format!("       {}", tmclsim_protocol::mnemonic::format(*ins)),
             };

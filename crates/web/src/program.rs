@@ -48,7 +48,7 @@ fn program_json(p: &Program) -> Value {
         .source_map
         .iter()
         .enumerate()
-        .map(|(a, s)| json!({"address": a, "file": s.file, "line": s.line, "column": s.column, "text": s.text}))
+        .map(|(a, s)| json!({"address": a, "file": &*s.file, "line": s.line, "column": s.column, "text": s.text}))
         .collect();
     let listing: String =
         p.instructions.iter().enumerate().map(|(a, w)| format!("{a:5}  {}\n", tmclsim_protocol::mnemonic::format(*w))).collect();
