@@ -20,4 +20,3 @@ pub const MAX_ERRORS: usize = 100;
 /// second. A hundred typos in a program of a few thousand names take a
 /// small part of it; once it is spent, errors come without suggestion.
 pub const MAX_SUGGESTION_WORK: u64 = 20_000_000;
-
