@@ -1,0 +1,12 @@
+//! tmclsim in JavaScript: a WebAssembly module (wasm-bindgen) with one
+//! virtual TMCL module per `Module` object, in stepped virtual time (the
+//! wall clock is never read), and the assembler. `scripts/wasm` builds
+//! `target/wasm/tmclsim.js`; docs/playground.md describes the API.
+//!
+//! [`sim::Sim`] holds the logic in plain Rust (tested natively); the
+//! binding in `bindings.rs` turns its values into JavaScript ones.
+
+mod bindings;
+pub mod sim;
+
+pub use bindings::JsModule;
