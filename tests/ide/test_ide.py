@@ -388,3 +388,47 @@ def test_a_public_address_needs_the_token(page, start):
     page.wait_for_function("document.querySelector('[data-testid=ro-position]').textContent === '0'")
     with urllib.request.urlopen(f"{base}api/modules?token={token}") as r:
         assert json.loads(r.read())[0]["profile"] == "TMCM-1141"
+
+
+LOOP_WITH_WAIT = """Loop:   CALC ADD, 1
+        WAIT TICKS, 0, 50
+        CALC ADD, 10
+        JA Loop
+"""
+
+
+def current_line(page, line):
+    page.wait_for_function(f"document.querySelector('[data-testid=editor]').dataset.currentLine === '{line}'")
+
+
+@pytest.mark.parametrize("target", ["virtual", "link"])
+def test_a_breakpoint_stops_the_loop_every_time_and_a_waiting_wait_is_the_current_line(served, page, start, target):
+    url = served.url
+    if target == "link":
+        url = start(["ide", "--tcp", served.tcp, "--web", "127.0.0.1:0"], last="open:").printed("open")
+    open_app(page, url)
+    tab(page, "program")
+    page.evaluate("s => window.tmclEditor.setValue(s)", LOOP_WITH_WAIT)
+    page.click("[data-testid=prog-download]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
+    # On the line after the WAIT: every pass of the loop stops there.
+    page.locator(".CodeMirror-linenumber").get_by_text("3", exact=True).click()
+    page.locator("[data-testid=breakpoint]").wait_for()
+    page.click("[data-testid=prog-run]")
+    for acc in ["1", "12", "23"]:
+        page.wait_for_function(f"document.querySelector('[data-testid=ps-acc]').textContent === '{acc}'")
+        current_line(page, 3)
+        assert page.inner_text("[data-testid=ps-break]") == "at address 2"
+        page.click("[data-testid=prog-continue]")
+    page.wait_for_function("document.querySelector('[data-testid=ps-acc]').textContent === '34'")
+    # Single steps: onto the WAIT, then into it; while it waits the WAIT's
+    # line is the current one (the counter holds its address, rule 35).
+    page.click("[data-testid=prog-step]")
+    page.click("[data-testid=prog-step]")
+    page.click("[data-testid=prog-step]")
+    current_line(page, 2)
+    page.click("[data-testid=prog-step]")
+    page.wait_for_function("document.querySelector('[data-testid=ps-mode]').textContent.includes('(WAIT)')")
+    current_line(page, 2)
+    assert page.inner_text("[data-testid=ps-pc]") == "1"
+    page.click("[data-testid=prog-stop]")

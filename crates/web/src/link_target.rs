@@ -17,8 +17,9 @@ use tmclsim_protocol::{FRAME_LEN, Instruction, opcode};
 struct Debug {
     breakpoints: Vec<u16>,
     hit: Option<u16>,
-    /// Set to stop the stepping thread.
-    halt: Option<Arc<AtomicBool>>,
+    /// Set to stop the stepping thread, which is joined before anything
+    /// else is sent (a late step or hit would land in the next run).
+    halt: Option<(Arc<AtomicBool>, std::thread::JoinHandle<()>)>,
 }
 
 pub struct LinkTarget {
@@ -90,7 +91,11 @@ impl LinkTarget {
             }
             let Some((mode, pc)) = self.counter(id) else { break };
             if breakpoints.contains(&pc) && last != Some(pc) {
-                self.with_debug(id, |d| d.hit = Some(pc));
+                self.with_debug(id, |d| {
+                    if !halt.load(Ordering::Relaxed) {
+                        d.hit = Some(pc);
+                    }
+                });
                 break;
             }
             last = Some(pc);
@@ -149,15 +154,19 @@ impl Target for Arc<LinkTarget> {
             check(&self.exchange(id, Instruction::new(opcode::RESET_APPLICATION, 0, 0, 0))?)?;
         }
         let halt = Arc::new(AtomicBool::new(false));
-        self.with_debug(id, |d| d.halt = Some(halt.clone()));
-        let me = self.clone();
-        std::thread::spawn(move || me.step_to_breakpoint(id, halt));
+        let (me, flag) = (self.clone(), halt.clone());
+        let thread = std::thread::spawn(move || me.step_to_breakpoint(id, flag));
+        self.with_debug(id, |d| d.halt = Some((halt, thread)));
         Ok(())
     }
 
     fn halt(&self, id: usize) {
-        if let Some(h) = self.with_debug(id, |d| d.halt.take()) {
-            h.store(true, Ordering::Relaxed);
+        if let Some((flag, thread)) = self.with_debug(id, |d| d.halt.take()) {
+            flag.store(true, Ordering::Relaxed);
+            // Not under the lock: the thread takes it to note a hit.
+            if thread.thread().id() != std::thread::current().id() {
+                let _ = thread.join();
+            }
         }
     }
 }

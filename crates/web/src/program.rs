@@ -169,6 +169,11 @@ pub fn state_of(app: &App, id: usize) -> Result<Value, ApiError> {
         2 => "step",
         _ => "reset",
     };
+    // A breakpoint is where a stopped program stands: a stale hit (a run or
+    // continue under way, a counter read before the hit was noted) is not
+    // one.
+    let pc = (status & 0xFFFF) as u16;
+    let breakpoint = t.breakpoint_hit(id).filter(|&b| b == pc && mode != "running");
     let user: Vec<Option<i32>> = replies[3..].iter().map(|raw| (raw[2] >= 100).then(|| word(raw))).collect();
     let snap = t.snapshot(id);
     // The comparison flags JC tests (EQ/ZE, LT, GT) and the error flags.
@@ -188,11 +193,11 @@ pub fn state_of(app: &App, id: usize) -> Result<Value, ApiError> {
         f.join(" ")
     });
     Ok(json!({
-        "mode": mode, "pc": status & 0xFFFF, "waiting": (status >> 16) & 0xFF == 1,
+        "mode": mode, "pc": pc, "waiting": (status >> 16) & 0xFF == 1,
         "accumulator": accumulator, "x": x, "flags": flags,
         "errors": snap.as_ref().map(|s| s.program.errors),
         "stack_depth": snap.as_ref().map(|s| s.program.stack_depth),
-        "breakpoint": t.breakpoint_hit(id), "breakpoints": t.breakpoints(id), "user_variables": user,
+        "breakpoint": breakpoint, "breakpoints": t.breakpoints(id), "user_variables": user,
         "time": t.time(id),
     }))
 }

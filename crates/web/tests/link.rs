@@ -73,3 +73,54 @@ fn a_module_on_a_serial_port_is_reached_as_a_real_one() {
     drop(web);
     drop(server);
 }
+
+/// A loop with a WAIT and a breakpoint on the instruction after it: the
+/// program stops there every time it comes round, also after Continue, and
+/// no state read while it runs on names a breakpoint.
+fn stops_every_time(url: &dyn Fn(&str) -> String) {
+    let source = "Loop: CALC ADD, 1\n  WAIT TICKS, 0, 2\n  CALC ADD, 10\n  JA Loop\n";
+    let last = post_text(&url("/api/modules/0/program/download"), json!({"source": source}));
+    assert!(last.contains("\"verified\":true"), "{last}");
+    post(&url("/api/modules/0/program/breakpoints"), json!({"addresses": [2]}));
+    post(&url("/api/modules/0/program/run"), json!({}));
+    for round in 1..=3 {
+        let mut st = serde_json::Value::Null;
+        assert!(
+            eventually(5.0, || {
+                st = get(&url("/api/modules/0/program/state")).1;
+                st["breakpoint"] == 2
+            }),
+            "round {round}: {st}"
+        );
+        assert_eq!((st["pc"].as_u64(), st["accumulator"].as_i64()), (Some(2), Some(11 * round - 10)), "round {round}: {st}");
+        assert_ne!(st["mode"], "running");
+        let (_, st) = post(&url("/api/modules/0/program/continue"), json!({}));
+        assert!(st["breakpoint"].is_null(), "{st}");
+        for _ in 0..5 {
+            let st = get(&url("/api/modules/0/program/state")).1;
+            let at_the_next_hit = st["pc"] == 2 && st["accumulator"].as_i64() == Some(11 * round + 1);
+            assert!(st["breakpoint"].is_null() || at_the_next_hit, "{st}");
+        }
+    }
+    // Run starts over at address 0: the last hit is not reported there.
+    let (_, st) = post(&url("/api/modules/0/program/run"), json!({}));
+    assert!(st["breakpoint"].is_null() || st["pc"] == 2, "{st}");
+    post(&url("/api/modules/0/program/stop"), json!({}));
+}
+
+#[test]
+fn a_breakpoint_by_steps_stops_every_time_the_loop_reaches_it() {
+    let s = Served::new();
+    let tcp = s.tcp().to_string();
+    let target = LinkTarget::open(Some(&tcp), None, 9600, &[1], Duration::from_secs(1)).unwrap();
+    let web =
+        tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
+            .unwrap();
+    stops_every_time(&|p: &str| format!("http://{}{p}", web.addr()));
+}
+
+#[test]
+fn a_breakpoint_in_the_firmware_stops_every_time_the_loop_reaches_it() {
+    let s = Served::new();
+    stops_every_time(&|p: &str| s.url(p));
+}
