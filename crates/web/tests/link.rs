@@ -13,7 +13,7 @@ use tmclsim_web::{LinkTarget, WebConfig};
 fn a_served_module_over_tcp_lists_answers_and_stops_at_breakpoints() {
     let s = Served::new();
     let tcp = s.tcp().to_string();
-    let target = LinkTarget::open(Some(&tcp), None, 9600, &[1], Duration::from_secs(1)).unwrap();
+    let target = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[1]), Duration::from_secs(1)).unwrap();
     let web =
         tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
             .unwrap();
@@ -43,11 +43,14 @@ fn a_served_module_over_tcp_lists_answers_and_stops_at_breakpoints() {
 }
 
 #[test]
-fn an_address_that_does_not_answer_is_named() {
+fn an_address_that_does_not_answer_is_named_and_left_out() {
     let s = Served::new();
     let tcp = s.tcp().to_string();
-    let e = LinkTarget::open(Some(&tcp), None, 9600, &[1, 7], Duration::from_millis(200)).err().unwrap();
-    assert!(e.contains("module 7"), "{e}");
+    let target = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[1, 7]), Duration::from_millis(200)).unwrap();
+    assert_eq!(target.missing(), &[7]);
+    assert_eq!(tmclsim_web::Target::modules(&target).iter().map(|m| m.address).collect::<Vec<_>>(), vec![1]);
+    let e = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[5, 7]), Duration::from_millis(200)).err().unwrap();
+    assert!(e.contains("answered at address 5, 7"), "{e}");
 }
 
 #[test]
@@ -58,7 +61,8 @@ fn a_module_on_a_serial_port_is_reached_as_a_real_one() {
     let module = tmclsim_firmware::Module::new(tmclsim_firmware::Profile::built_in("tmcm-3110").unwrap());
     let config = tmclsim_server::ServerConfig { pty: Some(link.clone()), warn_exposure: false, ..Default::default() };
     let server = tmclsim_server::start(module, config).unwrap();
-    let target = LinkTarget::open(None, Some(link.to_str().unwrap()), 9600, &[1], Duration::from_secs(1)).unwrap();
+    let target =
+        LinkTarget::open(None, Some(link.to_str().unwrap()), 9600, tmclsim_web::Probe::Addresses(&[1]), Duration::from_secs(1)).unwrap();
     let web =
         tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
             .unwrap();
@@ -102,6 +106,11 @@ fn stops_every_time(url: &dyn Fn(&str) -> String) {
             assert!(st["breakpoint"].is_null() || at_the_next_hit, "{st}");
         }
     }
+    // The program read back (134) up to its end, disassembled.
+    let (status, back) = get(&url("/api/modules/0/program/source"));
+    assert_eq!((status, back["words"].as_u64()), (200, Some(4)), "{back}");
+    let text = back["source"].as_str().unwrap();
+    assert!(text.contains("CALC ADD, 1") && text.contains("WAIT TICKS, 0, 2") && text.contains("JA "), "{text}");
     // Run starts over at address 0: the last hit is not reported there.
     let (_, st) = post(&url("/api/modules/0/program/run"), json!({}));
     assert!(st["breakpoint"].is_null() || st["pc"] == 2, "{st}");
@@ -112,7 +121,7 @@ fn stops_every_time(url: &dyn Fn(&str) -> String) {
 fn a_breakpoint_by_steps_stops_every_time_the_loop_reaches_it() {
     let s = Served::new();
     let tcp = s.tcp().to_string();
-    let target = LinkTarget::open(Some(&tcp), None, 9600, &[1], Duration::from_secs(1)).unwrap();
+    let target = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[1]), Duration::from_secs(1)).unwrap();
     let web =
         tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
             .unwrap();
