@@ -196,6 +196,15 @@ pub fn exchange(app: &App, id: usize, ins: Instruction) -> Result<Value, ApiErro
 
 fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8; FRAME_LEN]) -> Value {
     let value = i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]);
+    if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
+        // The reply is text from its second byte on: no status, no value.
+        let version = String::from_utf8_lossy(&raw[1..]).trim_end_matches('\0').to_string();
+        return json!({
+            "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
+            "status": null, "status_text": null, "value": null, "version": version,
+            "text": format!("version {version}"),
+        });
+    }
     json!({
         "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
         "status": raw[2], "status_text": crate::status_text(raw[2]), "value": value,

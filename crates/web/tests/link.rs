@@ -25,6 +25,13 @@ fn a_served_module_over_tcp_lists_answers_and_stops_at_breakpoints() {
     );
     let (_, r) = post(&url("/api/modules/0/command"), json!({"line": "GAP 4, 0"}));
     assert_eq!(r["status"].as_u64(), Some(100));
+    // 136 type 0 answers a string, not a status.
+    let (_, r) = post(&url("/api/modules/0/command"), json!({"line": "#136 0 0 0"}));
+    assert_eq!(
+        (r["version"].as_str(), r["text"].as_str(), r["status"].is_null()),
+        (Some("1141V146"), Some("version 1141V146"), true),
+        "{r}"
+    );
     // The world is the simulator's: a link target has none.
     assert_eq!(post(&url("/api/modules/0/world"), json!({"line": "reset"})).0, 409);
 
