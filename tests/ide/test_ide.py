@@ -388,3 +388,72 @@ def test_a_public_address_needs_the_token(page, start):
     page.wait_for_function("document.querySelector('[data-testid=ro-position]').textContent === '0'")
     with urllib.request.urlopen(f"{base}api/modules?token={token}") as r:
         assert json.loads(r.read())[0]["profile"] == "TMCM-1141"
+
+
+LOOP_WITH_WAIT = """Loop:   CALC ADD, 1
+        WAIT TICKS, 0, 50
+        CALC ADD, 10
+        JA Loop
+"""
+
+
+def current_line(page, line):
+    page.wait_for_function(f"document.querySelector('[data-testid=editor]').dataset.currentLine === '{line}'")
+
+
+@pytest.mark.parametrize("target", ["virtual", "link"])
+def test_a_breakpoint_stops_the_loop_every_time_and_a_waiting_wait_is_the_current_line(served, page, start, target):
+    url = served.url
+    if target == "link":
+        url = start(["ide", "--tcp", served.tcp, "--web", "127.0.0.1:0"], last="open:").printed("open")
+    open_app(page, url)
+    tab(page, "program")
+    page.evaluate("s => window.tmclEditor.setValue(s)", LOOP_WITH_WAIT)
+    page.click("[data-testid=prog-download]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
+    # On the line after the WAIT: every pass of the loop stops there.
+    page.locator(".CodeMirror-linenumber").get_by_text("3", exact=True).click()
+    page.locator("[data-testid=breakpoint]").wait_for()
+    page.click("[data-testid=prog-run]")
+    for acc in ["1", "12", "23"]:
+        page.wait_for_function(f"document.querySelector('[data-testid=ps-acc]').textContent === '{acc}'")
+        current_line(page, 3)
+        assert page.inner_text("[data-testid=ps-break]") == "at address 2"
+        page.click("[data-testid=prog-continue]")
+    page.wait_for_function("document.querySelector('[data-testid=ps-acc]').textContent === '34'")
+    # Single steps: onto the WAIT, then into it; while it waits the WAIT's
+    # line is the current one (the counter holds its address, rule 35).
+    page.click("[data-testid=prog-step]")
+    page.click("[data-testid=prog-step]")
+    page.click("[data-testid=prog-step]")
+    current_line(page, 2)
+    page.click("[data-testid=prog-step]")
+    page.wait_for_function("document.querySelector('[data-testid=ps-mode]').textContent.includes('(WAIT)')")
+    current_line(page, 2)
+    assert page.inner_text("[data-testid=ps-pc]") == "1"
+    page.click("[data-testid=prog-stop]")
+
+
+def test_a_link_is_scanned_a_program_read_back_and_the_version_shown(page, start):
+    bus = start(["serve", "--bus", "tmcm-1141@1,tmcm-351@7", "--tcp", "127.0.0.1:0"])
+    ide = start(["ide", "--tcp", bus.printed("tcp"), "--bus-addresses", "1,5", "--web", "127.0.0.1:0"], last="open:")
+    open_app(page, ide.printed("open"))
+    assert page.locator("[data-testid=module-item]").count() == 1
+    page.click("[data-testid=scan-go]")
+    page.locator("[data-testid=scan-item]").nth(1).wait_for()
+    items = page.locator("[data-testid=scan-item]").all_inner_texts()
+    assert "TMCM-1141 · address 1" in items[0] and "1141V146" in items[0]
+    assert "TMCM-351 · address 7" in items[1] and "0351V445" in items[1] and "not listed" in items[1]
+    page.fill("[data-testid=direct-input]", "#136 0 0 0")
+    page.press("[data-testid=direct-input]", "Enter")
+    page.locator("[data-testid=direct-reply]").wait_for()
+    assert page.inner_text("[data-testid=direct-reply]") == "version 1141V146"
+    tab(page, "program")
+    page.evaluate("s => window.tmclEditor.setValue(s)", LOOP_WITH_WAIT)
+    page.click("[data-testid=prog-download]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
+    page.evaluate("() => window.tmclEditor.setValue('')")
+    page.click("[data-testid=prog-read]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.startsWith('read 4 words')")
+    text = page.evaluate("() => window.tmclEditor.getValue()")
+    assert "CALC ADD, 1" in text and "WAIT TICKS, 0, 50" in text and "JA " in text

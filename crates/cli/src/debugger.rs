@@ -72,7 +72,8 @@ impl Debugger {
         self.report_changes(m);
         println!("debugger: h for help");
         loop {
-            let pc = m.program().pc;
+            // While a WAIT waits, the counter stands on the WAIT (135 type 1).
+            let pc = m.program().counter();
             let waiting = if m.program().wait.is_some() { " (waiting)" } else { "" };
             print!("[{:.3} s] {}  {}{waiting} > ", m.now_ns() as f64 * 1e-9, place(program, pc), text_at(program, pc));
             std::io::stdout().flush().ok();
@@ -302,7 +303,7 @@ fn breakpoints(m: &mut Module, program: &Program, add: bool, args: &[&str]) {
 /// hold instructions, with their addresses.
 fn list(m: &Module, program: &Program, args: &[&str]) {
     let center = match args {
-        [] => m.program().pc,
+        [] => m.program().counter(),
         [at] => match resolve(at, program) {
             Ok(a) => a,
             Err(e) => return println!("{e}"),
@@ -315,7 +316,7 @@ fn list(m: &Module, program: &Program, args: &[&str]) {
     });
     let from = center.saturating_sub(4) as usize;
     for a in from..(from + 9).min(program.instructions.len()) {
-        let mark = if a == m.program().pc as usize {
+        let mark = if a == m.program().counter() as usize {
             "=>"
         } else if m.program().breakpoints.contains(&(a as u16)) {
             " *"
@@ -373,7 +374,10 @@ impl Quantity {
                 let name = name.join(" ");
                 let number = match mnemonic::parse_number(&name) {
                     Some(n) => u8::try_from(n).ok().filter(|n| profile.axis_parameter(*n).is_some()),
-                    None => profile.axis_parameter_named(&name).map(|p| p.number),
+                    // The manual's name, or the console's (`actual_position`).
+                    None => profile.axis_parameter_named(&name).map(|p| p.number).or_else(|| {
+                        tmclsim_host::names::find(profile, tmclsim_host::names::Table::Axis, &name, None).map(|(_, p)| p.number)
+                    }),
                 };
                 let names = profile.axis_parameters().map(|p| p.name.as_str());
                 let number = number.ok_or_else(|| {
@@ -387,7 +391,10 @@ impl Quantity {
                 let number = mnemonic::parse_number(&name);
                 let found = (0..=3u8).flat_map(|b| profile.global_parameters(b).map(move |p| (b, p))).find(|(b, p)| match number {
                     Some(n) => i64::from(p.number) == n && bank.is_none_or(|x| x == i64::from(*b)),
-                    None => p.name.eq_ignore_ascii_case(&name) && bank.is_none_or(|x| x == i64::from(*b)),
+                    None => {
+                        (p.name.eq_ignore_ascii_case(&name) || tmclsim_host::names::snake(&p.name) == tmclsim_host::names::snake(&name))
+                            && bank.is_none_or(|x| x == i64::from(*b))
+                    }
                 });
                 let names = (0..=3u8).flat_map(|b| profile.global_parameters(b).map(|p| p.name.as_str()));
                 match found {
@@ -445,7 +452,7 @@ impl Quantity {
         match self {
             Quantity::Accumulator => r.accumulator.to_string(),
             Quantity::X => r.x.to_string(),
-            Quantity::Pc => p.pc.to_string(),
+            Quantity::Pc => p.counter().to_string(),
             Quantity::Flags => format!("compare {:?}, error flags {:#04x}", r.compare, r.errors),
             Quantity::Stack => format!("{:?}", p.stack),
             Quantity::Axis { number, motor } => {

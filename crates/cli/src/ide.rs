@@ -10,9 +10,12 @@ use std::sync::Arc;
 pub struct IdeArgs {
     #[command(flatten)]
     pub link: crate::client::Link,
-    /// The module addresses on the link (an RS485 bus has several).
-    #[arg(long, value_name = "A,B,…", default_value = "1", value_delimiter = ',')]
+    /// The module addresses on the link (an RS485 bus has several); those that do not answer are named and left out.
+    #[arg(long, value_name = "A,B,…", default_value = "1", value_delimiter = ',', conflicts_with = "scan")]
     pub bus_addresses: Vec<u8>,
+    /// Ask every address 1…255 (136) and list each module that answers.
+    #[arg(long)]
+    pub scan: bool,
     /// Where the app listens.
     #[arg(long, value_name = "ADDR", default_value = tmclsim_web::DEFAULT_ADDR, value_parser = crate::socket_address)]
     pub web: std::net::SocketAddr,
@@ -25,13 +28,17 @@ pub struct IdeArgs {
 }
 
 pub fn run(args: IdeArgs) -> Result<ExitCode, String> {
+    let probe = if args.scan { tmclsim_web::Probe::Scan } else { tmclsim_web::Probe::Addresses(&args.bus_addresses) };
     let target = tmclsim_web::LinkTarget::open(
         args.link.tcp.as_deref(),
         args.link.port.as_deref(),
         args.link.baud,
-        &args.bus_addresses,
+        probe,
         crate::millis(args.timeout),
     )?;
+    for a in target.missing() {
+        eprintln!("tmclsim ide: no module answered at address {a}: left out");
+    }
     use tmclsim_web::Target;
     let names: Vec<String> = target.modules().iter().map(|m| format!("{} at address {}", m.firmware, m.address)).collect();
     let link = target.describe();

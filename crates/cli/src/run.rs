@@ -263,7 +263,7 @@ fn summary(m: &Module, program: &tmclsim_asm::Program, wall: std::time::Duration
         t / wall.as_secs_f64().max(1e-9),
         p.executed
     );
-    let at = crate::debugger::place(program, p.pc);
+    let at = crate::debugger::place(program, p.counter());
     println!("program: {:?} at {at}{}", p.mode, if p.wait.is_some() { ", waiting" } else { "" });
     inspect(m);
 }

@@ -276,3 +276,15 @@ fn a_long_run_is_quiet_when_stderr_is_no_terminal() {
     assert!(stderr.is_empty(), "no progress bar in a pipe: {stderr}");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+#[test]
+fn a_waiting_wait_is_where_the_debugger_stands_and_console_names_are_taken() {
+    let djnz = example("djnz_3_7_43.tmc");
+    // The step onto the WAIT starts it: the counter holds the WAIT's own
+    // address while it waits (docs/behaviour.md rule 35).
+    let t = debug(&djnz, &["--break", "djnz_3_7_43.tmc:8"], b"s\np pc\np AP actual_position\np GP tmcl_tick_timer\nq\n");
+    assert!(t.contains("djnz_3_7_43.tmc:8 (3)  WAIT TICKS, 0, 500 (waiting) >"), "{t}");
+    assert!(t.contains("> program counter = 3"), "{t}");
+    assert!(t.contains("AP 1 (Actual position) motor 0 = "), "{t}");
+    assert!(t.contains("GP 132 ("), "{t}");
+}

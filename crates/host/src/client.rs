@@ -58,6 +58,12 @@ impl Client {
         self.stream.write_all(&frame).map_err(|e| format!("write: {e}"))
     }
 
+    /// Reads one frame without sending anything (a late reply), within
+    /// the timeout.
+    pub fn read_reply(&mut self) -> Result<[u8; FRAME_LEN], String> {
+        self.read_frame()
+    }
+
     fn read_frame(&mut self) -> Result<[u8; FRAME_LEN], String> {
         let start = Instant::now();
         let mut buf = [0u8; FRAME_LEN];

@@ -126,6 +126,7 @@ pub fn router(app: App) -> Router {
         .route("/assets/{*path}", get(crate::assets::asset))
         .route("/api/info", get(info))
         .route("/api/modules", get(modules))
+        .route("/api/scan", post(scan))
         .route(&format!("{m}/profile"), get(profile))
         .route(&format!("{m}/command"), post(command))
         .route(&format!("{m}/read"), post(read))
@@ -135,6 +136,7 @@ pub fn router(app: App) -> Router {
         .route("/api/assemble", post(crate::program::assemble))
         .route(&format!("{m}/program/download"), post(crate::program::download))
         .route(&format!("{m}/program/state"), get(crate::program::state))
+        .route(&format!("{m}/program/source"), get(crate::program::source))
         .route(&format!("{m}/program/breakpoints"), post(crate::program::breakpoints))
         .route(&format!("{m}/program/{{action}}"), post(crate::program::action))
         .layer(axum::middleware::from_fn_with_state(app.clone(), crate::security::guard))
@@ -160,6 +162,21 @@ async fn modules(State(app): State<App>) -> Json<Value> {
     Json(Value::Array(list))
 }
 
+/// `POST /api/scan`: the modules that answer on a link target's link,
+/// whether or not the app lists them.
+async fn scan(State(app): State<App>) -> Result<Json<Value>, ApiError> {
+    if (0..app.target.modules().len()).any(|id| app.is_downloading(id)) {
+        return Err(ApiError(StatusCode::CONFLICT, "a program is being downloaded: scan when it is done".into()));
+    }
+    let listed: Vec<u8> = app.target.modules().iter().map(|m| m.address).collect();
+    let found = blocking(move || app.target.scan()).await??;
+    let list: Vec<Value> = found
+        .iter()
+        .map(|f| json!({"address": f.address, "firmware": f.firmware, "profile": f.profile, "listed": listed.contains(&f.address)}))
+        .collect();
+    Ok(Json(json!({ "modules": list })))
+}
+
 async fn profile(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
     let p = app.profile(id)?.ok_or_else(|| ApiError(StatusCode::NOT_FOUND, "tmclsim has no profile of this module's type".into()))?;
     Ok(Json(crate::profile_json::of(&p)))
@@ -179,6 +196,15 @@ pub fn exchange(app: &App, id: usize, ins: Instruction) -> Result<Value, ApiErro
 
 fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8; FRAME_LEN]) -> Value {
     let value = i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]);
+    if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
+        // The reply is text from its second byte on: no status, no value.
+        let version = String::from_utf8_lossy(&raw[1..]).trim_end_matches('\0').to_string();
+        return json!({
+            "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
+            "status": null, "status_text": null, "value": null, "version": version,
+            "text": format!("version {version}"),
+        });
+    }
     json!({
         "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
         "status": raw[2], "status_text": crate::status_text(raw[2]), "value": value,

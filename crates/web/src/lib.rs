@@ -14,7 +14,7 @@ mod serve;
 pub mod target;
 pub mod virtual_target;
 
-pub use link_target::LinkTarget;
+pub use link_target::{Found, LinkTarget, Probe};
 pub use serve::Limits;
 pub use target::{ModuleEntry, Target, TargetError};
 pub use virtual_target::VirtualTarget;

@@ -144,6 +144,37 @@ pub async fn download(State(app): State<App>, Path(id): Path<usize>, Json(b): Js
     Ok(([(header::CONTENT_TYPE, "application/x-ndjson")], Body::from_stream(stream)).into_response())
 }
 
+/// The module's program memory as 134 reads it, up to the program's end
+/// (the empty words after the last one are not part of it).
+fn read_program(app: &App, id: usize) -> Result<Vec<Instruction>, TargetError> {
+    let t = &app.target;
+    let address = t.modules().get(id).ok_or(TargetError::NoModule)?.address;
+    let words = app.profile(id).ok().flatten().map_or(u16::MAX, |p| p.module.program_memory);
+    let mut all = Vec::new();
+    for a in 0..i32::from(words) {
+        let raw = t.request(id, Instruction::new(opcode::READ_MEMORY, 0, 0, a))?;
+        if raw[1] == address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
+            // Past the memory's end (status 4), or code protection.
+            if a > 0 && raw[2] == Status::InvalidValue.code() {
+                break;
+            }
+            return Err(TargetError::Failed(format!("reading word {a}: status {} ({})", raw[2], crate::status_text(raw[2]))));
+        }
+        all.push(Instruction::from_bytes(raw[1..8].try_into().expect("seven bytes")));
+    }
+    let end = all.iter().rposition(|w| *w != Instruction::default()).map_or(0, |p| p + 1);
+    all.truncate(end);
+    Ok(all)
+}
+
+/// `GET program/source`: the program read back from the module (134),
+/// disassembled.
+pub async fn source(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
+    app.idle(id)?;
+    let words = blocking(move || read_program(&app, id)).await??;
+    Ok(Json(json!({"words": words.len(), "source": tmclsim_asm::disassemble(&words, None)})))
+}
+
 fn word(raw: &[u8; 9]) -> i32 {
     i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]])
 }
@@ -169,6 +200,11 @@ pub fn state_of(app: &App, id: usize) -> Result<Value, ApiError> {
         2 => "step",
         _ => "reset",
     };
+    // A breakpoint is where a stopped program stands: a stale hit (a run or
+    // continue under way, a counter read before the hit was noted) is not
+    // one.
+    let pc = (status & 0xFFFF) as u16;
+    let breakpoint = t.breakpoint_hit(id).filter(|&b| b == pc && mode != "running");
     let user: Vec<Option<i32>> = replies[3..].iter().map(|raw| (raw[2] >= 100).then(|| word(raw))).collect();
     let snap = t.snapshot(id);
     // The comparison flags JC tests (EQ/ZE, LT, GT) and the error flags.
@@ -188,11 +224,11 @@ pub fn state_of(app: &App, id: usize) -> Result<Value, ApiError> {
         f.join(" ")
     });
     Ok(json!({
-        "mode": mode, "pc": status & 0xFFFF, "waiting": (status >> 16) & 0xFF == 1,
+        "mode": mode, "pc": pc, "waiting": (status >> 16) & 0xFF == 1,
         "accumulator": accumulator, "x": x, "flags": flags,
         "errors": snap.as_ref().map(|s| s.program.errors),
         "stack_depth": snap.as_ref().map(|s| s.program.stack_depth),
-        "breakpoint": t.breakpoint_hit(id), "breakpoints": t.breakpoints(id), "user_variables": user,
+        "breakpoint": breakpoint, "breakpoints": t.breakpoints(id), "user_variables": user,
         "time": t.time(id),
     }))
 }

@@ -91,6 +91,10 @@ pub trait Target: Send + Sync + 'static {
     fn run(&self, id: usize, start: bool) -> Result<(), TargetError>;
     /// Stops a run that the target drives itself (breakpoints by steps).
     fn halt(&self, _id: usize) {}
+    /// Every module that answers on the link (136 at addresses 1…255).
+    fn scan(&self) -> Result<Vec<crate::link_target::Found>, TargetError> {
+        Err(TargetError::Unsupported("a scan looks for modules on a TMCL link; virtual modules are all in the module list".into()))
+    }
 }
 
 /// An error status in a reply as a failure.

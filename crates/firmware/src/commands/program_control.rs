@@ -30,6 +30,7 @@ impl Module {
                     self.program.stack.clear();
                     self.program.wait = None;
                     self.program.handler = None;
+                    self.program.hit_breakpoint = None;
                 }
                 self.start_program();
                 Ok(ok(from.unwrap_or(0)))

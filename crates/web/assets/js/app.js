@@ -1,7 +1,7 @@
 // The browser IDE: the module list on the left, one panel per tab. Every
 // command is a TMCL request through the server (crates/web/README.md).
 import { get, Live } from "./api.js";
-import { moduleList } from "./modules.js";
+import { moduleList, scanButton } from "./modules.js";
 import { DirectPanel } from "./direct.js";
 import { ParamsPanel } from "./params.js";
 import { MotionPanel } from "./motion.js";
@@ -70,6 +70,7 @@ async function main() {
     });
   }
   moduleList(modules, (id) => pick(modules, info, id));
+  scanButton(info);
   if (modules.length) await pick(modules, info, 0);
 }
 

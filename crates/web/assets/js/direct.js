@@ -96,7 +96,10 @@ export class DirectPanel {
     const r = await post(m(this.ctx.id, "command"), { line });
     if (r.error) entry.append(el("div", { class: "err", "data-testid": "direct-reply", text: r.error }));
     else {
-      entry.append(el("div", { class: r.status >= 100 ? "ok" : "err", "data-testid": "direct-reply", text: `${r.text}   [${r.status} ${r.status_text}]` }));
+      // 136 type 0 answers text in place of a status and a value.
+      const ok = r.version !== undefined || r.status >= 100;
+      const text = r.version !== undefined ? r.text : `${r.text}   [${r.status} ${r.status_text}]`;
+      entry.append(el("div", { class: ok ? "ok" : "err", "data-testid": "direct-reply", text }));
       entry.append(el("div", { class: "req", text: `  ${r.request}  →  ${r.reply}` }));
     }
     this.log.scrollTop = this.log.scrollHeight;

@@ -1,6 +1,6 @@
 // The module list: filterable, so that one among a thousand is found; only
 // the first matches are drawn.
-import { el } from "./api.js";
+import { el, post } from "./api.js";
 
 const SHOWN = 200;
 
@@ -43,4 +43,25 @@ export function moduleList(modules, onPick) {
   }
   filter.addEventListener("input", draw);
   draw();
+}
+
+/** The scan of a link target: every module that answers 136, with the
+ * ones the app does not list marked. */
+export function scanButton(info) {
+  document.getElementById("scan").hidden = info.target !== "link";
+  const list = document.getElementById("scan-list");
+  const button = document.getElementById("scan-go");
+  button.addEventListener("click", async () => {
+    button.disabled = true;
+    list.replaceChildren(el("li", { text: "scanning addresses 1…255…" }));
+    const r = await post("/api/scan").finally(() => (button.disabled = false));
+    if (r.error) return list.replaceChildren(el("li", { class: "error", text: r.error }));
+    list.replaceChildren(
+      el("li", { "data-testid": "scan-count", text: `${r.modules.length} module(s) answered` }),
+      ...r.modules.map((x) =>
+        el("li", { "data-testid": "scan-item" },
+          el("b", { text: `${x.profile ?? "unknown type"} · address ${x.address}` }),
+          el("small", { text: `${x.firmware}${x.listed ? "" : " · not listed: restart with --bus-addresses or --scan"}` }))),
+    );
+  });
 }

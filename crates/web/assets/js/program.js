@@ -4,7 +4,7 @@
 // addresses with the assembler's source map), the current line and the
 // interpreter's registers live.
 import "./tmcl-mode.js";
-import { post, postLines, el, m } from "./api.js";
+import { get, post, postLines, el, m } from "./api.js";
 
 const EXAMPLE = `// A shuttle: back and forth between two positions, counting the trips.
         SAP 4, 0, 1000          // maximum positioning speed
@@ -38,6 +38,7 @@ export class ProgramPanel {
     const on = (id, f) => document.getElementById(id).addEventListener("click", f);
     on("prog-assemble", () => this.assemble());
     on("prog-download", () => this.download());
+    on("prog-read", () => this.readBack());
     for (const action of ["run", "stop", "pause", "step", "continue", "reset"]) on(`prog-${action}`, () => this.act(action));
     this.message = document.getElementById("prog-message");
   }
@@ -120,6 +121,17 @@ export class ProgramPanel {
     await this.sendBreakpoints();
     if (last.verified) this.say(`downloaded ${last.words} words, verified by reading back (134)`);
     else this.say(`downloaded ${last.words} words, but reading them back (134) found a difference`, true);
+  }
+
+  /** The module's program (134), disassembled, in the editor. */
+  async readBack() {
+    this.say("reading the program memory (134)…");
+    const r = await get(m(this.ctx.id, "program/source"));
+    if (r.error) return this.say(r.error, true);
+    this.clearDiagnostics();
+    this.editor.setValue(r.source);
+    this.map = null;
+    this.say(`read ${r.words} words from the module; download it to debug with its lines`);
   }
 
   /** The first address at a line, or at the next line with an instruction. */
