@@ -177,7 +177,10 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>
 /// socket between frames and works for microseconds per frame. Elsewhere
 /// it stays at the normal priority.
 fn realtime() {
-    let param = libc::sched_param { sched_priority: 10 };
+    // SAFETY: an all-zero sched_param is valid (the C library's other
+    // fields, where it has any, mean "unused" at zero).
+    let mut param: libc::sched_param = unsafe { std::mem::zeroed() };
+    param.sched_priority = 10;
     // SAFETY: sets the scheduling of this thread with a valid parameter.
     let _ = unsafe { libc::pthread_setschedparam(libc::pthread_self(), libc::SCHED_FIFO, &param) };
 }
