@@ -156,3 +156,13 @@ fn a_line_past_4096_bytes_is_skipped_unheld_and_fails_the_script() {
     assert!(out.contains("> GAP 4, 0\nMaximum positioning speed (4) = "), "the next line is served: {out}");
     assert_eq!(o.status.code(), Some(1), "a skipped line fails the script");
 }
+
+#[test]
+fn comment_lines_are_skipped_and_raw_commands_are_not() {
+    let server = Server::start(&["--tcp", "127.0.0.1:0"]);
+    let script = "// set the speed first\n# then read it back\n#\nSAP 4, 0, 700\n#6 4 0 0\n";
+    let (code, out) = console(&["--tcp", &server.tcp()], script);
+    assert_eq!(code, Some(0), "comments are no failures: {out}");
+    assert!(out.contains("> #6 4 0 0\nMaximum positioning speed (4) = 700"), "a raw command still runs: {out}");
+    server.stop();
+}

@@ -159,8 +159,9 @@ impl Session {
         let words: Vec<&str> = text.split_whitespace().collect();
         match words.as_slice() {
             [] => {}
-            [c] if c.starts_with("//") => {}
-            [c, ..] if c.starts_with("//") => {}
+            // Comments: `// …`, and `#` followed by a space or nothing
+            // (`#136 0 0 0` is a raw command).
+            [c, ..] if c.starts_with("//") || *c == "#" => {}
             ["quit" | "exit" | "q"] => return Ok(false),
             ["help" | "?"] => println!("{HELP}"),
             ["help", topic] => println!("{}", self.help(topic)),
