@@ -3,20 +3,17 @@
 
 mod common;
 
-use common::{Served, eventually, get, post, post_text};
+use common::{Served, app_on_loopback, app_over_tcp, eventually, get, post, post_text};
 use serde_json::json;
 use std::sync::Arc;
 use std::time::Duration;
-use tmclsim_web::{LinkTarget, WebConfig};
+use tmclsim_web::LinkTarget;
 
 #[test]
 fn a_served_module_over_tcp_lists_answers_and_stops_at_breakpoints() {
     let s = Served::new();
     let tcp = s.tcp().to_string();
-    let target = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[1]), Duration::from_secs(1)).unwrap();
-    let web =
-        tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
-            .unwrap();
+    let web = app_over_tcp(&tcp);
     let url = |p: &str| format!("http://{}{p}", web.addr());
     let (_, list) = get(&url("/api/modules"));
     assert_eq!(
@@ -70,9 +67,7 @@ fn a_module_on_a_serial_port_is_reached_as_a_real_one() {
     let server = tmclsim_server::start(module, config).unwrap();
     let target =
         LinkTarget::open(None, Some(link.to_str().unwrap()), 9600, tmclsim_web::Probe::Addresses(&[1]), Duration::from_secs(1)).unwrap();
-    let web =
-        tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
-            .unwrap();
+    let web = app_on_loopback(Arc::new(target), Default::default());
     let url = |p: &str| format!("http://{}{p}", web.addr());
     let (_, list) = get(&url("/api/modules"));
     assert_eq!(list[0]["profile"], "TMCM-3110");
@@ -128,10 +123,7 @@ fn stops_every_time(url: &dyn Fn(&str) -> String) {
 fn a_breakpoint_by_steps_stops_every_time_the_loop_reaches_it() {
     let s = Served::new();
     let tcp = s.tcp().to_string();
-    let target = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[1]), Duration::from_secs(1)).unwrap();
-    let web =
-        tmclsim_web::start(Arc::new(target), WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits: Default::default() })
-            .unwrap();
+    let web = app_over_tcp(&tcp);
     stops_every_time(&|p: &str| format!("http://{}{p}", web.addr()));
 }
 

@@ -31,8 +31,7 @@ impl Served {
         let config = ServerConfig { tcp: Some("127.0.0.1:0".parse().unwrap()), warn_exposure: false, ..ServerConfig::default() };
         let server = tmclsim_server::start(module, config).unwrap();
         let target = Arc::new(VirtualTarget::new(server.links()));
-        let web = tmclsim_web::start(target, WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits }).unwrap();
-        Served { web, server }
+        Served { web: app_on_loopback(target, limits), server }
     }
 
     pub fn tcp(&self) -> SocketAddr {
@@ -47,6 +46,18 @@ impl Served {
     pub fn host(&self) -> TcpStream {
         TcpStream::connect(self.tcp()).unwrap()
     }
+}
+
+/// The app in front of `target` on a free loopback port.
+pub fn app_on_loopback(target: Arc<dyn tmclsim_web::Target>, limits: tmclsim_web::Limits) -> WebHandle {
+    tmclsim_web::start(target, WebConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false, limits }).unwrap()
+}
+
+/// The app over a TMCL link to the TCP endpoint `tcp`, with module 1 on it.
+pub fn app_over_tcp(tcp: &str) -> WebHandle {
+    let probe = tmclsim_web::Probe::Addresses(&[1]);
+    let target = tmclsim_web::LinkTarget::open(Some(tcp), None, 9600, probe, std::time::Duration::from_secs(1)).unwrap();
+    app_on_loopback(Arc::new(target), Default::default())
 }
 
 /// A JSON answer and its HTTP status, whatever the status.
