@@ -32,6 +32,8 @@ struct AxisSeries {
 
 const WIDTH: u32 = 1200;
 const PANEL_HEIGHT: u32 = 230;
+/// The strip right of each panel that holds its legend.
+const LEGEND_WIDTH: u32 = 190;
 /// Points drawn per line at most; denser series are drawn as their
 /// minimum and maximum per slice of time, so that no extreme is lost.
 const MAX_POINTS: usize = 4000;
@@ -206,11 +208,14 @@ where
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
     for (panel, area) in panels.iter().zip(root.split_evenly((panels.len(), 1))) {
+        // The legend has a strip of its own, right of the plot: it never
+        // covers a curve.
+        let (area, legend) = area.split_horizontally(area.dim_in_pixel().0.saturating_sub(LEGEND_WIDTH));
         let (lo, hi) = range(panel.lines.iter().flat_map(|(_, _, p)| p.iter().map(|q| q.1)));
         let mut chart = ChartBuilder::on(&area)
             .caption(&panel.title, ("sans-serif", 16))
             .margin(8)
-            .margin_right(24)
+            .margin_right(16)
             .x_label_area_size(34)
             .y_label_area_size(70)
             .build_cartesian_2d(t0..t1, lo..hi)
@@ -226,24 +231,23 @@ where
             .y_label_formatter(&|v| if (hi - lo) >= 10.0 { format!("{v:.0}") } else { format!("{v:.2}") })
             .draw()
             .map_err(e)?;
-        for (name, color, points) in &panel.lines {
-            let color = *color;
-            chart
-                .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
-                .map_err(e)?
-                .label(name.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        for (_, color, points) in &panel.lines {
+            chart.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2))).map_err(e)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(e)?;
+        draw_legend(&legend, &panel.lines).map_err(e)?;
     }
     root.present().map_err(e)
+}
+
+/// A panel's legend, top down in its strip: a short line of each curve's
+/// colour, then its name.
+fn draw_legend<DB: DrawingBackend>(strip: &DrawingArea<DB, Shift>, lines: &[Line]) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    for (k, (name, color, _)) in lines.iter().enumerate() {
+        let y = 36 + 20 * k as i32;
+        strip.draw(&PathElement::new(vec![(0, y), (18, y)], color.stroke_width(2)))?;
+        strip.draw(&Text::new(name.as_str(), (24, y - 7), ("sans-serif", 12)))?;
+    }
+    Ok(())
 }
 
 /// The y range of a panel, with a margin; a flat line gets ±1.

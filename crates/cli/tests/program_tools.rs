@@ -109,6 +109,21 @@ fn run_plots_svg_with_labelled_axes_and_samples_at_a_fixed_step() {
     for label in ["time (s)", "µsteps", "actual position (AP 1)", "target position (AP 0)", "actual speed (AP 3)", "axis 0: velocity"] {
         assert!(text_svg.contains(label), "{label} missing");
     }
+    // The legend stands right of the curves, never on them: the actual
+    // position's curve (blue, 2 px, many points) ends left of its name.
+    let curve_right = text_svg
+        .split("<polyline")
+        .filter(|p| p.contains("stroke=\"#1F77B4\" stroke-width=\"2\""))
+        .filter_map(|p| p.split("points=\"").nth(1)?.split('"').next())
+        .filter(|points| points.split_whitespace().count() > 2)
+        .flat_map(|points| points.split_whitespace().filter_map(|xy| xy.split(',').next()?.parse::<f64>().ok()).collect::<Vec<_>>())
+        .fold(f64::MIN, f64::max);
+    let name_x: f64 = text_svg
+        .split("<text x=\"")
+        .find(|p| p.split("</text>").next().and_then(|t| t.split('>').nth(1)).is_some_and(|t| t.trim() == "actual position (AP 1)"))
+        .and_then(|p| p.split('"').next()?.parse().ok())
+        .expect("the legend names the actual position");
+    assert!(curve_right > 500.0 && name_x > curve_right, "legend at x {name_x}, curve up to x {curve_right}");
     // The time axis is the window: its ticks (centred under the axis) run
     // from 5 to 15 s.
     let ticks: Vec<f64> = text_svg
