@@ -1,8 +1,11 @@
 //! Where a module is, as the command line names it: `--tcp` or `--port`,
 //! and its address. The link itself is `tmclsim_host::Client`.
 
+use std::sync::Arc;
 use std::time::Duration;
+use tmclsim_firmware::Profile;
 pub use tmclsim_host::{Client, hex};
+use tmclsim_protocol::{Instruction, opcode};
 
 /// A link to modules (a tmclsim server or real ones): TCP or a serial port.
 #[derive(clap::Args)]
@@ -40,4 +43,20 @@ impl LinkArgs {
 /// one did, not a link that failed.
 pub fn unanswered(error: &str) -> bool {
     error.starts_with("no reply") || error.starts_with("only ") || error.ends_with("has a wrong checksum")
+}
+
+/// The profile named, or the one of the type the module reports.
+pub fn profile(client: &mut Client, named: Option<&str>) -> Result<Option<Arc<Profile>>, String> {
+    if let Some(name) = named {
+        return Profile::built_in(name).map(Some);
+    }
+    let reply = client.request(Instruction::new(opcode::FIRMWARE_VERSION, 1, 0, 0))?;
+    let type_number = (reply.value as u32) >> 16;
+    match Profile::built_in(&format!("tmcm-{type_number}")) {
+        Ok(p) => Ok(Some(p)),
+        Err(_) => {
+            println!("module type {type_number} has no profile in tmclsim: parameters by number only (--module names one)");
+            Ok(None)
+        }
+    }
 }

@@ -202,6 +202,7 @@ pub struct ServeArgs {
 }
 
 #[derive(Args)]
+#[command(after_long_help = world_commands())]
 pub struct WorldArgs {
     /// The control socket printed by `tmclsim serve`.
     #[arg(long, value_name = "ADDR")]
@@ -219,8 +220,13 @@ pub struct SendArgs {
     /// How long to wait for the reply, in milliseconds.
     #[arg(long, value_name = "MS", default_value_t = 1000)]
     pub timeout: u64,
-    /// The command: a mnemonic (`GAP 1, 0`, `MVP ABS, 0, 51200`) or a raw
-    /// instruction `#OPCODE TYPE MOTOR VALUE` (e.g. `#136 0 0 0`).
+    /// The module's profile, for parameter names (default: the one of the
+    /// type the module reports with 136, asked only for a name).
+    #[arg(long)]
+    pub module: Option<String>,
+    /// The command: a mnemonic (`GAP 1, 0`, `GAP actual_position, 0`,
+    /// `MVP ABS, 0, 51200`) or a raw instruction `#OPCODE TYPE MOTOR VALUE`
+    /// (e.g. `#136 0 0 0`).
     #[arg(required = true, num_args = 1.., value_name = "COMMAND")]
     pub command: Vec<String>,
 }
@@ -409,6 +415,12 @@ pub(crate) fn socket_address(text: &str) -> Result<SocketAddr, String> {
     all.iter().find(|a| a.is_ipv4()).or(all.first()).copied().ok_or_else(|| format!("'{text}' names no address"))
 }
 
+/// `tmclsim world --help`: the control commands, one per line.
+fn world_commands() -> String {
+    let items: Vec<&str> = tmclsim_firmware::world_command::help_items().collect();
+    format!("Commands (any may start with @ADDRESS: the module at that address on a bus; docs/world.md):\n  {}", items.join("\n  "))
+}
+
 fn world(args: WorldArgs) -> Result<ExitCode, String> {
     use std::io::{BufRead, Write};
     let mut s = std::net::TcpStream::connect(&args.control).map_err(|e| format!("cannot connect to {}: {e}", args.control))?;
@@ -424,7 +436,13 @@ fn world(args: WorldArgs) -> Result<ExitCode, String> {
         Ok(_) => {}
     }
     let Ok(line) = String::from_utf8(line) else { return Err(not_control()) };
-    print!("{line}");
+    // The list of commands comes as one line (the socket speaks in
+    // lines); it is printed a command per line.
+    if line.trim_end().strip_prefix("ok ") == Some(tmclsim_firmware::world_command::HELP) {
+        println!("ok\n{}", world_commands());
+    } else {
+        print!("{line}");
+    }
     Ok(if line.starts_with("ok") { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 

@@ -7,8 +7,22 @@ use tmclsim_protocol::{Reply, Request, Status, mnemonic, opcode};
 
 pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     let line = args.command.join(" ");
-    let ins = mnemonic::parse_line(&line).map_err(|e| format!("{line}: {e}"))?;
+    let parsed = mnemonic::parse_line(&line);
+    if let Err(e) = &parsed
+        && !has_name_operand(&line)
+    {
+        return Err(format!("{line}: {e}"));
+    }
     let mut client = args.link.open(crate::millis(args.timeout))?;
+    // A parameter's name needs the module's profile: named with --module,
+    // or the one of the type the module reports (136), asked only then.
+    let ins = match parsed {
+        Ok(ins) => ins,
+        Err(_) => {
+            let profile = crate::client::profile(&mut client, args.module.as_deref())?;
+            tmclsim_host::line::parse(&line, profile.as_deref()).map_err(|e| format!("{line}: {e}"))?
+        }
+    };
     println!("request: {}  ({})", hex(&Request::new(args.link.address, ins).encode()), mnemonic::format(ins));
     if ins.opcode == opcode::FACTORY_DEFAULTS {
         client.send_only(ins)?;
@@ -45,4 +59,15 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     let status = Status::from_code(r.status).map_or(format!("{} (unknown)", r.status), |s| s.to_string());
     println!("host {} module {} status {status} opcode {} ({}) value {}", r.host, r.module, r.opcode, opcode::name(r.opcode), r.value);
     Ok(if r.status < 100 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// Whether the line is a parameter command (SAP, GGP, …) whose type
+/// operand is a word, not a number: a parameter's name.
+fn has_name_operand(line: &str) -> bool {
+    match mnemonic::tokens(line).as_slice() {
+        [(_, head), (_, word), ..] => {
+            opcode::from_mnemonic(head).and_then(tmclsim_host::names::table_of).is_some() && mnemonic::parse_number(word).is_none()
+        }
+        _ => false,
+    }
 }

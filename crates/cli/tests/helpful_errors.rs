@@ -94,3 +94,44 @@ fn a_link_the_module_has_no_interface_for_is_refused() {
     assert_eq!(out.status.code(), Some(2), "{}", common::text(&out));
     assert!(common::text(&out).contains("TMCM-1310 has no RS-485 interface"), "{}", common::text(&out));
 }
+
+#[test]
+fn send_takes_parameter_names_as_the_console_does() {
+    let server = common::Server::start(&["--tcp", "127.0.0.1:0", "--log-frames"]);
+    let tcp = server.tcp();
+    let (code, text) = tmclsim(&["send", "--tcp", &tcp, "SAP", "maximum_positioning_speed,", "0,", "1234"]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(text.contains("(SAP 4, 0, 1234)") && text.contains("status 100 (ok)"), "{text}");
+    // The profile of the type the module reports (136 type 1) was asked,
+    // because a name was given.
+    assert_eq!(server.log_has("to 1: #136 1 0 0"), 1, "one 136 to find the profile");
+    let (code, text) = tmclsim(&["send", "--tcp", &tcp, "--module", "tmcm-1141", "GAP", "max_pos_speed", "0"]);
+    assert_eq!(code, Some(2), "{text}");
+    assert!(text.contains("column 5: the TMCM-1141 has no axis parameter 'max_pos_speed'"), "{text}");
+    let (code, text) = tmclsim(&["send", "--tcp", &tcp, "--module", "tmcm-1141", "GAP", "maximum_positioning_speed,", "0"]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(text.contains("value 1234"), "{text}");
+    // Numbers need no profile: no 136 is sent for them.
+    let (code, text) = tmclsim(&["send", "--tcp", &tcp, "GAP", "4,", "0"]);
+    assert!(code == Some(0) && text.contains("value 1234"), "{text}");
+    assert_eq!(server.log_has("to 1: #136 1 0 0"), 1, "still the one 136");
+    server.stop();
+}
+
+#[test]
+fn world_lists_its_commands_a_line_each_and_shows_the_load() {
+    let (code, text) = tmclsim(&["world", "--help"]);
+    assert_eq!(code, Some(0), "{text}");
+    for command in ["  show [AXIS]", "  load AXIS TORQUE [FROM TO]", "  link mute on|off"] {
+        assert!(text.lines().any(|l| l == command), "{command} on a line of its own: {text}");
+    }
+    let server = common::Server::start(&["--tcp", "127.0.0.1:0"]);
+    let control = server.control();
+    let (code, text) = tmclsim(&["world", "--control", &control, "help"]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(text.lines().any(|l| l == "  switch AXIS left|right|home press|release|auto"), "{text}");
+    assert_eq!(tmclsim(&["world", "--control", &control, "load", "0", "80"]).0, Some(0));
+    let (code, text) = tmclsim(&["world", "--control", &control, "show"]);
+    assert!(code == Some(0) && text.trim_end().ends_with("load 80 %"), "{text}");
+    server.stop();
+}

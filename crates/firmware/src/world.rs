@@ -89,7 +89,8 @@ impl AxisWorld {
     /// The torque demand at a mechanical position and time (sum of the
     /// loads that apply).
     pub fn load_at(&self, mech: f64, t_s: f64) -> f64 {
-        self.loads.iter().filter(|l| l.applies(mech, t_s)).map(|l| l.torque).sum()
+        // A fold from +0.0: an empty float sum is -0.0.
+        self.loads.iter().filter(|l| l.applies(mech, t_s)).fold(0.0, |sum, l| sum + l.torque)
     }
 
     /// `mech` held within the end stops (unchanged without them). Unlike

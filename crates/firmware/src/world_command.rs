@@ -14,6 +14,13 @@ switch AXIS left|right|home press|release|auto | place AXIS left|right POSITION 
 place AXIS carriage POSITION | reset | travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \
 link drop N | link corrupt N | link delay MS | link mute on|off | link clear | show [AXIS] | help";
 
+/// The commands of [`HELP`], one per item, without the `[@ADDRESS]`
+/// that any of them may start with (for a help page that lists them a
+/// line each).
+pub fn help_items() -> impl Iterator<Item = &'static str> {
+    HELP.trim_start_matches("commands: [@ADDRESS] ").split(" | ")
+}
+
 /// One of the three switches of an axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SwitchKind {
@@ -291,8 +298,9 @@ impl WorldCommand {
                 let mut out = format!("time {:.3} s", m.now_ns() as f64 * 1e-9);
                 for a in list {
                     let (l, r, h) = m.switches(a);
+                    let load = m.world().axes[a].load_at(m.mechanical_position(a), m.now_ns() as f64 * 1e-9);
                     out.push_str(&format!(
-                        "; axis {a}: position {} carriage {:.1} speed {} left {} right {} home {}",
+                        "; axis {a}: position {} carriage {:.1} speed {} left {} right {} home {} load {load} %",
                         m.actual_position(a),
                         m.mechanical_position(a),
                         m.actual_speed(a),

@@ -32,6 +32,10 @@ fn control_lines_change_the_world_and_the_link() {
     assert_eq!(say("temperature 130"), "ok");
     assert_eq!(say("fault 0 open-a on"), "ok");
     assert!(say("show").contains("home 0"));
+    let shown = say("show");
+    assert!(shown.contains("load 0 %"), "no load yet: {shown}");
+    assert_eq!(say("load 0 80"), "ok");
+    assert!(say("show 0").ends_with("home 0 load 80 %"), "the load the world puts on the axis");
     assert!(say("input x 1").starts_with("error: 'x' is not a valid input number"));
     assert!(say("switch 3 left press").contains("axis 3 does not exist"));
     assert!(say("frobnicate").starts_with("error: unknown command"));

@@ -11,7 +11,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use tmclsim_firmware::Profile;
 use tmclsim_host::{line, names, reply};
-use tmclsim_protocol::{Instruction, mnemonic, opcode};
+use tmclsim_protocol::{mnemonic, opcode};
 
 #[derive(clap::Args)]
 pub struct ConsoleArgs {
@@ -38,7 +38,7 @@ Tab completes mnemonics, symbols and parameter names.";
 
 pub fn run(args: ConsoleArgs) -> Result<ExitCode, String> {
     let mut client = args.link.open(crate::millis(args.timeout))?;
-    let profile = profile(&mut client, args.module.as_deref())?;
+    let profile = crate::client::profile(&mut client, args.module.as_deref())?;
     let link = args.link.link.tcp.as_deref().map_or_else(|| args.link.link.port.clone().unwrap_or_default(), |t| format!("TCP {t}"));
     match &profile {
         Some(p) => println!(
@@ -98,22 +98,6 @@ fn read_line(input: &mut impl BufRead, max: usize) -> std::io::Result<Option<Opt
         input.consume(taken + usize::from(ended));
         if ended {
             return Ok(Some((!too_long).then(|| String::from_utf8_lossy(&line).trim_end_matches('\r').to_string())));
-        }
-    }
-}
-
-/// The profile named, or the one of the type the module reports.
-fn profile(client: &mut crate::client::Client, named: Option<&str>) -> Result<Option<Arc<Profile>>, String> {
-    if let Some(name) = named {
-        return Profile::built_in(name).map(Some);
-    }
-    let reply = client.request(Instruction::new(opcode::FIRMWARE_VERSION, 1, 0, 0))?;
-    let type_number = (reply.value as u32) >> 16;
-    match Profile::built_in(&format!("tmcm-{type_number}")) {
-        Ok(p) => Ok(Some(p)),
-        Err(_) => {
-            println!("module type {type_number} has no profile in tmclsim: parameters by number only (--module names one)");
-            Ok(None)
         }
     }
 }
