@@ -9,6 +9,7 @@ import { ChartsPanel } from "./charts.js";
 import { IoPanel } from "./io.js";
 import { ProgramPanel } from "./program.js";
 import { WorldPanel } from "./world.js";
+import { unitControls } from "./units.js";
 
 const panels = {
   direct: new DirectPanel(),
@@ -19,27 +20,37 @@ const panels = {
   program: new ProgramPanel(),
   world: new WorldPanel(),
 };
+// Read by the tests.
+window.tmclsimCharts = panels.charts;
 let active = "direct";
 let live = null;
-let parts = [];
+// Per subscription id: which panel's signals are where in a sample.
+const layouts = new Map();
+let subscription = 0;
 
 function resubscribe(ctx) {
-  // Every panel's signals in one subscription; each gets its slice back.
-  parts = [];
+  // Every panel's signals in one subscription; each gets its slice back,
+  // with the signals it asked for in that subscription.
+  const parts = [];
   const signals = [];
   for (const [name, p] of Object.entries(panels)) {
     const s = p.signals ? p.signals() : [];
-    parts.push([name, signals.length, s.length]);
+    parts.push({ name, start: signals.length, signals: s });
     signals.push(...s);
   }
-  live.subscribe({ signals, rate: panels.charts.rate(), program: active === "program" });
+  subscription += 1;
+  layouts.set(subscription, parts);
+  live.subscribe({ signals, rate: panels.charts.rate(), program: active === "program", id: subscription });
 }
 
 function onSample(msg) {
-  if (msg.error) return;
-  for (const [name, start, n] of parts) {
+  const parts = layouts.get(msg.sub);
+  if (msg.error || !parts) return;
+  // Samples of older subscriptions will not come any more.
+  for (const id of layouts.keys()) if (id < msg.sub) layouts.delete(id);
+  for (const { name, start, signals } of parts) {
     const p = panels[name];
-    if (p.onSample) p.onSample(msg.t, msg.values.slice(start, start + n), msg);
+    if (p.onSample) p.onSample(msg.t, msg.values.slice(start, start + signals.length), msg, signals);
   }
 }
 
@@ -56,6 +67,7 @@ async function pick(modules, info, id) {
 }
 
 async function main() {
+  unitControls(document.getElementById("units"), document.getElementById("fullsteps"));
   const info = await get("/api/info");
   document.getElementById("target").textContent = `${info.target === "virtual" ? "virtual modules" : "TMCL link"} · ${info.link}`;
   const modules = await get("/api/modules");
