@@ -29,14 +29,22 @@ const layouts = new Map();
 let subscription = 0;
 
 function resubscribe(ctx) {
-  // Every panel's signals in one subscription; each gets its slice back,
-  // with the signals it asked for in that subscription.
+  // Every panel's signals in one subscription, each signal read once; each
+  // panel gets its own back, with the signals it asked for then.
   const parts = [];
   const signals = [];
+  const at = new Map();
   for (const [name, p] of Object.entries(panels)) {
-    const s = p.signals ? p.signals() : [];
-    parts.push({ name, start: signals.length, signals: s });
-    signals.push(...s);
+    const asked = p.signals ? p.signals() : [];
+    const indices = asked.map((x) => {
+      const key = `${x.kind}:${x.index}:${x.number}`;
+      if (!at.has(key)) {
+        at.set(key, signals.length);
+        signals.push(x);
+      }
+      return at.get(key);
+    });
+    parts.push({ name, indices, signals: asked });
   }
   subscription += 1;
   layouts.set(subscription, parts);
@@ -48,9 +56,9 @@ function onSample(msg) {
   if (msg.error || !parts) return;
   // Samples of older subscriptions will not come any more.
   for (const id of layouts.keys()) if (id < msg.sub) layouts.delete(id);
-  for (const { name, start, signals } of parts) {
+  for (const { name, indices, signals } of parts) {
     const p = panels[name];
-    if (p.onSample) p.onSample(msg.t, msg.values.slice(start, start + signals.length), msg, signals);
+    if (p.onSample) p.onSample(msg.t, indices.map((i) => msg.values[i]), msg, signals);
   }
 }
 
