@@ -120,3 +120,26 @@ def shot(page, name):
 def pytest_terminal_summary(terminalreporter):
     if TAKEN:
         terminalreporter.write_line(f"screenshots: {len(TAKEN)} in {SHOTS}")
+
+
+def downloaded(page, testid):
+    """The bytes of the file a click on `testid` downloads."""
+    with page.expect_download() as d:
+        page.click(f"[data-testid={testid}]")
+    return pathlib.Path(d.value.path()).read_bytes()
+
+
+def csv_rows(page, testid):
+    """The CSV a click on `testid` downloads, as lists of cells."""
+    return [line.split(",") for line in downloaded(page, testid).decode().splitlines()]
+
+
+def series(page, key):
+    """The charts' samples of one signal (`ap:0:1`: AP 1 of motor 0), as
+    kept: None where it was not read."""
+    return page.evaluate("(k) => window.tmclsimCharts.store.get(k)", key)
+
+
+def wait_samples(page, n):
+    """Until the charts hold at least `n` samples."""
+    page.wait_for_function(f"window.tmclsimCharts.t.length >= {n}")

@@ -10,7 +10,7 @@ import urllib.error
 import urllib.request
 
 import pytest
-from conftest import open_app, shot, tab
+from conftest import csv_rows, downloaded, open_app, series, shot, tab, wait_samples
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1141
 
@@ -275,11 +275,10 @@ def test_a_foreign_origin_is_refused(served):
         assert "refused" in json.loads(e.read())["error"]
 
 
-def test_a_drag_zooms_the_charts_and_pauses_them(served, page):
+def test_a_drag_zooms_and_pauses_the_view_while_the_samples_keep_coming(served, page):
     open_app(page, served.url)
     tab(page, "charts")
-    page.wait_for_function("/\\d+ samples/.test(document.querySelector('[data-testid=chart-info]').textContent)")
-    page.wait_for_timeout(1500)
+    wait_samples(page, 50)
     box = page.locator("[data-testid=chart-position] .u-over").bounding_box()
     y = box["y"] + box["height"] / 2
     page.mouse.move(box["x"] + box["width"] * 0.2, y)
@@ -287,11 +286,75 @@ def test_a_drag_zooms_the_charts_and_pauses_them(served, page):
     page.mouse.move(box["x"] + box["width"] * 0.6, y, steps=5)
     page.mouse.up()
     assert page.inner_text("[data-testid=chart-pause]") == "Resume"
-    info = page.inner_text("[data-testid=chart-info]")
-    page.wait_for_timeout(400)
-    assert page.inner_text("[data-testid=chart-info]") == info, "paused: no redraw"
+    view = "(() => { const u = window.tmclsimCharts.charts[0]; return [u.data[0].length, u.scales.x.min, u.scales.x.max]; })()"
+    kept = page.evaluate("window.tmclsimCharts.t.length")
+    frozen = page.evaluate(view)
+    page.wait_for_timeout(1000)
+    assert page.evaluate(view) == frozen, "paused and zoomed: the view stays"
+    assert page.evaluate("window.tmclsimCharts.t.length") >= kept + 20, "paused: the samples keep coming"
     page.click("[data-testid=chart-pause]")
-    page.wait_for_function(f"document.querySelector('[data-testid=chart-info]').textContent !== {info!r}")
+    page.wait_for_function(f"window.tmclsimCharts.charts[0].data[0].length > {frozen[0]}")
+    # The samples taken while paused are drawn: no hole in the time axis.
+    t = page.evaluate("window.tmclsimCharts.charts[0].data[0]")
+    assert max(b - a for a, b in zip(t, t[1:])) < 0.3, "a hole where the view was paused"
+
+
+def test_an_added_signal_starts_with_gaps_never_an_invented_zero(served, page):
+    open_app(page, served.url)
+    tab(page, "charts")
+    wait_samples(page, 20)
+    page.select_option("[data-testid=chart-add]", "ap:0:4")
+    page.wait_for_function("(window.tmclsimCharts.store.get('ap:0:4') || []).filter((v) => v !== null).length >= 20")
+    added, position = page.evaluate("['ap:0:4', 'ap:0:1'].map((k) => window.tmclsimCharts.store.get(k))")
+    # The maximum positioning speed is 1000 from power-up: every value
+    # read is 1000, and before the signal was added there are gaps.
+    assert added[0] is None, "nothing was read before the signal was added"
+    assert {v for v in added if v is not None} == {1000}, "a value that was never read"
+    assert len(position) == len(added) and position[0] is not None, "the other series go on"
+    head, *rows = csv_rows(page, "chart-added-csv")
+    assert head == ["t_s", "Maximum positioning speed (AP 4) [int]"]
+    assert rows[0][1] == "" and rows[-1][1] == "1000", "a gap is an empty cell"
+
+
+def test_each_scale_group_has_its_own_axis(served, page):
+    open_app(page, served.url)
+    tab(page, "charts")
+    wait_samples(page, 20)
+    page.wait_for_timeout(300)
+    axes = page.evaluate("""Object.fromEntries(window.tmclsimCharts.charts.map((u) => [u.panel.title,
+        u.axes.slice(1).map((a) => ({ scale: a.scale, label: a.label, min: u.scales[a.scale].min, max: u.scales[a.scale].max }))]))""")
+    drawn_on = page.evaluate("Object.fromEntries(window.tmclsimCharts.charts.map((u) => [u.panel.title, u.series.slice(1).map((s) => s.scale)]))")
+    # Load (0…1023) and current (0…31) each on their own axis.
+    load = axes["Load and current"]
+    assert [a["label"] for a in load] == ["0…1023", "0…31"], load
+    assert drawn_on["Load and current"] == [load[0]["scale"], load[1]["scale"]] and load[0]["scale"] != load[1]["scale"]
+    # Switches (0/1) on an axis that spans 0 and 1, not 0…100.
+    [switches] = axes["Switches"]
+    assert switches["min"] > -1 and switches["max"] < 2, switches
+    assert drawn_on["Switches"] == [switches["scale"]] * 3
+    [position] = axes["Position"]
+    assert position["label"] == "µsteps" and drawn_on["Position"] == [position["scale"]] * 2, "actual and target share one axis"
+
+
+def test_every_chart_exports_png_and_csv(served, page):
+    open_app(page, served.url)
+    tab(page, "charts")
+    wait_samples(page, 50)
+    titles = page.evaluate("window.tmclsimCharts.panels.map((p) => p.title.toLowerCase().replace(/\\W+/g, '-'))")
+    assert titles == ["position", "velocity", "load-and-current", "switches", "outputs"]
+    for name in titles:
+        assert page.inner_text(f"[data-testid=chart-{name}-png]") == "PNG"
+        assert page.inner_text(f"[data-testid=chart-{name}-csv]") == "CSV"
+    png = downloaded(page, "chart-position-png")
+    assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 2000
+    head, *rows = csv_rows(page, "chart-position-csv")
+    assert head == ["t_s", "Actual position (AP 1)", "Target position (AP 0)"]
+    t = [float(r[0]) for r in rows]
+    # Seconds: 50 samples a second (the rate chosen) are 0.02 s apart.
+    steps = sorted(b - a for a, b in zip(t, t[1:]))
+    assert 0.01 < steps[len(steps) // 2] < 0.05, steps[len(steps) // 2]
+    head, *rows = csv_rows(page, "chart-switches-csv")
+    assert len(head) == 4 and all(set(r[1:]) <= {"0", "1"} for r in rows)
 
 
 FLEET = """world = "stage"
@@ -344,6 +407,7 @@ def test_charts_follow_a_chosen_motor_and_the_world_sets_an_analog_input(page, s
     served = start(["serve", "--module", "tmcm-6110", "--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0"])
     open_app(page, served.printed("web"))
     tab(page, "charts")
+    wait_samples(page, 10)
     page.select_option("[data-testid=chart-axis]", "2")
     with ConnectionManager(f"--interface socket_serial_tmcl --port {served.printed('tcp')}").connect() as interface:
         interface.send(1, 0, 2, 300)  # ROR 2, 300
@@ -355,14 +419,16 @@ def test_charts_follow_a_chosen_motor_and_the_world_sets_an_analog_input(page, s
         assert speed == 300
         other = interface.get_axis_parameter(3, 0)
     page.wait_for_timeout(500)
-    with page.expect_download() as d:
-        page.click("[data-testid=chart-csv]")
-    csv = open(d.value.path()).read().splitlines()
-    head = csv[0].split(",")
-    assert "Actual speed (AP 3; motor 2)" in head, head
+    # Motor 2's series start where it was chosen, with gaps before (never a
+    # 0 that was not read); motor 0's samples are kept.
+    motor2, motor0 = series(page, "ap:2:3"), series(page, "ap:0:3")
+    assert motor2[0] is None and motor2[-1] == 300
+    assert motor0[0] == 0 and motor0[-1] is None
+    assert all(v is not None for v in motor2[motor2.index(300):]), "read every sample since"
+    head, *rows = csv_rows(page, "chart-csv")
+    assert "Actual speed (AP 3; motor 2) [int]" in head, head
     assert not any("motor 0" in h for h in head)
-    last = csv[-1].split(",")
-    assert int(last[head.index("Actual speed (AP 3; motor 2)")]) == 300 != other
+    assert int(rows[-1][head.index("Actual speed (AP 3; motor 2) [int]")]) == 300 != other
     # An ADC value set in the world is what GIO N, 1 reads in the IO panel.
     tab(page, "world")
     page.select_option("[data-testid=world-analog]", "4")
@@ -459,3 +525,66 @@ def test_a_link_is_scanned_a_program_read_back_and_the_version_shown(page, start
     page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.startsWith('read 4 words')")
     text = page.evaluate("() => window.tmclEditor.getValue()")
     assert "CALC ADD, 1" in text and "WAIT TICKS, 0, 50" in text and "JA " in text
+
+
+def cell(page, number):
+    return page.inner_text(f"[data-testid=value-ap-0-{number}]")
+
+
+def test_speeds_and_accelerations_convert_with_the_modules_formula(served, page):
+    """The example of docs/ide.md: AP 4 = 1678 and AP 5 = 100 with pulse
+    divisor 3, ramp divisor 7 and 256 microsteps (the TMCM-1141's
+    defaults), a 200-step motor."""
+    open_app(page, served.url)
+    page.select_option("[data-testid=units]", "internal")
+    page.fill("[data-testid=fullsteps]", "200")
+    page.dispatch_event("[data-testid=fullsteps]", "change")
+    with pytrinamic(served) as interface:
+        interface.set_axis_parameter(4, 0, 1678)
+        interface.set_axis_parameter(5, 0, 100)
+    tab(page, "params")
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '1678'")
+    page.select_option("[data-testid=units]", "pps")
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '51208.5'")
+    assert cell(page, 5) == "46566.1"
+    assert page.inner_text("[data-testid=row-ap-0-5] td:nth-child(5)") == "pps/s"
+    page.select_option("[data-testid=units]", "rpm")
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '60.01'")
+    assert cell(page, 5) == "54.5697"
+    assert page.inner_text("[data-testid=row-ap-0-4] td:nth-child(5)") == "rpm"
+    assert cell(page, 1) == "0", "a position is not converted"
+    # A 400-step motor turns at half the speed.
+    page.fill("[data-testid=fullsteps]", "400")
+    page.dispatch_event("[data-testid=fullsteps]", "change")
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '30.005'")
+    shot(page, "parameters-rpm")
+    # A value typed in rpm is sent in internal units: 30 rpm of a 200-step
+    # motor is 10 240 pps, 838.9 → 839.
+    page.fill("[data-testid=fullsteps]", "200")
+    page.dispatch_event("[data-testid=fullsteps]", "change")
+    page.fill("[data-testid=edit-ap-0-4]", "30")
+    page.click("[data-testid=set-ap-0-4]")
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '30.005'")
+    with pytrinamic(served) as interface:
+        assert interface.get_axis_parameter(4, 0) == 839
+    # The conversion follows the pulse divisor: 4 halves every speed.
+    page.fill("[data-testid=edit-ap-0-154]", "4")
+    page.click("[data-testid=set-ap-0-154]")
+    page.wait_for_function("document.querySelector('[data-testid=value-ap-0-4]').textContent === '15.0025'")
+    page.fill("[data-testid=edit-ap-0-154]", "3")
+    page.click("[data-testid=set-ap-0-154]")
+    # The motion panel takes and shows rpm; the chart draws them.
+    tab(page, "motion")
+    page.fill("[data-testid=rot-speed]", "60")
+    page.click("[data-testid=ror]")
+    page.wait_for_function("document.querySelector('[data-testid=motion-log]').textContent.includes('ROR 0, 1678')")
+    page.wait_for_function("document.querySelector('[data-testid=ro-speed]').textContent === '60.01'")
+    with pytrinamic(served) as interface:
+        assert interface.get_axis_parameter(2, 0) == 1678
+    tab(page, "charts")
+    page.wait_for_timeout(500)
+    velocity = page.evaluate("(() => { const u = window.tmclsimCharts.charts[1]; return [u.axes[1].label, u.data[1][u.data[1].length - 1]]; })()")
+    assert velocity[0] == "rpm" and abs(velocity[1] - 60.00996) < 1e-4, velocity
+    head, *rows = csv_rows(page, "chart-velocity-csv")
+    assert head == ["t_s", "Actual speed (AP 3) [rpm]"]
+    assert abs(float(rows[-1][1]) - 60.00996) < 1e-4

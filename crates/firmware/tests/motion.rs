@@ -231,3 +231,14 @@ fn an_hour_of_motion_in_one_advance() {
     let pos = m.axis(0).motion.x;
     assert!((pos - expected).abs() < 1.0, "{pos} vs {expected}");
 }
+
+/// The clock every built-in profile states is the one the ramp generator
+/// runs at, so the IDE's unit conversion (profile data) and the simulated
+/// motion agree.
+#[test]
+fn every_built_in_profile_states_the_clock_the_ramps_run_at() {
+    for name in tmclsim_profile::Profile::names() {
+        let p = tmclsim_profile::Profile::built_in(name).unwrap();
+        assert_eq!(p.features.motion_clock_hz as f64, motion::FCLK, "{name}");
+    }
+}

@@ -131,6 +131,10 @@ pub struct Features {
     pub baud_rates: Vec<u32>,
     /// The motor current (mA RMS) that AP 6 = 255 (100 %) means.
     pub full_scale_current_ma: u32,
+    /// The motion controller's clock (Hz): the f_CLK of the formulas that
+    /// turn velocity and acceleration values into microsteps per second
+    /// (docs/behaviour.md rule 23).
+    pub motion_clock_hz: u32,
 }
 
 fn yes_no(b: bool) -> String {
@@ -202,6 +206,7 @@ impl Features {
                 }
             }),
             ("full_scale_current_ma", format!("{} mA RMS", self.full_scale_current_ma)),
+            ("motion_clock_hz", format!("{} Hz", self.motion_clock_hz)),
         ]
     }
 
@@ -239,6 +244,9 @@ impl Features {
         }
         if self.full_scale_current_ma == 0 {
             return Err("features.full_scale_current_ma is 0".into());
+        }
+        if self.motion_clock_hz == 0 {
+            return Err("features.motion_clock_hz is 0".into());
         }
         if self.encoder_deviation_stop && self.encoder == Encoder::None {
             return Err("features.encoder_deviation_stop needs an encoder (features.encoder is \"none\")".into());
@@ -289,6 +297,7 @@ mod tests {
         assert_eq!(f.eeprom_magic, None);
         assert_eq!(f.shutdown_pin, None);
         assert_eq!(f.full_scale_current_ma, 1100);
+        assert_eq!(f.motion_clock_hz, 16_000_000, "manual 6.1.1");
         // GP 65 codes → bit/s; codes the module lacks fall back to code 0.
         assert_eq!(p.baud_rate(0), 9600);
         assert_eq!(p.baud_rate(7), 115_200);
@@ -397,7 +406,7 @@ mod tests {
         let readme = include_str!("../../../profiles/README.md");
         let p = Profile::built_in("tmcm-351").unwrap();
         let list = p.features.list();
-        assert_eq!(list.len(), 15);
+        assert_eq!(list.len(), 16);
         for (key, value) in &list {
             let row = if matches!(*key, "can" | "ethercat") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };
             assert!(readme.contains(&row), "{key} has no row in the README's features table");
@@ -406,6 +415,7 @@ mod tests {
         let get = |k: &str| list.iter().find(|(key, _)| *key == k).unwrap().1.clone();
         assert_eq!(get("eeprom_magic"), "GP 64 = 0xE4");
         assert_eq!(get("full_scale_current_ma"), "2800 mA RMS");
+        assert_eq!(get("motion_clock_hz"), "16000000 Hz");
         assert!(get("baud_rates").contains("codes 0…11"));
     }
 }

@@ -95,6 +95,19 @@ pub struct Parameter {
     /// When the values within `min…max` are not all valid: the valid
     /// ones, as inclusive ranges (e.g. AP 193's modes 1–8, 65–68, 133–136).
     pub ranges: Vec<(i64, i64)>,
+    /// What the value measures when it is a velocity or an acceleration in
+    /// the motion controller's units (docs/behaviour.md rule 23).
+    pub quantity: Option<Quantity>,
+}
+
+/// A parameter whose value is in the motion controller's units: converted
+/// to microsteps per second (or per second²) with the pulse and ramp
+/// divisors and `features.motion_clock_hz`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Quantity {
+    Velocity,
+    Acceleration,
 }
 
 impl Parameter {
@@ -241,6 +254,8 @@ struct ParameterRow {
     /// Valid values as inclusive `[from, to]` ranges within min…max.
     #[serde(default)]
     ranges: Vec<[i64; 2]>,
+    #[serde(default)]
+    quantity: Option<Quantity>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -359,6 +374,7 @@ impl Profile {
                     unit: row.unit.clone(),
                     note: row.note.clone(),
                     ranges: row.ranges.iter().map(|&[lo, hi]| (lo, hi)).collect(),
+                    quantity: row.quantity,
                 });
             }
             Ok(())

@@ -26,6 +26,10 @@ struct Subscription {
     rate: Option<f64>,
     #[serde(default)]
     program: bool,
+    /// Echoed in every sample of this subscription, so that the app knows
+    /// which signals a sample holds even while a new subscription is on its
+    /// way.
+    id: Option<u64>,
 }
 
 pub async fn live(ws: WebSocketUpgrade, State(app): State<App>, Path(id): Path<usize>) -> Response {
@@ -82,10 +86,13 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
                     // reads as program words: the stream pauses.
                     continue;
                 }
-                let (a, signals, program) = (app.clone(), sub.signals.clone(), sub.program);
+                let (a, signals, program, sub_id) = (app.clone(), sub.signals.clone(), sub.program, sub.id);
                 let take = move || {
                     let (values, t) = read_all(a.target.as_ref(), id, &signals).map_err(|e| e.to_string())?;
                     let mut out = json!({"t": t, "values": values});
+                    if let Some(s) = sub_id {
+                        out["sub"] = json!(s);
+                    }
                     if program {
                         out["program"] = crate::program::state_of(&a, id).map_err(|e| e.1)?;
                     }

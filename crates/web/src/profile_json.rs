@@ -1,10 +1,11 @@
 //! A module's profile as the app shows it: parameter tables with access,
-//! range, default and its source, ports, commands and the reference search
-//! modes by name.
+//! range, default and its source, ports, commands, the reference search
+//! modes by name, and what the unit conversion needs (which rows are
+//! velocities and accelerations, the motion controller's clock).
 
 use serde_json::{Value, json};
 use tmclsim_profile::ReferenceSearchFamily;
-use tmclsim_profile::{Parameter, PortDirection, Profile};
+use tmclsim_profile::{Parameter, PortDirection, Profile, Quantity};
 
 fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
     let a = &p.access;
@@ -19,6 +20,10 @@ fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
         "min": p.min, "max": p.max, "default": p.default, "default_source": source,
         "note": p.note, "storable": a.eeprom, "ranges": p.ranges,
         "snake": tmclsim_host::names::snake(&p.name),
+        "quantity": p.quantity.map(|q| match q {
+            Quantity::Velocity => "velocity",
+            Quantity::Acceleration => "acceleration",
+        }),
     });
     if let Some(b) = bank {
         v["bank"] = json!(b);
@@ -73,6 +78,7 @@ pub fn of(profile: &Profile) -> Value {
     json!({
         "name": m.name, "axes": m.axes, "program_memory": m.program_memory,
         "user_variables": m.user_variables, "commands": commands,
+        "motion_clock_hz": profile.features.motion_clock_hz,
         "axis_parameters": axis, "global_parameters": global,
         "inputs": port(PortDirection::Input), "outputs": port(PortDirection::Output),
         "reference_modes": reference_modes(profile.features.reference_search).into_iter().map(|(v, n)| json!({"value": v, "name": n})).collect::<Vec<_>>(),

@@ -38,6 +38,22 @@ fn the_profile_has_ranges_defaults_sources_and_reference_modes() {
 }
 
 #[test]
+fn the_profile_says_what_the_unit_conversion_needs() {
+    let s = Served::new();
+    let (_, p) = get(&s.url("/api/modules/0/profile"));
+    // TMCM-1141 manual 6.1.1: f_CLK = 16 MHz; AP 2, 3, 4, 130, 181, 182,
+    // 194, 195 are velocities, AP 5 an acceleration.
+    assert_eq!(p["motion_clock_hz"], 16_000_000);
+    let quantity = |n: i64| p["axis_parameters"].as_array().unwrap().iter().find(|r| r["number"] == n).unwrap()["quantity"].clone();
+    for n in [2, 3, 4, 130, 181, 182, 194, 195] {
+        assert_eq!(quantity(n), "velocity", "AP {n}");
+    }
+    assert_eq!(quantity(5), "acceleration");
+    assert_eq!(quantity(1), Value::Null, "a position is neither");
+    assert_eq!(quantity(154), Value::Null, "the pulse divisor is neither");
+}
+
+#[test]
 fn direct_mode_takes_names_and_answers_in_words() {
     let s = Served::new();
     let (code, r) = post(&s.url("/api/modules/0/command"), json!({"line": "SAP maximum_positioning_speed, 0, 1234"}));
@@ -186,6 +202,38 @@ fn the_live_socket_streams_positions_a_host_changes() {
         }
     }
     assert!(moved, "the position the host's MVP changes reaches the stream");
+}
+
+#[test]
+fn every_sample_names_the_subscription_it_was_read_for() {
+    let s = Served::new();
+    let url = format!("ws://{}/api/modules/0/live", s.web.addr());
+    let (mut ws, _) = tungstenite::connect(url).unwrap();
+    let one = json!({"signals": [{"kind": "ap", "number": 4, "index": 0}], "rate": 100, "id": 7});
+    ws.send(tungstenite::Message::Text(one.to_string().into())).unwrap();
+    let two =
+        json!({"signals": [{"kind": "ap", "number": 4, "index": 0}, {"kind": "ap", "number": 154, "index": 0}], "rate": 100, "id": 8});
+    ws.send(tungstenite::Message::Text(two.to_string().into())).unwrap();
+    // Samples of the first subscription may still come; each says which it
+    // is and has that subscription's signals; then only the second's come.
+    let mut seen_two = 0;
+    for _ in 0..200 {
+        let Ok(tungstenite::Message::Text(t)) = ws.read() else { continue };
+        let m: Value = serde_json::from_str(&t).unwrap();
+        let n = m["values"].as_array().unwrap().len();
+        match m["sub"].as_u64() {
+            Some(7) => assert_eq!((seen_two, n), (0, 1), "{m}"),
+            Some(8) => {
+                assert_eq!(m["values"], json!([1000, 3]), "AP 4 and AP 154 defaults");
+                seen_two += 1;
+                if seen_two == 3 {
+                    return;
+                }
+            }
+            other => panic!("sample without its subscription: {other:?} in {m}"),
+        }
+    }
+    panic!("the second subscription's samples did not come");
 }
 
 #[test]

@@ -97,3 +97,12 @@ export function axisOptions(select, profile) {
   const axes = profile ? profile.axes : 1;
   select.replaceChildren(...Array.from({ length: axes }, (_, i) => el("option", { value: String(i), text: String(i) })));
 }
+
+/** Saves `blob` as the file `name` (a download). */
+export function download(blob, name) {
+  const a = el("a", { href: URL.createObjectURL(blob), download: name });
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}

@@ -9,6 +9,7 @@ import { ChartsPanel } from "./charts.js";
 import { IoPanel } from "./io.js";
 import { ProgramPanel } from "./program.js";
 import { WorldPanel } from "./world.js";
+import { unitControls } from "./units.js";
 
 const panels = {
   direct: new DirectPanel(),
@@ -19,27 +20,45 @@ const panels = {
   program: new ProgramPanel(),
   world: new WorldPanel(),
 };
+// Read by the tests.
+window.tmclsimCharts = panels.charts;
 let active = "direct";
 let live = null;
-let parts = [];
+// Per subscription id: which panel's signals are where in a sample.
+const layouts = new Map();
+let subscription = 0;
 
 function resubscribe(ctx) {
-  // Every panel's signals in one subscription; each gets its slice back.
-  parts = [];
+  // Every panel's signals in one subscription, each signal read once; each
+  // panel gets its own back, with the signals it asked for then.
+  const parts = [];
   const signals = [];
+  const at = new Map();
   for (const [name, p] of Object.entries(panels)) {
-    const s = p.signals ? p.signals() : [];
-    parts.push([name, signals.length, s.length]);
-    signals.push(...s);
+    const asked = p.signals ? p.signals() : [];
+    const indices = asked.map((x) => {
+      const key = `${x.kind}:${x.index}:${x.number}`;
+      if (!at.has(key)) {
+        at.set(key, signals.length);
+        signals.push(x);
+      }
+      return at.get(key);
+    });
+    parts.push({ name, indices, signals: asked });
   }
-  live.subscribe({ signals, rate: panels.charts.rate(), program: active === "program" });
+  subscription += 1;
+  layouts.set(subscription, parts);
+  live.subscribe({ signals, rate: panels.charts.rate(), program: active === "program", id: subscription });
 }
 
 function onSample(msg) {
-  if (msg.error) return;
-  for (const [name, start, n] of parts) {
+  const parts = layouts.get(msg.sub);
+  if (msg.error || !parts) return;
+  // Samples of older subscriptions will not come any more.
+  for (const id of layouts.keys()) if (id < msg.sub) layouts.delete(id);
+  for (const { name, indices, signals } of parts) {
     const p = panels[name];
-    if (p.onSample) p.onSample(msg.t, msg.values.slice(start, start + n), msg);
+    if (p.onSample) p.onSample(msg.t, indices.map((i) => msg.values[i]), msg, signals);
   }
 }
 
@@ -56,6 +75,7 @@ async function pick(modules, info, id) {
 }
 
 async function main() {
+  unitControls(document.getElementById("units"), document.getElementById("fullsteps"));
   const info = await get("/api/info");
   document.getElementById("target").textContent = `${info.target === "virtual" ? "virtual modules" : "TMCL link"} · ${info.link}`;
   const modules = await get("/api/modules");

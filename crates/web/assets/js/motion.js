@@ -1,7 +1,9 @@
 // Motion: rotate, stop, move absolute/relative with a speed, reference
 // search with the mode chosen by name; the axis's position, speed and
-// switches from the live stream.
+// switches from the live stream. Speeds are shown and entered in the
+// page's unit, converted with the motor's divisors as last read.
 import { post, el, m, axisOptions } from "./api.js";
+import { factor, show as inUnit, toInternal, divisorReads, divisorsOf } from "./units.js";
 
 // AP 1 actual, AP 0 target position, AP 3 actual speed, AP 8 position
 // reached, AP 11 / 10 / 9 left, right and home switch.
@@ -12,16 +14,28 @@ export class MotionPanel {
     this.axis = document.getElementById("motion-axis");
     this.log = document.getElementById("motion-log");
     this.axis.addEventListener("change", () => this.ctx.resubscribe());
-    const speed = () => Number(document.getElementById("rot-speed").value);
+    // A speed typed in the page's unit, as the internal value sent.
+    const internal = (x) => {
+      const v = toInternal(Number(x), "velocity", this.ctx.profile?.motion_clock_hz, this.divisors);
+      if (v == null) this.log.append(el("div", { class: "err", text: "the motor's divisors (AP 140, 153, 154) are not read yet: no conversion" }));
+      return v;
+    };
+    const speed = () => internal(document.getElementById("rot-speed").value);
     const pos = () => Number(document.getElementById("mvp-value").value);
     const a = () => this.axis.value || "0";
     const on = (id, f) => document.getElementById(id).addEventListener("click", f);
-    on("rol", () => this.send(`ROL ${a()}, ${speed()}`));
-    on("ror", () => this.send(`ROR ${a()}, ${speed()}`));
+    const rotate = (how) => {
+      const v = speed();
+      if (v != null) this.send(`${how} ${a()}, ${v}`);
+    };
+    on("rol", () => rotate("ROL"));
+    on("ror", () => rotate("ROR"));
     on("mst", () => this.send(`MST ${a()}`));
     const move = async (how) => {
-      const v = document.getElementById("mvp-speed").value;
-      if (v !== "" && !(await this.send(`SAP 4, ${a()}, ${Number(v)}`))) return;
+      const typed = document.getElementById("mvp-speed").value;
+      const v = typed === "" ? "" : internal(typed);
+      if (v === null) return;
+      if (v !== "" && !(await this.send(`SAP 4, ${a()}, ${v}`))) return;
       await this.send(`MVP ${how}, ${a()}, ${pos()}`);
     };
     on("mvp-abs", () => move("ABS"));
@@ -53,15 +67,18 @@ export class MotionPanel {
 
   signals() {
     const index = Number(this.axis.value || 0);
-    return (this.readout ?? []).map((number) => ({ kind: "ap", number, index }));
+    return [...(this.readout ?? []).map((number) => ({ kind: "ap", number, index })), ...divisorReads(this.ctx?.profile, index)];
   }
 
-  onSample(t, values) {
-    const v = Object.fromEntries(this.readout.map((n, i) => [n, values[i]]));
+  onSample(t, values, msg, signals) {
+    const v = {};
+    signals.forEach((s, i) => (v[s.number] = values[i]));
+    this.divisors = divisorsOf(signals, values, signals[0]?.index);
+    const f = factor("velocity", this.ctx.profile?.motion_clock_hz, this.divisors);
     const show = (id, x) => (document.getElementById(id).textContent = x ?? "–");
     show("ro-position", v[1]);
     show("ro-target", v[0]);
-    show("ro-speed", v[3]);
+    show("ro-speed", v[3] == null ? undefined : f == null ? "–" : inUnit(v[3] * f));
     show("ro-reached", v[8] === undefined ? undefined : v[8] ? "yes" : "no");
     const sw = (x) => (x === undefined || x === null ? "–" : x ? "1" : "0");
     show("ro-switches", `${sw(v[11])} / ${sw(v[10])} / ${sw(v[9])}`);

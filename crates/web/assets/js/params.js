@@ -1,7 +1,10 @@
 // The parameter grid: the profile's axis and global parameters with their
 // live values, edited with validation against the range (SAP/SGP), stored
-// and restored (STAP/RSAP, STGP/RSGP). Values that change flash.
+// and restored (STAP/RSAP, STGP/RSGP). Values that change flash. Speeds and
+// accelerations are shown and typed in the page's unit, converted with the
+// motor's divisors read with the rows.
 import { post, el, m, axisOptions } from "./api.js";
+import { factor, show, toInternal, unitName, onUnits, divisorReads, divisorsOf } from "./units.js";
 
 const POLL_MS = 300;
 const INT_MIN = -2147483648;
@@ -21,6 +24,7 @@ export class ParamsPanel {
     this.filter.addEventListener("input", () => this.draw());
     this.axis.addEventListener("change", () => this.draw());
     for (const r of document.querySelectorAll("input[name=ptable]")) r.addEventListener("change", () => this.draw());
+    onUnits(() => this.draw());
     this.visible = false;
     // Only the rows on screen are read: a real module on a slow link answers
     // a few hundred requests a second at best.
@@ -75,15 +79,18 @@ export class ParamsPanel {
         const index = global ? r.bank : motor;
         const kind = global ? "gp" : "ap";
         const value = el("td", { class: "value", "data-testid": `value-${kind}-${index}-${r.number}`, text: "–" });
-        const input = el("input", { type: "number", "data-testid": `edit-${kind}-${index}-${r.number}`, step: "1" });
+        const input = el("input", { type: "number", "data-testid": `edit-${kind}-${index}-${r.number}`, step: r.quantity ? "any" : "1" });
         const set = el("button", { "data-testid": `set-${kind}-${index}-${r.number}`, text: "Set" });
         const writable = r.access.includes("W");
         input.disabled = set.disabled = !writable;
-        input.addEventListener("input", () => input.classList.toggle("invalid", input.value !== "" && !inRange(r, Number(input.value))));
+        // The typed value, in internal units (null: not a value).
+        const typedValue = () => (input.value === "" ? null : r.quantity ? toInternal(Number(input.value), r.quantity, p.motion_clock_hz, this.divisors) : Number(input.value));
+        input.addEventListener("input", () => input.classList.toggle("invalid", input.value !== "" && !inRange(r, typedValue())));
         const doSet = async () => {
-          const v = Number(input.value);
-          if (input.value === "" || !inRange(r, v)) {
-            this.say(`${r.name}: ${input.value} is outside ${r.min}…${r.max}${r.ranges.length ? " (" + r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") + ")" : ""}`, true);
+          const v = typedValue();
+          if (v === null || !inRange(r, v)) {
+            const where = r.quantity ? `${range.textContent} ${unitName(r.quantity)}` : `${r.min}…${r.max}${r.ranges.length ? " (" + r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") + ")" : ""}`;
+            this.say(v === null && input.value !== "" ? `${r.name}: the motor's divisors are not read yet` : `${r.name}: ${input.value} is outside ${where}`, true);
             input.classList.add("invalid");
             return;
           }
@@ -107,25 +114,39 @@ export class ParamsPanel {
             extra.append(b, " ");
           }
         }
-        const range = r.ranges.length ? r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") : r.min === INT_MIN && r.max === INT_MAX ? "signed 32 bit" : `${r.min}…${r.max}`;
+        const range = el("td", { class: "range", title: `${r.min}…${r.max}` });
+        const def = el("td", { class: "default", title: r.note ?? "" }, el("span"), " ", el("span", { class: `src src-${r.default_source}`, text: r.default_source }));
+        const unit = el("td", { text: r.quantity ? unitName(r.quantity) : (r.unit ?? "") });
+        const rangeText = r.ranges.length ? r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") : r.min === INT_MIN && r.max === INT_MAX ? "signed 32 bit" : `${r.min}…${r.max}`;
         const tr = el("tr", { "data-testid": `row-${kind}-${index}-${r.number}` },
           el("td", { class: "num", text: String(r.number) }),
           el("td", { class: "num bank", text: global ? String(r.bank) : "" }),
           el("td", { class: "name", text: r.name, title: r.note ?? "" }),
           value,
-          el("td", { text: r.unit ?? "" }),
+          unit,
           el("td", { text: r.access }),
-          el("td", { class: "range", text: range, title: `${r.min}…${r.max}` }),
-          el("td", { class: "default", title: r.note ?? "" }, String(r.default), " ", el("span", { class: `src src-${r.default_source}`, text: r.default_source })),
+          range,
+          def,
           el("td", { class: "actions" }, input, " ", set),
           extra);
-        this.rows.push({ r, kind, index, value, tr, readable: r.access.includes("R") });
+        const row = { r, kind, index, value, tr, readable: r.access.includes("R"), range, rangeText, def: def.firstChild };
+        this.rows.push(row);
+        this.inUnit(row);
         this.observer.observe(tr);
         return tr;
       }),
     );
     this.status.textContent = `${rows.length} parameters`;
     this.poll();
+  }
+
+  /** Range and default of a row, in the page's unit for a speed or an
+   * acceleration (as read with the last divisors). */
+  inUnit(x) {
+    const f = x.r.quantity ? factor(x.r.quantity, this.ctx.profile.motion_clock_hz, this.divisors) : 1;
+    const conv = (v) => (f === 1 ? String(v) : show(f == null ? null : v * f));
+    x.range.textContent = f === 1 ? x.rangeText : `${conv(x.r.min)}…${conv(x.r.max)}`;
+    x.def.textContent = conv(x.r.default);
   }
 
   answer(r, a) {
@@ -144,10 +165,18 @@ export class ParamsPanel {
     if (!rows.length) return;
     this.polling = true;
     try {
-      const a = await post(m(this.ctx.id, "read"), { reads: rows.map((x) => ({ kind: x.kind, number: x.r.number, index: x.index })) });
+      // The motor's divisors come with the rows, for the speeds among them.
+      const motor = rows[0].kind === "ap" ? rows[0].index : null;
+      const extra = motor === null ? [] : divisorReads(this.ctx.profile, motor);
+      const reads = [...extra, ...rows.map((x) => ({ kind: x.kind, number: x.r.number, index: x.index }))];
+      const a = await post(m(this.ctx.id, "read"), { reads });
       if (!a.values) return;
+      this.divisors = divisorsOf(extra, a.values, motor);
+      const values = a.values.slice(extra.length);
       rows.forEach((x, i) => {
-        const text = a.values[i] === null ? "error" : String(a.values[i]);
+        if (x.r.quantity) this.inUnit(x);
+        const f = x.r.quantity ? factor(x.r.quantity, this.ctx.profile.motion_clock_hz, this.divisors) : 1;
+        const text = values[i] === null ? "error" : f === 1 ? String(values[i]) : show(f == null ? null : values[i] * f);
         if (x.value.textContent !== text) {
           const changed = x.value.textContent !== "–";
           x.value.textContent = text;
