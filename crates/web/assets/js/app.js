@@ -1,7 +1,8 @@
 // The browser IDE: the module list on the left, one panel per tab. Every
-// command is a TMCL request through the server (crates/web/README.md).
-import { get, Live } from "./api.js";
-import { moduleList, scanButton } from "./modules.js";
+// command is a TMCL request through the target (api.js: the server, or the
+// playground's modules in the page).
+import { get, openLive } from "./api.js";
+import { moduleList, scanButton, addButton } from "./modules.js";
 import { DirectPanel } from "./direct.js";
 import { ParamsPanel } from "./params.js";
 import { MotionPanel } from "./motion.js";
@@ -50,7 +51,7 @@ async function pick(modules, info, id) {
   if (live) live.close();
   const ctx = { id, module: mod, profile, info, virtual: mod.virtual, resubscribe: () => resubscribe(ctx) };
   for (const p of Object.values(panels)) p.setModule(ctx);
-  live = new Live(id, onSample);
+  live = openLive(id, onSample);
   resubscribe(ctx);
   window.tmclsimReady = true;
 }
@@ -58,7 +59,7 @@ async function pick(modules, info, id) {
 async function main() {
   const info = await get("/api/info");
   document.getElementById("target").textContent = `${info.target === "virtual" ? "virtual modules" : "TMCL link"} · ${info.link}`;
-  const modules = await get("/api/modules");
+  let modules = await get("/api/modules");
   let ctxRef = null;
   for (const b of document.querySelectorAll("#tabs button")) {
     b.addEventListener("click", () => {
@@ -69,8 +70,13 @@ async function main() {
       if (live) resubscribe(ctxRef);
     });
   }
-  moduleList(modules, (id) => pick(modules, info, id));
+  const list = moduleList(modules, (id) => pick(modules, info, id));
   scanButton(info);
+  addButton(info, async (id) => {
+    modules = await get("/api/modules");
+    list.update(modules, id);
+    await pick(modules, info, id);
+  });
   if (modules.length) await pick(modules, info, 0);
 }
 
