@@ -6,22 +6,29 @@
 import init, * as tmclsim from "../tmclsim.js";
 import { useTarget } from "./api.js";
 
-await init();
-window.tmclsim = tmclsim;
-const page = new tmclsim.Playground();
-page.request("POST", "/api/modules", JSON.stringify({ profile: "tmcm-1141" }));
-
-// Virtual time moves with the wall clock; a tab in the background (timers
-// slowed down) loses time rather than catching up in one leap.
+// Virtual time moves with the wall clock, at most this much at once: a tab
+// in the background (timers slowed down) loses time rather than catching
+// up in one leap.
 const MAX_STEP_S = 0.25;
-let last = performance.now();
-setInterval(() => {
-  const now = performance.now();
-  page.advance(Math.min(MAX_STEP_S, (now - last) / 1000));
-  last = now;
-}, 10);
 
-const ask = (method, path, body) => JSON.parse(page.request(method, path, body === undefined ? "" : JSON.stringify(body)));
+// The WebAssembly loads while the app's modules do; requests wait for it.
+let page = null;
+const loaded = init().then(() => {
+  window.tmclsim = tmclsim;
+  page = new tmclsim.Playground();
+  page.request("POST", "/api/modules", JSON.stringify({ profile: "tmcm-1141" }));
+  let last = performance.now();
+  setInterval(() => {
+    const now = performance.now();
+    page.advance(Math.min(MAX_STEP_S, (now - last) / 1000));
+    last = now;
+  }, 10);
+});
+
+async function ask(method, path, body) {
+  await loaded;
+  return JSON.parse(page.request(method, path, body === undefined ? "" : JSON.stringify(body)));
+}
 
 /** The live stream of module `id`: a sample at the subscription's rate. */
 class PageLive {
@@ -35,7 +42,7 @@ class PageLive {
     clearInterval(this.timer);
     const hz = Math.min(100, Math.max(1, this.sub.rate || 20));
     this.timer = setInterval(() => {
-      if (this.sub.signals.length || this.sub.program) this.onSample(JSON.parse(page.sample(this.id, JSON.stringify(this.sub))));
+      if (page && (this.sub.signals.length || this.sub.program)) this.onSample(JSON.parse(page.sample(this.id, JSON.stringify(this.sub))));
     }, 1000 / hz);
   }
   subscribe(sub) {
@@ -48,10 +55,10 @@ class PageLive {
 }
 
 useTarget({
-  call: async (method, path, body) => ask(method, path, body),
+  call: ask,
   // A download's progress lines come as one array.
   postLines: async (path, body, onLine) => {
-    const answer = ask("POST", path, body);
+    const answer = await ask("POST", path, body);
     const lines = Array.isArray(answer) ? answer : [answer];
     lines.forEach(onLine);
     return lines[lines.length - 1];
