@@ -42,7 +42,7 @@ pub fn run(args: IdeArgs) -> Result<ExitCode, String> {
     use tmclsim_web::Target;
     let names: Vec<String> = target.modules().iter().map(|m| format!("{} at address {}", m.firmware, m.address)).collect();
     let link = target.describe();
-    let web = start(Arc::new(target), args.web, args.web_public)?;
+    let web = start(target, args.web, args.web_public)?;
     println!("tmclsim ide: {} on {link}", names.join(", "));
     println!("open: {}", web.url());
     use std::io::Write;

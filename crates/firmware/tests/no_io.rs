@@ -1,5 +1,5 @@
-//! The pure crates (protocol, profile, firmware, asm, and wasm, their
-//! JavaScript binding) do no I/O, so that
+//! The pure crates (protocol, profile, firmware, asm, ide, the browser
+//! IDE's answers, and wasm, their JavaScript binding) do no I/O, so that
 //! they build for `wasm32-unknown-unknown` (scripts/test builds them for
 //! it) and behave the same wherever they run: no files, sockets, threads,
 //! processes, environment or standard streams in their sources, and no
@@ -17,7 +17,7 @@ use rust_source::{Token, ident, rust_files, tokens, use_tree};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-const CRATES: [&str; 5] = ["protocol", "profile", "firmware", "asm", "wasm"];
+const CRATES: [&str; 6] = ["protocol", "profile", "firmware", "asm", "ide", "wasm"];
 
 /// Modules of `std` (`core`, `alloc`) that do I/O.
 const STD_IO: [&str; 6] = ["fs", "net", "thread", "os", "process", "env"];

@@ -4,9 +4,9 @@
 //! `trace` and the browser IDE.
 
 pub mod client;
-pub mod line;
-pub mod names;
-pub mod reply;
 pub mod trace;
+
+// Without I/O, so that the playground has them too.
+pub use tmclsim_ide::{line, names, reply};
 
 pub use client::{Client, hex};

@@ -1,6 +1,7 @@
 //! The JavaScript class `Module`: each method calls [`Sim`] and turns its
 //! values into JavaScript ones (plain objects, `Uint8Array`s, `Error`s).
 
+use crate::page::Page;
 use crate::sim::{Answer, Assembled, Failure, Sim, mode_name};
 use js_sys::{Array, Error, Object, Reflect};
 use wasm_bindgen::prelude::*;
@@ -162,5 +163,43 @@ impl JsModule {
     #[wasm_bindgen(js_name = takeEvents)]
     pub fn take_events(&mut self) -> Vec<js_sys::Uint8Array> {
         self.sim.take_events().iter().map(|e| js_sys::Uint8Array::from(&e[..])).collect()
+    }
+}
+
+/// The browser IDE's modules in the page: its API (crates/web/README.md)
+/// answered without a server, in JSON text.
+#[wasm_bindgen(js_name = Playground)]
+pub struct JsPlayground {
+    page: Page,
+}
+
+#[wasm_bindgen(js_class = Playground)]
+impl JsPlayground {
+    /// A playground without modules.
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> JsPlayground {
+        JsPlayground { page: Page::new() }
+    }
+
+    /// A request of the API (`"POST"`, `"/api/modules/0/command"`, the
+    /// body's JSON) → the answer's JSON; errors are `{"error": …}`.
+    pub fn request(&mut self, method: &str, path: &str, body: &str) -> String {
+        self.page.request(method, path, body).to_string()
+    }
+
+    /// One sample of module `id`'s live stream for a subscription's JSON.
+    pub fn sample(&self, id: usize, subscription: &str) -> String {
+        self.page.sample(id, subscription).to_string()
+    }
+
+    /// Moves every module's virtual time on by `seconds`.
+    pub fn advance(&mut self, seconds: f64) -> Result<(), JsValue> {
+        self.page.advance(seconds).map_err(error)
+    }
+}
+
+impl Default for JsPlayground {
+    fn default() -> JsPlayground {
+        JsPlayground::new()
     }
 }

@@ -5,8 +5,11 @@
 //!
 //! [`sim::Sim`] holds the logic in plain Rust (tested natively); the
 //! binding in `bindings.rs` turns its values into JavaScript ones.
+//! [`page::Page`] is the playground's side of the browser IDE: its API
+//! answered in the page, over `Sim`s (the class `Playground`).
 
 mod bindings;
+pub mod page;
 pub mod sim;
 
-pub use bindings::JsModule;
+pub use bindings::{JsModule, JsPlayground};

@@ -306,6 +306,17 @@ impl Sim {
         State { pc: program.counter(), mode: program.mode, accumulator: registers.accumulator, x: registers.x, executed: program.executed }
     }
 
+    /// Reads as an observer makes them (docs/behaviour.md rule 86): the
+    /// model's replies, `None` for what is not a read; nothing changes.
+    pub fn observe(&mut self, all: &[Instruction]) -> Vec<Option<[u8; FRAME_LEN]>> {
+        self.bus.observe(0, all)
+    }
+
+    /// The program's breakpoints: the firmware stops on them.
+    pub fn set_breakpoints(&mut self, addresses: &[u16]) {
+        self.bus.module_mut(0).set_breakpoints(addresses);
+    }
+
     /// A world command (docs/world.md): its answer, or what is wrong.
     pub fn world(&mut self, line: &str) -> Result<String, Failure> {
         match line.split_whitespace().next() {

@@ -12,8 +12,9 @@ use serde::Deserialize;
 use serde_json::{Value, json};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use tmclsim_ide::answers::{self, Read, Write};
 use tmclsim_profile::Profile;
-use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
+use tmclsim_protocol::Instruction;
 
 #[derive(Clone)]
 pub struct App {
@@ -148,18 +149,7 @@ async fn info(State(app): State<App>) -> Json<Value> {
 }
 
 async fn modules(State(app): State<App>) -> Json<Value> {
-    let virt = app.target.kind() == "virtual";
-    let list: Vec<Value> = app
-        .target
-        .modules()
-        .iter()
-        .enumerate()
-        .map(|(id, m)| {
-            json!({"id": id, "address": m.address, "profile": m.profile.as_ref().map(|p| p.module.name.clone()),
-                   "firmware": m.firmware, "link": m.link, "virtual": virt})
-        })
-        .collect();
-    Json(Value::Array(list))
+    Json(answers::modules_json(app.target.as_ref()))
 }
 
 /// `POST /api/scan`: the modules that answer on a link target's link,
@@ -179,37 +169,12 @@ async fn scan(State(app): State<App>) -> Result<Json<Value>, ApiError> {
 
 async fn profile(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
     let p = app.profile(id)?.ok_or_else(|| ApiError(StatusCode::NOT_FOUND, "tmclsim has no profile of this module's type".into()))?;
-    Ok(Json(crate::profile_json::of(&p)))
-}
-
-pub fn hex(b: &[u8]) -> String {
-    b.iter().map(|x| format!("{x:02x}")).collect::<Vec<_>>().join(" ")
+    Ok(Json(tmclsim_ide::profile_json::of(&p)))
 }
 
 /// A request and its reply as the app shows them.
 pub fn exchange(app: &App, id: usize, ins: Instruction) -> Result<Value, ApiError> {
-    let address = app.address(id)?;
-    let profile = app.profile(id)?;
-    let raw = app.target.request(id, ins)?;
-    Ok(described(address, profile.as_deref(), ins, &raw))
-}
-
-fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8; FRAME_LEN]) -> Value {
-    let value = i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]);
-    if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
-        // The reply is text from its second byte on: no status, no value.
-        let version = String::from_utf8_lossy(&raw[1..]).trim_end_matches('\0').to_string();
-        return json!({
-            "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
-            "status": null, "status_text": null, "value": null, "version": version,
-            "text": format!("version {version}"),
-        });
-    }
-    json!({
-        "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
-        "status": raw[2], "status_text": crate::status_text(raw[2]), "value": value,
-        "text": tmclsim_host::reply::describe(ins, raw, address, profile),
-    })
+    Ok(answers::exchange(app.target.as_ref(), id, ins)?)
 }
 
 #[derive(Deserialize)]
@@ -219,45 +184,8 @@ struct CommandBody {
 
 async fn command(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<CommandBody>) -> Result<Json<Value>, ApiError> {
     app.idle(id)?;
-    let profile = app.profile(id)?;
-    let ins = tmclsim_host::line::parse(&body.line, profile.as_deref()).map_err(|e| bad(format!("column {}: {}", e.column, e.message)))?;
+    let ins = answers::parse_line(app.target.as_ref(), id, &body.line).map_err(bad)?;
     Ok(Json(blocking(move || exchange(&app, id, ins)).await??))
-}
-
-#[derive(Deserialize, Clone, Copy)]
-pub struct Read {
-    pub kind: ReadKind,
-    pub number: u8,
-    #[serde(default)]
-    pub index: u8,
-}
-
-#[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-pub enum ReadKind {
-    Ap,
-    Gp,
-    Input,
-    Output,
-}
-
-impl Read {
-    pub fn instruction(self) -> Instruction {
-        match self.kind {
-            ReadKind::Ap => Instruction::new(opcode::GAP, self.number, self.index, 0),
-            ReadKind::Gp => Instruction::new(opcode::GGP, self.number, self.index, 0),
-            ReadKind::Input => Instruction::new(opcode::GIO, self.number, self.index, 0),
-            ReadKind::Output => Instruction::new(opcode::GIO, self.number, 2, 0),
-        }
-    }
-}
-
-/// The values of `reads` (`None` where the module answered an error) and
-/// the module's clock after them.
-pub fn read_all(target: &dyn Target, id: usize, reads: &[Read]) -> Result<(Vec<Option<i32>>, f64), TargetError> {
-    let all: Vec<Instruction> = reads.iter().map(|r| r.instruction()).collect();
-    let (replies, t) = target.observe(id, &all)?;
-    Ok((replies.iter().map(|raw| (raw[2] >= 100).then(|| i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]))).collect(), t))
 }
 
 #[derive(Deserialize)]
@@ -267,41 +195,12 @@ struct ReadBody {
 
 async fn read(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<ReadBody>) -> Result<Json<Value>, ApiError> {
     app.observable(id)?;
-    if body.reads.len() > 4096 {
-        return Err(bad("at most 4096 reads at once"));
-    }
-    let (values, t) = blocking(move || read_all(app.target.as_ref(), id, &body.reads)).await??;
-    Ok(Json(json!({ "values": values, "t": t })))
+    Ok(Json(blocking(move || answers::read_json(app.target.as_ref(), id, &body.reads)).await??))
 }
 
-#[derive(Deserialize)]
-struct WriteBody {
-    kind: ReadKind,
-    number: u8,
-    #[serde(default)]
-    index: u8,
-    value: Option<i64>,
-    op: Option<String>,
-}
-
-async fn write(State(app): State<App>, Path(id): Path<usize>, Json(b): Json<WriteBody>) -> Result<Json<Value>, ApiError> {
+async fn write(State(app): State<App>, Path(id): Path<usize>, Json(w): Json<Write>) -> Result<Json<Value>, ApiError> {
     app.idle(id)?;
-    let axis = match b.kind {
-        ReadKind::Ap => true,
-        ReadKind::Gp => false,
-        _ => return Err(bad("write takes kind 'ap' or 'gp'; outputs are set with SIO in a command")),
-    };
-    let (set, store, restore) = if axis { (opcode::SAP, opcode::STAP, opcode::RSAP) } else { (opcode::SGP, opcode::STGP, opcode::RSGP) };
-    let ins = match (b.op.as_deref(), b.value) {
-        (None | Some("set"), Some(v)) => {
-            let v = i32::try_from(v).map_err(|_| bad(format!("{v} does not fit a 32-bit value")))?;
-            Instruction::new(set, b.number, b.index, v)
-        }
-        (None | Some("set"), None) => return Err(bad("give a value")),
-        (Some("store"), _) => Instruction::new(store, b.number, b.index, 0),
-        (Some("restore"), _) => Instruction::new(restore, b.number, b.index, 0),
-        (Some(other), _) => return Err(bad(format!("op '{other}': use set, store or restore"))),
-    };
+    let ins = w.instruction().map_err(bad)?;
     Ok(Json(blocking(move || exchange(&app, id, ins)).await??))
 }
 
@@ -311,11 +210,7 @@ struct WorldBody {
 }
 
 async fn world(State(app): State<App>, Path(id): Path<usize>, Json(b): Json<WorldBody>) -> Result<Json<Value>, ApiError> {
-    if b.line.len() > 4096 {
-        return Err(bad("a world line is at most 4096 bytes"));
-    }
-    let text = blocking(move || app.target.world(id, &b.line)).await??;
-    Ok(Json(json!({ "ok": text })))
+    Ok(Json(blocking(move || answers::world_json(app.target.as_ref(), id, &b.line)).await??))
 }
 
 async fn world_state(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
@@ -323,15 +218,5 @@ async fn world_state(State(app): State<App>, Path(id): Path<usize>) -> Result<Js
     let s = blocking(move || app.target.snapshot(id))
         .await?
         .ok_or_else(|| ApiError(StatusCode::CONFLICT, "the world exists only around virtual modules".into()))?;
-    let axes: Vec<Value> = s
-        .axes
-        .iter()
-        .map(|a| {
-            json!({"left": a.left, "right": a.right, "home": a.home, "load": a.load, "carriage": a.carriage,
-                        "position": a.position, "speed": a.speed, "current": a.current, "stallguard": a.stallguard,
-                        "stopped_by_switch": a.stopped_by_switch})
-        })
-        .collect();
-    Ok(Json(json!({"time": s.time_ns as f64 * 1e-9, "axes": axes, "inputs": s.io.inputs, "outputs": s.io.outputs,
-                   "analog": s.io.analog, "supply": s.io.supply, "temperature": s.io.temperature})))
+    Ok(Json(answers::world_state_json(&s)))
 }

@@ -7,16 +7,16 @@ mod api;
 mod assets;
 pub mod link_target;
 mod live;
-mod profile_json;
 mod program;
 mod security;
 mod serve;
-pub mod target;
 pub mod virtual_target;
 
-pub use link_target::{Found, LinkTarget, Probe};
+pub use link_target::{LinkTarget, Probe};
 pub use serve::Limits;
 pub use target::{ModuleEntry, Target, TargetError};
+pub use tmclsim_ide::status_text;
+pub use tmclsim_ide::target::{self, Found};
 pub use virtual_target::VirtualTarget;
 
 use std::net::SocketAddr;
@@ -77,11 +77,6 @@ impl Drop for WebHandle {
             let _ = t.join();
         }
     }
-}
-
-/// The status text of a reply status code.
-pub fn status_text(code: u8) -> &'static str {
-    tmclsim_protocol::Status::from_code(code).map_or("unknown status", |s| s.describe())
 }
 
 /// Starts the app on its own thread.

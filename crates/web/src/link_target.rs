@@ -4,10 +4,10 @@
 //! program counter (135 type 1) after every step, until it reaches one
 //! (docs/behaviour.md rule 86).
 
-use crate::target::{ModuleEntry, Target, TargetError, check};
+use crate::target::{Found, ModuleEntry, Target, TargetError, check};
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, Weak};
 use std::time::{Duration, Instant};
 use tmclsim_host::Client;
 use tmclsim_host::client::profile_of_version;
@@ -23,6 +23,9 @@ struct Debug {
 }
 
 pub struct LinkTarget {
+    /// The target itself, for the stepping thread of a run with
+    /// breakpoints.
+    me: Weak<LinkTarget>,
     client: Mutex<Client>,
     entries: Vec<ModuleEntry>,
     opened: Instant,
@@ -38,15 +41,6 @@ pub enum Probe<'a> {
     Addresses(&'a [u8]),
     /// Every address 1…255 ([`LinkTarget::scan`]).
     Scan,
-}
-
-/// A module that answered a scan.
-#[derive(Clone, Debug)]
-pub struct Found {
-    pub address: u8,
-    pub firmware: String,
-    /// The profile's name, if the module's type has one.
-    pub profile: Option<String>,
 }
 
 /// How a scan asks: on a TCP link a window of addresses at once, then a
@@ -87,7 +81,8 @@ impl LinkTarget {
                 format!("no module on {link} answered at address {}", list.join(", "))
             });
         }
-        Ok(Arc::new(LinkTarget {
+        Ok(Arc::new_cyclic(|me| LinkTarget {
+            me: me.clone(),
             client: Mutex::new(client),
             entries,
             missing,
@@ -164,7 +159,7 @@ impl LinkTarget {
     }
 }
 
-impl Target for Arc<LinkTarget> {
+impl Target for LinkTarget {
     fn kind(&self) -> &'static str {
         "link"
     }
@@ -212,7 +207,8 @@ impl Target for Arc<LinkTarget> {
             check(&self.exchange(id, Instruction::new(opcode::RESET_APPLICATION, 0, 0, 0))?)?;
         }
         let halt = Arc::new(AtomicBool::new(false));
-        let (me, flag) = (self.clone(), halt.clone());
+        let me = self.me.upgrade().ok_or_else(|| TargetError::Failed("the link is closing".into()))?;
+        let flag = halt.clone();
         let thread = std::thread::spawn(move || me.step_to_breakpoint(id, flag));
         self.with_debug(id, |d| d.halt = Some((halt, thread)));
         Ok(())

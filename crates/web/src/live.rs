@@ -2,16 +2,14 @@
 //! app subscribed to (TMCL reads through the target) at the rate it asked
 //! for, and the program's state when asked.
 
-use crate::api::{App, Read, read_all};
+use crate::api::App;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::extract::{Path, State};
 use axum::response::Response;
-use serde::Deserialize;
 use serde_json::json;
 use std::time::Duration;
+use tmclsim_ide::live::{Subscription, sample};
 
-/// Most signals per subscription.
-const MAX_SIGNALS: usize = 64;
 /// Largest message (and frame) a client may send: a subscription of
 /// [`MAX_SIGNALS`] signals takes a few KiB.
 pub const MAX_MESSAGE: usize = 64 * 1024;
@@ -19,26 +17,12 @@ pub const MAX_MESSAGE: usize = 64 * 1024;
 /// that sends more is closed with a reason.
 pub const MAX_MESSAGES_PER_SECOND: u32 = 50;
 
-#[derive(Deserialize, Default)]
-struct Subscription {
-    #[serde(default)]
-    signals: Vec<Read>,
-    rate: Option<f64>,
-    #[serde(default)]
-    program: bool,
-    /// Echoed in every sample of this subscription, so that the app knows
-    /// which signals a sample holds even while a new subscription is on its
-    /// way.
-    id: Option<u64>,
-}
-
 pub async fn live(ws: WebSocketUpgrade, State(app): State<App>, Path(id): Path<usize>) -> Response {
     ws.max_message_size(MAX_MESSAGE).max_frame_size(MAX_MESSAGE).on_upgrade(move |socket| stream(socket, app, id))
 }
 
-fn period(rate: Option<f64>) -> Duration {
-    let hz = rate.filter(|r| r.is_finite()).unwrap_or(20.0).clamp(1.0, 100.0);
-    Duration::from_secs_f64(1.0 / hz)
+fn period(sub: &Subscription) -> Duration {
+    Duration::from_secs_f64(1.0 / sub.hz())
 }
 
 async fn stream(mut socket: WebSocket, app: App, id: usize) {
@@ -47,7 +31,7 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
         return;
     }
     let mut sub = Subscription::default();
-    let mut tick = tokio::time::interval(period(None));
+    let mut tick = tokio::time::interval(period(&sub));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     let (mut second, mut messages) = (tokio::time::Instant::now(), 0u32);
     loop {
@@ -66,45 +50,29 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
                     return;
                 }
                 let Message::Text(text) = msg else { continue };
-                match serde_json::from_str::<Subscription>(&text) {
-                    Ok(s) if s.signals.len() <= MAX_SIGNALS => {
-                        tick = tokio::time::interval(period(s.rate));
+                match Subscription::parse(&text) {
+                    Ok(s) => {
+                        tick = tokio::time::interval(period(&s));
                         tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
                         sub = s;
                     }
-                    Ok(_) => {
-                        let _ = socket.send(Message::Text(json!({"error": format!("at most {MAX_SIGNALS} signals")}).to_string().into())).await;
-                    }
                     Err(e) => {
-                        let _ = socket.send(Message::Text(json!({"error": format!("subscription: {e}")}).to_string().into())).await;
+                        let _ = socket.send(Message::Text(json!({"error": e}).to_string().into())).await;
                     }
                 }
             }
             _ = tick.tick() => {
-                if (sub.signals.is_empty() && !sub.program) || app.observable(id).is_err() {
+                if sub.is_empty() || app.observable(id).is_err() {
                     // A module on a link in download mode would store the
                     // reads as program words: the stream pauses.
                     continue;
                 }
-                let (a, signals, program, sub_id) = (app.clone(), sub.signals.clone(), sub.program, sub.id);
-                let take = move || {
-                    let (values, t) = read_all(a.target.as_ref(), id, &signals).map_err(|e| e.to_string())?;
-                    let mut out = json!({"t": t, "values": values});
-                    if let Some(s) = sub_id {
-                        out["sub"] = json!(s);
-                    }
-                    if program {
-                        out["program"] = crate::program::state_of(&a, id).map_err(|e| e.1)?;
-                    }
-                    Ok::<_, String>(out)
-                };
+                let (a, s) = (app.clone(), sub.clone());
+                let take = move || sample(a.target.as_ref(), id, &s);
                 // Virtual modules answer in microseconds: no thread hand-off.
-                let sample = if app.target.blocks() { tokio::task::spawn_blocking(take).await } else { Ok(take()) };
-                let text = match sample {
-                    Ok(Ok(v)) => v.to_string(),
-                    Ok(Err(e)) => json!({"error": e}).to_string(),
-                    Err(_) => return,
-                };
+                let answer = if app.target.blocks() { tokio::task::spawn_blocking(take).await } else { Ok(take()) };
+                let Ok(v) = answer else { return };
+                let text = v.to_string();
                 if socket.send(Message::Text(text.into())).await.is_err() {
                     return;
                 }

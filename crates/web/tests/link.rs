@@ -5,7 +5,6 @@ mod common;
 
 use common::{Served, app_on_loopback, app_over_tcp, eventually, get, post, post_text};
 use serde_json::json;
-use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_web::LinkTarget;
 
@@ -52,7 +51,7 @@ fn an_address_that_does_not_answer_is_named_and_left_out() {
     let tcp = s.tcp().to_string();
     let target = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[1, 7]), Duration::from_millis(200)).unwrap();
     assert_eq!(target.missing(), &[7]);
-    assert_eq!(tmclsim_web::Target::modules(&target).iter().map(|m| m.address).collect::<Vec<_>>(), vec![1]);
+    assert_eq!(tmclsim_web::Target::modules(target.as_ref()).iter().map(|m| m.address).collect::<Vec<_>>(), vec![1]);
     let e = LinkTarget::open(Some(&tcp), None, 9600, tmclsim_web::Probe::Addresses(&[5, 7]), Duration::from_millis(200)).err().unwrap();
     assert!(e.contains("answered at address 5, 7"), "{e}");
 }
@@ -67,7 +66,7 @@ fn a_module_on_a_serial_port_is_reached_as_a_real_one() {
     let server = tmclsim_server::start(module, config).unwrap();
     let target =
         LinkTarget::open(None, Some(link.to_str().unwrap()), 9600, tmclsim_web::Probe::Addresses(&[1]), Duration::from_secs(1)).unwrap();
-    let web = app_on_loopback(Arc::new(target), Default::default());
+    let web = app_on_loopback(target, Default::default());
     let url = |p: &str| format!("http://{}{p}", web.addr());
     let (_, list) = get(&url("/api/modules"));
     assert_eq!(list[0]["profile"], "TMCM-3110");

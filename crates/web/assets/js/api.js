@@ -1,7 +1,29 @@
-// The IDE server's API (crates/web/README.md): JSON over HTTP, and the live
-// WebSocket of one module.
+// The IDE's API (crates/web/README.md): requests and their JSON answers, and
+// the live stream of one module. They go to a target: the server over HTTP
+// and a WebSocket (the default), or the playground's modules in the page,
+// which answer the same requests with the same JSON (playground.js).
 
-export async function call(method, path, body) {
+const http = {
+  call: httpCall,
+  postLines: httpPostLines,
+  live: (id, onSample) => new Live(id, onSample),
+};
+let target = http;
+
+/** Sends every request to `t` from now on: `{call, postLines, live}`. */
+export function useTarget(t) {
+  target = t;
+}
+
+export const call = (method, path, body) => target.call(method, path, body);
+export const get = (path) => call("GET", path);
+export const post = (path, body) => call("POST", path, body ?? {});
+/** POST that answers newline-delimited JSON; `onLine` gets each object. */
+export const postLines = (path, body, onLine) => target.postLines(path, body, onLine);
+/** The live stream of module `id`: `{subscribe(sub), close()}`. */
+export const openLive = (id, onSample) => target.live(id, onSample);
+
+async function httpCall(method, path, body) {
   const init = { method, headers: {} };
   if (body !== undefined) {
     init.headers["Content-Type"] = "application/json";
@@ -18,11 +40,7 @@ export async function call(method, path, body) {
   return data;
 }
 
-export const get = (path) => call("GET", path);
-export const post = (path, body) => call("POST", path, body ?? {});
-
-/** POST that answers newline-delimited JSON; `onLine` gets each object. */
-export async function postLines(path, body, onLine) {
+async function httpPostLines(path, body, onLine) {
   const r = await fetch(path, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
   const reader = r.body.getReader();
   const decoder = new TextDecoder();
@@ -51,7 +69,7 @@ export async function postLines(path, body, onLine) {
 
 /** The live stream of module `id`: `subscribe(sub)` (re)sends the
  * subscription, `onSample` gets every message. */
-export class Live {
+class Live {
   constructor(id, onSample) {
     this.id = id;
     this.onSample = onSample;

@@ -1,7 +1,8 @@
 // The browser IDE: the module list on the left, one panel per tab. Every
-// command is a TMCL request through the server (crates/web/README.md).
-import { get, Live } from "./api.js";
-import { moduleList, scanButton } from "./modules.js";
+// command is a TMCL request through the target (api.js: the server, or the
+// playground's modules in the page).
+import { get, openLive } from "./api.js";
+import { moduleList, scanButton, addButton } from "./modules.js";
 import { DirectPanel } from "./direct.js";
 import { ParamsPanel } from "./params.js";
 import { MotionPanel } from "./motion.js";
@@ -69,7 +70,7 @@ async function pick(modules, info, id) {
   if (live) live.close();
   const ctx = { id, module: mod, profile, info, virtual: mod.virtual, resubscribe: () => resubscribe(ctx) };
   for (const p of Object.values(panels)) p.setModule(ctx);
-  live = new Live(id, onSample);
+  live = openLive(id, onSample);
   resubscribe(ctx);
   window.tmclsimReady = true;
 }
@@ -78,7 +79,7 @@ async function main() {
   unitControls(document.getElementById("units"), document.getElementById("fullsteps"));
   const info = await get("/api/info");
   document.getElementById("target").textContent = `${info.target === "virtual" ? "virtual modules" : "TMCL link"} · ${info.link}`;
-  const modules = await get("/api/modules");
+  let modules = await get("/api/modules");
   let ctxRef = null;
   for (const b of document.querySelectorAll("#tabs button")) {
     b.addEventListener("click", () => {
@@ -89,8 +90,13 @@ async function main() {
       if (live) resubscribe(ctxRef);
     });
   }
-  moduleList(modules, (id) => pick(modules, info, id));
+  const list = moduleList(modules, (id) => pick(modules, info, id));
   scanButton(info);
+  addButton(info, async (id) => {
+    modules = await get("/api/modules");
+    list.update(modules, id);
+    await pick(modules, info, id);
+  });
   if (modules.length) await pick(modules, info, 0);
 }
 

@@ -9,12 +9,15 @@ function short(link) {
   return link.length > 26 ? `${link.slice(0, link.indexOf(" ") + 1)}…${link.slice(-18)}` : link;
 }
 
+/** The list; `update(modules, selected)` draws another list. */
 export function moduleList(modules, onPick) {
   const list = document.getElementById("module-list");
   const filter = document.getElementById("module-filter");
   const count = document.getElementById("module-count");
   let selected = 0;
-  const text = modules.map((m) => `${m.address} ${m.profile ?? ""} ${m.firmware} ${m.link}`.toLowerCase());
+  let text;
+  const describe = () => (text = modules.map((m) => `${m.address} ${m.profile ?? ""} ${m.firmware} ${m.link}`.toLowerCase()));
+  describe();
   function draw() {
     const words = filter.value.toLowerCase().split(/\s+/).filter(Boolean);
     // A word that is a module's address puts that module first.
@@ -43,6 +46,31 @@ export function moduleList(modules, onPick) {
   }
   filter.addEventListener("input", draw);
   draw();
+  return {
+    update(all, id) {
+      modules = all;
+      selected = id;
+      describe();
+      draw();
+    },
+  };
+}
+
+/** Adding a module of any built-in profile, where the target can (the
+ * playground's modules in the page). */
+export function addButton(info, onAdded) {
+  const box = document.getElementById("add-module");
+  box.hidden = !info.playground;
+  if (!info.playground) return;
+  const select = document.getElementById("add-profile");
+  select.replaceChildren(...info.profiles.map((p) => el("option", { value: p, text: p.toUpperCase() })));
+  select.value = "tmcm-1141";
+  const message = document.getElementById("add-message");
+  document.getElementById("add-go").addEventListener("click", async () => {
+    const r = await post("/api/modules", { profile: select.value });
+    message.textContent = r.error ?? "";
+    if (!r.error) await onAdded(r.id);
+  });
 }
 
 /** The scan of a link target: every module that answers 136, with the

@@ -41,6 +41,39 @@ export class ProgramPanel {
     on("prog-read", () => this.readBack());
     for (const action of ["run", "stop", "pause", "step", "continue", "reset"]) on(`prog-${action}`, () => this.act(action));
     this.message = document.getElementById("prog-message");
+    this.examples = document.getElementById("prog-example");
+    this.examples.addEventListener("change", () => {
+      const pick = this.examples.value;
+      this.examples.value = "";
+      if (pick) this.openExample(pick);
+    });
+  }
+
+  /** The playground's example programs (examples/index.json beside the
+   * page): a menu, and `?example=NAME` opens one. */
+  async loadExamples() {
+    if (this.list) return;
+    const r = await fetch("examples/index.json").catch(() => null);
+    if (!r?.ok) return;
+    this.list = await r.json();
+    this.examples.append(...this.list.map((x) => el("option", { value: x.name, text: x.title })));
+    this.examples.hidden = false;
+    const wanted = new URLSearchParams(location.search).get("example");
+    if (wanted) {
+      document.querySelector("[data-tab=program]").click();
+      await this.openExample(wanted);
+    }
+  }
+
+  async openExample(name) {
+    const x = this.list.find((e) => e.name === name);
+    if (!x) return this.say(`no example '${name}'`, true);
+    const r = await fetch(`examples/${x.name}.tmc`);
+    if (!r.ok) return this.say(`examples/${x.name}.tmc: HTTP ${r.status}`, true);
+    this.editor.setValue(await r.text());
+    this.clearDiagnostics();
+    this.map = null;
+    this.say(x.about);
   }
 
   shown(on) {
@@ -52,6 +85,7 @@ export class ProgramPanel {
     this.ctx = ctx;
     this.map = null;
     this.showState(null);
+    if (ctx.info.playground) this.loadExamples();
   }
 
   say(text, bad) {

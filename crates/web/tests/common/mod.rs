@@ -57,7 +57,7 @@ pub fn app_on_loopback(target: Arc<dyn tmclsim_web::Target>, limits: tmclsim_web
 pub fn app_over_tcp(tcp: &str) -> WebHandle {
     let probe = tmclsim_web::Probe::Addresses(&[1]);
     let target = tmclsim_web::LinkTarget::open(Some(tcp), None, 9600, probe, std::time::Duration::from_secs(1)).unwrap();
-    app_on_loopback(Arc::new(target), Default::default())
+    app_on_loopback(target, Default::default())
 }
 
 /// A JSON answer and its HTTP status, whatever the status.

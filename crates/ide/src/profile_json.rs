@@ -19,7 +19,7 @@ fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
         "number": p.number, "name": p.name, "unit": p.unit, "access": access,
         "min": p.min, "max": p.max, "default": p.default, "default_source": source,
         "note": p.note, "storable": a.eeprom, "ranges": p.ranges,
-        "snake": tmclsim_host::names::snake(&p.name),
+        "snake": crate::names::snake(&p.name),
         "quantity": p.quantity.map(|q| match q {
             Quantity::Velocity => "velocity",
             Quantity::Acceleration => "acceleration",

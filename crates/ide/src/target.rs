@@ -20,6 +20,15 @@ pub struct ModuleEntry {
     pub link: String,
 }
 
+/// A module that answered a scan.
+#[derive(Clone, Debug)]
+pub struct Found {
+    pub address: u8,
+    pub firmware: String,
+    /// The profile's name, if the module's type has one.
+    pub profile: Option<String>,
+}
+
 /// Why a target cannot do something.
 #[derive(Debug)]
 pub enum TargetError {
@@ -92,7 +101,7 @@ pub trait Target: Send + Sync + 'static {
     /// Stops a run that the target drives itself (breakpoints by steps).
     fn halt(&self, _id: usize) {}
     /// Every module that answers on the link (136 at addresses 1…255).
-    fn scan(&self) -> Result<Vec<crate::link_target::Found>, TargetError> {
+    fn scan(&self) -> Result<Vec<Found>, TargetError> {
         Err(TargetError::Unsupported("a scan looks for modules on a TMCL link; virtual modules are all in the module list".into()))
     }
 }

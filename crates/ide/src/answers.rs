@@ -1,0 +1,180 @@
+//! Direct mode, parameters and the world: a request to module `id` of a
+//! target and its answer as the app shows it.
+
+use crate::target::{ModuleEntry, Target, TargetError};
+use serde::Deserialize;
+use serde_json::{Value, json};
+use tmclsim_firmware::snapshot::ModuleSnapshot;
+use tmclsim_profile::Profile;
+use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
+
+/// Bytes as hex pairs: `01 06 01 …`.
+pub fn hex(b: &[u8]) -> String {
+    b.iter().map(|x| format!("{x:02x}")).collect::<Vec<_>>().join(" ")
+}
+
+/// Module `id` of the target.
+pub fn entry(target: &dyn Target, id: usize) -> Result<&ModuleEntry, TargetError> {
+    target.modules().get(id).ok_or(TargetError::NoModule)
+}
+
+/// A direct-mode line for module `id` (parameter names from its profile),
+/// or what is wrong with it: `column N: …`.
+pub fn parse_line(target: &dyn Target, id: usize, line: &str) -> Result<Instruction, String> {
+    let profile = target.modules().get(id).and_then(|m| m.profile.clone());
+    crate::line::parse(line, profile.as_deref()).map_err(|e| format!("column {}: {}", e.column, e.message))
+}
+
+/// A request and its reply as the app shows them.
+pub fn exchange(target: &dyn Target, id: usize, ins: Instruction) -> Result<Value, TargetError> {
+    let m = entry(target, id)?;
+    let (address, profile) = (m.address, m.profile.clone());
+    let raw = target.request(id, ins)?;
+    Ok(described(address, profile.as_deref(), ins, &raw))
+}
+
+fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8; FRAME_LEN]) -> Value {
+    let value = i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]);
+    if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
+        // The reply is text from its second byte on: no status, no value.
+        let version = String::from_utf8_lossy(&raw[1..]).trim_end_matches('\0').to_string();
+        return json!({
+            "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
+            "status": null, "status_text": null, "value": null, "version": version,
+            "text": format!("version {version}"),
+        });
+    }
+    json!({
+        "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
+        "status": raw[2], "status_text": crate::status_text(raw[2]), "value": value,
+        "text": crate::reply::describe(ins, raw, address, profile),
+    })
+}
+
+/// One value the app reads: an axis or global parameter, an input or an
+/// output.
+#[derive(Deserialize, Clone, Copy)]
+pub struct Read {
+    pub kind: ReadKind,
+    pub number: u8,
+    #[serde(default)]
+    pub index: u8,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ReadKind {
+    Ap,
+    Gp,
+    Input,
+    Output,
+}
+
+impl Read {
+    pub fn instruction(self) -> Instruction {
+        match self.kind {
+            ReadKind::Ap => Instruction::new(opcode::GAP, self.number, self.index, 0),
+            ReadKind::Gp => Instruction::new(opcode::GGP, self.number, self.index, 0),
+            ReadKind::Input => Instruction::new(opcode::GIO, self.number, self.index, 0),
+            ReadKind::Output => Instruction::new(opcode::GIO, self.number, 2, 0),
+        }
+    }
+}
+
+/// Most values read at once.
+pub const MAX_READS: usize = 4096;
+
+/// The values of `reads` (`None` where the module answered an error) and
+/// the module's clock after them.
+pub fn read_all(target: &dyn Target, id: usize, reads: &[Read]) -> Result<(Vec<Option<i32>>, f64), TargetError> {
+    let all: Vec<Instruction> = reads.iter().map(|r| r.instruction()).collect();
+    let (replies, t) = target.observe(id, &all)?;
+    Ok((replies.iter().map(|raw| (raw[2] >= 100).then(|| i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]))).collect(), t))
+}
+
+/// `{"values": […], "t": seconds}` for the reads, at most [`MAX_READS`].
+pub fn read_json(target: &dyn Target, id: usize, reads: &[Read]) -> Result<Value, TargetError> {
+    if reads.len() > MAX_READS {
+        return Err(TargetError::Failed(format!("at most {MAX_READS} reads at once")));
+    }
+    let (values, t) = read_all(target, id, reads)?;
+    Ok(json!({ "values": values, "t": t }))
+}
+
+/// A parameter write: a value set, or the parameter stored to or restored
+/// from the EEPROM.
+#[derive(Deserialize)]
+pub struct Write {
+    pub kind: ReadKind,
+    pub number: u8,
+    #[serde(default)]
+    pub index: u8,
+    pub value: Option<i64>,
+    pub op: Option<String>,
+}
+
+impl Write {
+    /// The instruction that does it (SAP/STAP/RSAP, SGP/STGP/RSGP), or what
+    /// is wrong.
+    pub fn instruction(&self) -> Result<Instruction, String> {
+        let axis = match self.kind {
+            ReadKind::Ap => true,
+            ReadKind::Gp => false,
+            _ => return Err("write takes kind 'ap' or 'gp'; outputs are set with SIO in a command".into()),
+        };
+        let (set, store, restore) =
+            if axis { (opcode::SAP, opcode::STAP, opcode::RSAP) } else { (opcode::SGP, opcode::STGP, opcode::RSGP) };
+        let (number, index) = (self.number, self.index);
+        match (self.op.as_deref(), self.value) {
+            (None | Some("set"), Some(v)) => {
+                let v = i32::try_from(v).map_err(|_| format!("{v} does not fit a 32-bit value"))?;
+                Ok(Instruction::new(set, number, index, v))
+            }
+            (None | Some("set"), None) => Err("give a value".into()),
+            (Some("store"), _) => Ok(Instruction::new(store, number, index, 0)),
+            (Some("restore"), _) => Ok(Instruction::new(restore, number, index, 0)),
+            (Some(other), _) => Err(format!("op '{other}': use set, store or restore")),
+        }
+    }
+}
+
+/// The module list as the app shows it.
+pub fn modules_json(target: &dyn Target) -> Value {
+    let virt = target.kind() == "virtual";
+    let list: Vec<Value> = target
+        .modules()
+        .iter()
+        .enumerate()
+        .map(|(id, m)| {
+            json!({"id": id, "address": m.address, "profile": m.profile.as_ref().map(|p| p.module.name.clone()),
+                   "firmware": m.firmware, "link": m.link, "virtual": virt})
+        })
+        .collect();
+    Value::Array(list)
+}
+
+/// Longest world line.
+pub const MAX_WORLD_LINE: usize = 4096;
+
+/// One line of the control protocol (docs/world.md) for module `id`.
+pub fn world_json(target: &dyn Target, id: usize, line: &str) -> Result<Value, TargetError> {
+    if line.len() > MAX_WORLD_LINE {
+        return Err(TargetError::Failed(format!("a world line is at most {MAX_WORLD_LINE} bytes")));
+    }
+    Ok(json!({ "ok": target.world(id, line)? }))
+}
+
+/// The world around a virtual module: switches, load, carriage and IO.
+pub fn world_state_json(s: &ModuleSnapshot) -> Value {
+    let axes: Vec<Value> = s
+        .axes
+        .iter()
+        .map(|a| {
+            json!({"left": a.left, "right": a.right, "home": a.home, "load": a.load, "carriage": a.carriage,
+                        "position": a.position, "speed": a.speed, "current": a.current, "stallguard": a.stallguard,
+                        "stopped_by_switch": a.stopped_by_switch})
+        })
+        .collect();
+    json!({"time": s.time_ns as f64 * 1e-9, "axes": axes, "inputs": s.io.inputs, "outputs": s.io.outputs,
+           "analog": s.io.analog, "supply": s.io.supply, "temperature": s.io.temperature})
+}
