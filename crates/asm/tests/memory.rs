@@ -5,6 +5,7 @@
 //! the limits (2 MiB per file, 4 MiB per assembly, 100 000 statements),
 //! run on two threads.
 
+#[path = "suite/common/mod.rs"]
 mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};

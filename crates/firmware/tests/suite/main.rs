@@ -1,0 +1,26 @@
+//! The firmware crate's integration tests, one test binary: one link, and
+//! the shared helpers built once.
+
+mod ascii;
+mod can_bus;
+mod common;
+mod deadlines;
+mod direct_mode;
+mod driver;
+mod eeprom;
+mod features;
+mod golden;
+mod motion;
+mod no_import_cycles;
+mod no_io;
+mod observers;
+mod program;
+mod reference_search;
+mod resync;
+mod rust_source;
+mod sibling_modules;
+mod single_axis_family;
+mod tmcm_1310;
+mod tmcm_351;
+mod world_lines;
+mod world_values;

@@ -1,0 +1,203 @@
+//! The crate's files depend on each other without cycles: the state files
+//! and leaf types know nothing of `Module`, and only the `impl Module`
+//! files depend on `module.rs`.
+//!
+//! The graph is read from the sources: a file depends on every file whose
+//! module a `use` (with `crate::`, `super::`, `self::` or a child module)
+//! or a `crate::…` path in it names.
+
+use crate::rust_source;
+
+use rust_source::{Token, ident, rust_files, tokens, use_tree};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+type Graph = BTreeMap<String, BTreeSet<String>>;
+
+/// Module path of a source file (`state/axis.rs` → `state::axis`, `lib.rs`
+/// → the root, ``).
+fn module_of(src: &Path, file: &Path) -> String {
+    let rel = file.strip_prefix(src).unwrap().with_extension("");
+    let mut parts: Vec<String> = rel.iter().map(|p| p.to_string_lossy().into_owned()).collect();
+    if matches!(parts.last().map(String::as_str), Some("lib" | "mod")) {
+        parts.pop();
+    }
+    parts.join("::")
+}
+
+fn join(base: &[String], rest: &[String]) -> Vec<String> {
+    base.iter().chain(rest).cloned().collect()
+}
+
+/// The file module a path (from the crate root) lies in: its longest
+/// prefix that is a file.
+fn file_of(path: &[String], files: &BTreeSet<String>) -> String {
+    (0..=path.len()).rev().map(|n| path[..n].join("::")).find(|m| files.contains(m)).unwrap_or_default()
+}
+
+/// The files one source file depends on.
+fn dependencies(text: &str, module: &str, files: &BTreeSet<String>) -> BTreeSet<String> {
+    let t = tokens(text);
+    let file_path: Vec<String> = if module.is_empty() { vec![] } else { module.split("::").map(String::from).collect() };
+    // Inline modules (`mod tests { … }`) open at a brace depth.
+    let mut inline: Vec<(usize, String)> = Vec::new();
+    let mut depth = 0;
+    let mut paths: Vec<(Vec<String>, Vec<String>, bool)> = Vec::new();
+    let mut i = 0;
+    while i < t.len() {
+        let here = join(&file_path, &inline.iter().map(|(_, n)| n.clone()).collect::<Vec<_>>());
+        match &t[i] {
+            Token::Punct('{') => depth += 1,
+            Token::Punct('}') => {
+                if inline.last().is_some_and(|(d, _)| *d == depth) {
+                    inline.pop();
+                }
+                depth -= 1;
+            }
+            Token::Ident(k) if k == "mod" => {
+                if let (Some(name), Some(Token::Punct('{'))) = (ident(t.get(i + 1)), t.get(i + 2)) {
+                    inline.push((depth + 1, name.to_string()));
+                }
+            }
+            Token::Ident(k) if k == "use" => {
+                let mut found = Vec::new();
+                i = use_tree(&t, i + 1, &[], &mut found);
+                paths.extend(found.into_iter().map(|p| (here.clone(), p, true)));
+                continue;
+            }
+            Token::Ident(k) if matches!(k.as_str(), "crate" | "super") && t.get(i + 1) == Some(&Token::PathSep) => {
+                let mut found = Vec::new();
+                i = use_tree(&t, i, &[], &mut found);
+                paths.extend(found.into_iter().map(|p| (here.clone(), p, false)));
+                continue;
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    let mut deps = BTreeSet::new();
+    for (here, path, in_use) in paths {
+        let mut base = here.clone();
+        let mut rest = &path[..];
+        let absolute = match rest.first().map(String::as_str) {
+            Some("crate") => join(&[], &rest[1..]),
+            Some("super") | Some("self") => {
+                while let Some(s) = rest.first().map(String::as_str) {
+                    match s {
+                        "super" => {
+                            base.pop();
+                        }
+                        "self" => {}
+                        _ => break,
+                    }
+                    rest = &rest[1..];
+                }
+                join(&base, rest)
+            }
+            // `use child::…` of a module declared in this one.
+            Some(first) if in_use && files.contains(&join(&here, &[first.to_string()]).join("::")) => join(&here, rest),
+            _ => continue,
+        };
+        deps.insert(file_of(&absolute, files));
+    }
+    deps.remove(module);
+    deps
+}
+
+fn crate_graph() -> Graph {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut paths = Vec::new();
+    rust_files(&src, &mut paths);
+    let files: BTreeSet<String> = paths.iter().map(|p| module_of(&src, p)).collect();
+    paths
+        .iter()
+        .map(|p| {
+            let module = module_of(&src, p);
+            let deps = dependencies(&std::fs::read_to_string(p).unwrap(), &module, &files);
+            (module, deps)
+        })
+        .collect()
+}
+
+fn name(module: &str) -> &str {
+    if module.is_empty() { "lib" } else { module }
+}
+
+/// A cycle of the graph, if it has one.
+fn find_cycle(graph: &Graph) -> Option<Vec<String>> {
+    fn visit(n: &str, graph: &Graph, done: &mut BTreeSet<String>, stack: &mut Vec<String>) -> Option<Vec<String>> {
+        if let Some(at) = stack.iter().position(|s| s == n) {
+            let mut cycle = stack[at..].to_vec();
+            cycle.push(n.to_string());
+            return Some(cycle);
+        }
+        if done.contains(n) {
+            return None;
+        }
+        stack.push(n.to_string());
+        for d in graph.get(n).into_iter().flatten() {
+            if let Some(c) = visit(d, graph, done, stack) {
+                return Some(c);
+            }
+        }
+        stack.pop();
+        done.insert(n.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    graph.keys().find_map(|n| visit(n, graph, &mut done, &mut Vec::new()))
+}
+
+fn reaches(graph: &Graph, from: &str, to: &str) -> bool {
+    let mut seen = BTreeSet::new();
+    let mut todo = vec![from.to_string()];
+    while let Some(n) = todo.pop() {
+        if n == to {
+            return true;
+        }
+        if seen.insert(n.clone()) {
+            todo.extend(graph.get(&n).into_iter().flatten().cloned());
+        }
+    }
+    false
+}
+
+#[test]
+fn the_crate_has_no_import_cycles() {
+    let graph = crate_graph();
+    if let Some(cycle) = find_cycle(&graph) {
+        let cycle: Vec<&str> = cycle.iter().map(|m| name(m)).collect();
+        panic!("import cycle: {}", cycle.join(" → "));
+    }
+}
+
+#[test]
+fn state_and_leaf_types_do_not_depend_on_module() {
+    let graph = crate_graph();
+    let leaves = ["outcome", "parameter_numbers", "program", "motion", "reference_search", "eeprom", "world", "world_file", "world_rules"];
+    let checked: Vec<&String> = graph.keys().filter(|m| m.starts_with("state") || leaves.contains(&m.as_str())).collect();
+    assert!(checked.iter().any(|m| m.starts_with("state::")), "the state files are found");
+    for m in checked {
+        assert!(!reaches(&graph, m, "module"), "{m} depends on module.rs");
+    }
+}
+
+#[test]
+fn the_graph_sees_the_dependencies() {
+    let graph = crate_graph();
+    let deps = |m: &str| graph.get(m).unwrap_or_else(|| panic!("no file {m}"));
+    assert!(deps("commands::motion").contains("module"), "use crate::module::Module");
+    assert!(deps("module").contains("state::axis"), "pub use crate::state::axis::Axis");
+    assert!(deps("").contains("module"), "pub use module::{{…}} in lib.rs");
+}
+
+#[test]
+fn a_cycle_is_found() {
+    let files: BTreeSet<String> = ["", "a", "b", "b::c"].map(String::from).into();
+    let a = dependencies("use crate::b::c::Thing; // crate::x\nfn f() { let s = \"crate::a\"; }", "a", &files);
+    let c = dependencies("use super::Y;\nmod tests {\n    use super::X;\n}\nfn g() { crate::a::f() }", "b::c", &files);
+    assert_eq!(a, ["b::c".to_string()].into());
+    assert_eq!(c, ["a".to_string(), "b".to_string()].into(), "super in an inline module names the file itself");
+    let graph: Graph = [("a".to_string(), a), ("b::c".to_string(), c)].into();
+    assert_eq!(find_cycle(&graph), Some(vec!["a".to_string(), "b::c".to_string(), "a".to_string()]));
+}
