@@ -103,7 +103,7 @@ impl Debugger {
                     return Ok(Debug::Continue);
                 }
                 "a" | "advance" => match args {
-                    [time] => match crate::run::parse_duration(time) {
+                    [time] => match crate::duration::parse_duration(time) {
                         Ok(d) => {
                             advance(m, program, d, end);
                             self.report_changes(m);
@@ -137,7 +137,7 @@ impl Debugger {
                     _ => println!("unwatch takes a watch number (w lists them) or all"),
                 },
                 "l" | "list" => list(m, program, args),
-                "i" | "inspect" if args.is_empty() => crate::run::inspect(m),
+                "i" | "inspect" if args.is_empty() => inspect(m),
                 "h" | "help" | "?" => println!("{HELP}"),
                 "q" | "quit" => return Ok(Debug::Quit),
                 "n" | "next" | "c" | "continue" | "i" | "inspect" => println!("{command} takes no arguments"),
@@ -191,6 +191,34 @@ fn text_at(program: &Program, address: u16) -> String {
         (Some(s), _) => s.text.clone(),
         (None, Some(i)) => mnemonic::format(*i),
         (None, None) => "(end of program)".into(),
+    }
+}
+
+/// Registers, stack, axes, outputs and the user variables that are not 0.
+pub fn inspect(m: &Module) {
+    let r = m.registers();
+    let p = m.program();
+    println!("  accumulator {}  X {}  compare {:?}  error flags {:#04x}", r.accumulator, r.x, r.compare, r.errors);
+    println!("  stack {:?}  interrupt handler {}", p.stack, if p.handler.is_some() { "active" } else { "none" });
+    for a in 0..m.profile().module.axes as usize {
+        let axis = m.axis(a);
+        println!(
+            "  axis {a}: position {} speed {} target {} mode {:?}",
+            m.actual_position(a),
+            m.actual_speed(a),
+            axis.target_word,
+            axis.motion.mode
+        );
+    }
+    println!("  outputs {:#b}", m.outputs());
+    let vars: Vec<String> = (0..m.profile().module.user_variables as usize)
+        .filter_map(|i| {
+            let v = m.user_variable_value(i);
+            (v != 0).then(|| format!("{i}={v}"))
+        })
+        .collect();
+    if !vars.is_empty() {
+        println!("  user variables {}", vars.join(" "));
     }
 }
 

@@ -4,19 +4,21 @@
 //! this crate's README.
 
 mod api;
+mod app;
 mod assets;
 pub mod link_target;
 mod live;
 mod profile_json;
 mod program;
+mod read;
 mod security;
 mod serve;
 pub mod target;
 pub mod virtual_target;
 
-pub use link_target::{Found, LinkTarget, Probe};
+pub use link_target::{LinkTarget, Probe};
 pub use serve::Limits;
-pub use target::{ModuleEntry, Target, TargetError};
+pub use target::{Found, ModuleEntry, Target, TargetError, status_text};
 pub use virtual_target::VirtualTarget;
 
 use std::net::SocketAddr;
@@ -79,11 +81,6 @@ impl Drop for WebHandle {
     }
 }
 
-/// The status text of a reply status code.
-pub fn status_text(code: u8) -> &'static str {
-    tmclsim_protocol::Status::from_code(code).map_or("unknown status", |s| s.describe())
-}
-
 /// Starts the app on its own thread.
 pub fn start(target: Arc<dyn Target>, config: WebConfig) -> std::io::Result<WebHandle> {
     if !config.addr.ip().is_loopback() && !config.public {
@@ -104,7 +101,7 @@ pub fn start(target: Arc<dyn Target>, config: WebConfig) -> std::io::Result<WebH
     listener.set_nonblocking(true)?;
     let addr = listener.local_addr()?;
     let (stop, stopped) = watch::channel(false);
-    let state = api::App::new(target, token.clone());
+    let state = app::App::new(target, token.clone());
     let thread = std::thread::Builder::new().name("tmclsim-web".into()).spawn(move || {
         // One thread: the app's requests are short; link targets' waits run
         // on the blocking pool.

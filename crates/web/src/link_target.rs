@@ -4,7 +4,7 @@
 //! program counter (135 type 1) after every step, until it reaches one
 //! (docs/behaviour.md rule 86).
 
-use crate::target::{ModuleEntry, Target, TargetError, check};
+use crate::target::{Found, ModuleEntry, Target, TargetError, check};
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -38,15 +38,6 @@ pub enum Probe<'a> {
     Addresses(&'a [u8]),
     /// Every address 1…255 ([`LinkTarget::scan`]).
     Scan,
-}
-
-/// A module that answered a scan.
-#[derive(Clone, Debug)]
-pub struct Found {
-    pub address: u8,
-    pub firmware: String,
-    /// The profile's name, if the module's type has one.
-    pub profile: Option<String>,
 }
 
 /// How a scan asks: on a TCP link a window of addresses at once, then a

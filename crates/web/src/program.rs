@@ -3,7 +3,7 @@
 //! for every word), run/stop/pause/step/continue/reset (128–131), the
 //! breakpoints, and the program's state (135, user variables).
 
-use crate::api::{ApiError, App, bad, blocking};
+use crate::app::{ASSEMBLERS, ApiError, App, bad, blocking};
 use crate::target::{TargetError, check};
 use axum::Json;
 use axum::body::Body;
@@ -18,10 +18,6 @@ use tmclsim_protocol::{Instruction, Status, opcode};
 
 /// Longest source the app sends (the assembler's own limit per file).
 const MAX_SOURCE: usize = 2 << 20;
-/// Assemblies at once (`/api/assemble` and downloads); another request
-/// meanwhile is answered 503 (docs/robustness.md).
-pub const ASSEMBLERS: usize = 2;
-
 /// Assembles on the blocking pool, at most [`ASSEMBLERS`] at once.
 async fn assemble_bounded(app: &App, source: String, profile: Option<std::sync::Arc<Profile>>) -> Result<Result<Program, Value>, ApiError> {
     let Ok(_slot) = app.assemblers.clone().try_acquire_owned() else {
@@ -94,7 +90,7 @@ fn download_words(app: &App, id: usize, words: &[Instruction], tx: &tokio::sync:
         let r = t.request(id, *w)?;
         if r[2] != Status::Loaded.code() {
             let _ = t.request(id, Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
-            return Err(TargetError::Failed(format!("word {a} was not stored: status {} ({})", r[2], crate::status_text(r[2]))));
+            return Err(TargetError::Failed(format!("word {a} was not stored: status {} ({})", r[2], crate::target::status_text(r[2]))));
         }
         if a % 8 == 7 || a + 1 == words.len() {
             send(json!({"progress": a + 1, "total": total}));
@@ -158,7 +154,7 @@ fn read_program(app: &App, id: usize) -> Result<Vec<Instruction>, TargetError> {
             if a > 0 && raw[2] == Status::InvalidValue.code() {
                 break;
             }
-            return Err(TargetError::Failed(format!("reading word {a}: status {} ({})", raw[2], crate::status_text(raw[2]))));
+            return Err(TargetError::Failed(format!("reading word {a}: status {} ({})", raw[2], crate::target::status_text(raw[2]))));
         }
         all.push(Instruction::from_bytes(raw[1..8].try_into().expect("seven bytes")));
     }

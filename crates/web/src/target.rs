@@ -92,7 +92,7 @@ pub trait Target: Send + Sync + 'static {
     /// Stops a run that the target drives itself (breakpoints by steps).
     fn halt(&self, _id: usize) {}
     /// Every module that answers on the link (136 at addresses 1…255).
-    fn scan(&self) -> Result<Vec<crate::link_target::Found>, TargetError> {
+    fn scan(&self) -> Result<Vec<Found>, TargetError> {
         Err(TargetError::Unsupported("a scan looks for modules on a TMCL link; virtual modules are all in the module list".into()))
     }
 }
@@ -101,6 +101,20 @@ pub trait Target: Send + Sync + 'static {
 pub fn check(reply: &[u8; FRAME_LEN]) -> Result<(), TargetError> {
     match reply[2] {
         s if s >= 100 => Ok(()),
-        s => Err(TargetError::Failed(format!("the module answered status {s} ({})", crate::status_text(s)))),
+        s => Err(TargetError::Failed(format!("the module answered status {s} ({})", status_text(s)))),
     }
+}
+
+/// A module that answered a scan.
+#[derive(Clone, Debug)]
+pub struct Found {
+    pub address: u8,
+    pub firmware: String,
+    /// The profile's name, if the module's type has one.
+    pub profile: Option<String>,
+}
+
+/// The status text of a reply status code.
+pub fn status_text(code: u8) -> &'static str {
+    tmclsim_protocol::Status::from_code(code).map_or("unknown status", |s| s.describe())
 }

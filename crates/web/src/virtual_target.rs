@@ -30,13 +30,13 @@ impl VirtualTarget {
         let mut places = Vec::new();
         for link in links {
             let name = link_name(link);
-            for index in 0..link.module.len() {
-                let (address, profile, firmware) = link.module.with_module(index, |m| {
+            for index in 0..link.bus.len() {
+                let (address, profile, firmware) = link.bus.with_module(index, |m| {
                     let p = m.profile().clone();
                     (m.address(), p.clone(), String::from_utf8_lossy(&p.version_text()).into_owned())
                 });
                 entries.push(ModuleEntry { address, profile: Some(profile), firmware, link: name.clone() });
-                places.push(Place { bus: link.module.clone(), index });
+                places.push(Place { bus: link.bus.clone(), index });
             }
         }
         let description = match links {
