@@ -161,9 +161,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         // program runs on past the breakpoint it stood on.
         let at_breakpoint = bus.module(0).program().hit_breakpoint.is_some() && bus.module(0).program().mode != RunMode::Run;
         if debugging || at_breakpoint {
-            let answer = debugger.session(bus.module_mut(0), &program, &mut lines, end)?;
-            // Steps moved the module; the bus follows.
-            bus.advance_to(bus.module(0).now_ns());
+            let answer = debugger.session(&mut bus, &program, &mut lines, end)?;
             match answer {
                 Debug::Continue => debugging = false,
                 Debug::Quit => break,

@@ -239,16 +239,9 @@ impl SharedBus {
     pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
         self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
-        let before = Self::generations(&mut s, |bus| {
-            // The addressed modules first catch up on their own, so that
-            // what their programs store is not taken for the request's.
-            let now = bus.now_ns();
-            for i in 0..bus.len() {
-                if bus.module(i).answers_to(frame[0]) {
-                    bus.module_mut(i).advance_to(now);
-                }
-            }
-        });
+        // The addressed modules first catch up on their own, so that what
+        // their programs store is not taken for the request's.
+        let before = Self::generations(&mut s, |bus| bus.catch_up_addressed(frame[0]));
         let mut answer = s.bus.handle_frame_from(link, frame);
         let written = Self::written_since(&s, before);
         let failed = self.after_request(s, link, sink, !answer.replies.is_empty());
