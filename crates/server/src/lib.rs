@@ -16,6 +16,7 @@
 mod clock;
 pub mod control;
 pub mod eeprom_file;
+mod eeprom_files;
 pub mod ethercat;
 mod faults;
 pub mod files;
