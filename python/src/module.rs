@@ -722,9 +722,9 @@ impl Module {
         let (shared, index) = (self.shared.clone(), self.index);
         py.detach(|| {
             catch(|| {
-                shared.with_module(index, |m| {
-                    let end = m.now_ns().saturating_add(limit);
-                    m.step_instruction(end, 10_000_000)
+                shared.with_bus(|bus| {
+                    let end = bus.now_ns().saturating_add(limit);
+                    bus.step_instruction(index, end, 10_000_000)
                 })
             })
         })

@@ -3,8 +3,9 @@
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Command, Stdio};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tmclsim_firmware::Module;
+use tmclsim_firmware::{Bus, Module, Profile};
 use tmclsim_protocol::Request;
 use tmclsim_protocol::mnemonic::parse_line;
 
@@ -164,13 +165,7 @@ fn programs() -> Result<(), String> {
         |src: &str| tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d));
     // A compute-only loop: 3 instructions per turn, never ending.
     let compute = asm("Loop:\n  CALC ADD, 1\n  COMP 2000000000\n  JC LT, Loop\n  STOP\n")?;
-    let mut m = Module::new(profile.clone());
-    m.load_program(&compute.instructions).map_err(|s| s.to_string())?;
-    m.start_program();
-    let t = Instant::now();
-    m.advance(3_600_000_000_000);
-    let wall = t.elapsed().as_secs_f64();
-    let n = m.program().executed;
+    let (n, wall) = run_program(&profile, &compute, 3_600_000_000_000)?;
     row!(
         "| VM, compute-only loop, 1 h of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
         n as f64 / wall / 1e6,
@@ -178,25 +173,13 @@ fn programs() -> Result<(), String> {
     );
     // The manual's 2.4 program (moves and WAIT POS) for an hour.
     let motion = asm(FIRST_STEPS)?;
-    let mut m = Module::new(profile.clone());
-    m.load_program(&motion.instructions).map_err(|s| s.to_string())?;
-    m.start_program();
-    let t = Instant::now();
-    m.advance(3_600_000_000_000);
-    let wall = t.elapsed().as_secs_f64();
-    let n = m.program().executed;
+    let (n, wall) = run_program(&profile, &motion, 3_600_000_000_000)?;
     row!("| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |", 3600.0 / wall, wall * 1e3);
     // A busy motion loop: GAP/COMP/JC polling while the motor moves.
     let polling = asm(
         "Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n",
     )?;
-    let mut m = Module::new(profile.clone());
-    m.load_program(&polling.instructions).map_err(|s| s.to_string())?;
-    m.start_program();
-    let t = Instant::now();
-    m.advance(600_000_000_000);
-    let wall = t.elapsed().as_secs_f64();
-    let n = m.program().executed;
+    let (n, wall) = run_program(&profile, &polling, 600_000_000_000)?;
     row!(
         "| VM, polling motion loop (GAP 8/JC), 10 min of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
         n as f64 / wall / 1e6,
@@ -213,6 +196,18 @@ fn programs() -> Result<(), String> {
     let wall = t.elapsed().as_secs_f64();
     row!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), lines as f64 / wall / 1e6);
     Ok(())
+}
+
+/// Runs `program` on a module of its own for `ns` of virtual time: the
+/// instructions it executed and the wall time, in seconds, that took.
+fn run_program(profile: &Arc<Profile>, program: &tmclsim_asm::Program, ns: u64) -> Result<(u64, f64), String> {
+    let mut m = Module::new(profile.clone());
+    m.load_program(&program.instructions).map_err(|s| s.to_string())?;
+    m.start_program();
+    let mut bus = Bus::single(m);
+    let t = Instant::now();
+    bus.advance(ns);
+    Ok((bus.module(0).program().executed, t.elapsed().as_secs_f64()))
 }
 
 /// Served modules that run standalone programs while no host talks to them:

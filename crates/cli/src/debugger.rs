@@ -8,8 +8,8 @@ use std::collections::BTreeMap;
 use std::io::Write;
 
 use tmclsim_asm::{LinePlace, Program, source_map};
-use tmclsim_firmware::Module;
 use tmclsim_firmware::program::RunMode;
+use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::{mnemonic, opcode, suggest};
 
 /// What the run loop does after the debugger.
@@ -56,15 +56,17 @@ pub struct Debugger {
 }
 
 impl Debugger {
-    /// One debugger session: commands until `continue` or `quit` (or the
-    /// end of the input).
+    /// One debugger session on the bus's (first) module: commands until
+    /// `continue` or `quit` (or the end of the input). Time moves on the
+    /// bus.
     pub fn session(
         &mut self,
-        m: &mut Module,
+        bus: &mut Bus,
         program: &Program,
         lines: &mut impl Iterator<Item = std::io::Result<String>>,
         end: u64,
     ) -> Result<Debug, String> {
+        let m = bus.module_mut(0);
         m.pause_program();
         if let Some(pc) = m.program().hit_breakpoint {
             println!("breakpoint at {}", place(program, pc));
@@ -72,6 +74,7 @@ impl Debugger {
         self.report_changes(m);
         println!("debugger: h for help");
         loop {
+            let m = bus.module_mut(0);
             // While a WAIT waits, the counter stands on the WAIT (135 type 1).
             let pc = m.program().counter();
             let waiting = if m.program().wait.is_some() { " (waiting)" } else { "" };
@@ -85,28 +88,28 @@ impl Debugger {
                 "s" | "step" => match count(args) {
                     Ok(n) => {
                         for _ in 0..n {
-                            if !step_one(m, end) {
+                            if !step_one(bus, end) {
                                 println!("the run's end (--for) is reached");
                                 break;
                             }
                         }
-                        self.report_changes(m);
+                        self.report_changes(bus.module(0));
                     }
                     Err(e) => println!("{e}"),
                 },
                 "n" | "next" if args.is_empty() => {
-                    next(m, end);
-                    self.report_changes(m);
+                    next(bus, end);
+                    self.report_changes(bus.module(0));
                 }
                 "c" | "continue" if args.is_empty() => {
                     m.start_program();
                     return Ok(Debug::Continue);
                 }
                 "a" | "advance" => match args {
-                    [time] => match crate::run::parse_duration(time) {
+                    [time] => match crate::duration::parse_duration(time) {
                         Ok(d) => {
-                            advance(m, program, d, end);
-                            self.report_changes(m);
+                            advance(bus, program, d, end);
+                            self.report_changes(bus.module(0));
                         }
                         Err(e) => println!("{e}"),
                     },
@@ -137,7 +140,7 @@ impl Debugger {
                     _ => println!("unwatch takes a watch number (w lists them) or all"),
                 },
                 "l" | "list" => list(m, program, args),
-                "i" | "inspect" if args.is_empty() => crate::run::inspect(m),
+                "i" | "inspect" if args.is_empty() => inspect(m),
                 "h" | "help" | "?" => println!("{HELP}"),
                 "q" | "quit" => return Ok(Debug::Quit),
                 "n" | "next" | "c" | "continue" | "i" | "inspect" => println!("{command} takes no arguments"),
@@ -194,6 +197,34 @@ fn text_at(program: &Program, address: u16) -> String {
     }
 }
 
+/// Registers, stack, axes, outputs and the user variables that are not 0.
+pub fn inspect(m: &Module) {
+    let r = m.registers();
+    let p = m.program();
+    println!("  accumulator {}  X {}  compare {:?}  error flags {:#04x}", r.accumulator, r.x, r.compare, r.errors);
+    println!("  stack {:?}  interrupt handler {}", p.stack, if p.handler.is_some() { "active" } else { "none" });
+    for a in 0..m.profile().module.axes as usize {
+        let axis = m.axis(a);
+        println!(
+            "  axis {a}: position {} speed {} target {} mode {:?}",
+            m.actual_position(a),
+            m.actual_speed(a),
+            axis.target_word,
+            axis.motion.mode
+        );
+    }
+    println!("  outputs {:#b}", m.outputs());
+    let vars: Vec<String> = (0..m.profile().module.user_variables as usize)
+        .filter_map(|i| {
+            let v = m.user_variable_value(i);
+            (v != 0).then(|| format!("{i}={v}"))
+        })
+        .collect();
+    if !vars.is_empty() {
+        println!("  user variables {}", vars.join(" "));
+    }
+}
+
 /// A breakpoint place: a label, an address or `FILE:LINE`.
 pub fn resolve(at: &str, program: &Program) -> Result<u16, String> {
     if let Some(a) = program.symbols.get(at) {
@@ -220,32 +251,37 @@ fn count(args: &[&str]) -> Result<u64, String> {
     }
 }
 
-/// One instruction, breakpoints aside; false when the run's end came first.
-fn step_one(m: &mut Module, end: u64) -> bool {
-    let bps = m.program().breakpoints.clone();
-    m.set_breakpoints(&[]);
-    let done = m.step_instruction(end, 10_000_000);
-    m.set_breakpoints(&bps);
+/// One instruction of the (first) module, breakpoints aside; false when
+/// the run's end came first.
+fn step_one(bus: &mut Bus, end: u64) -> bool {
+    let bps = bus.module(0).program().breakpoints.clone();
+    bus.module_mut(0).set_breakpoints(&[]);
+    let done = bus.step_instruction(0, end, 10_000_000);
+    bus.module_mut(0).set_breakpoints(&bps);
     done
 }
 
 /// One instruction; a CALL runs until it has returned (or a breakpoint
 /// or the run's end stops it first).
-fn next(m: &mut Module, end: u64) {
-    let pc = m.program().pc;
-    let depth = m.program().stack.len();
-    let is_call = m.program().memory.get(pc as usize).is_some_and(|i| i.opcode == opcode::CALL);
-    if !step_one(m, end) {
+fn next(bus: &mut Bus, end: u64) {
+    let p = bus.module(0).program();
+    let (pc, depth) = (p.pc, p.stack.len());
+    let is_call = p.memory.get(pc as usize).is_some_and(|i| i.opcode == opcode::CALL);
+    if !step_one(bus, end) {
         return println!("the run's end (--for) is reached");
     }
-    if !is_call || m.program().stack.len() <= depth {
+    if !is_call || bus.module(0).program().stack.len() <= depth {
         return;
     }
-    while m.program().stack.len() > depth || m.program().pc != pc + 1 {
-        if m.program().breakpoints.contains(&m.program().pc) {
-            return println!("breakpoint at address {}", m.program().pc);
+    loop {
+        let p = bus.module(0).program();
+        if p.stack.len() <= depth && p.pc == pc + 1 {
+            return;
         }
-        if m.program().mode == RunMode::Stop || !step_one(m, end) {
+        if p.breakpoints.contains(&p.pc) {
+            return println!("breakpoint at address {}", p.pc);
+        }
+        if p.mode == RunMode::Stop || !step_one(bus, end) {
             return println!("the subroutine did not return before the run's end");
         }
     }
@@ -253,24 +289,25 @@ fn next(m: &mut Module, end: u64) {
 
 /// Runs the program for `d` of virtual time, stopping early at a
 /// breakpoint.
-fn advance(m: &mut Module, program: &Program, d: u64, end: u64) {
-    let until = m.now_ns().saturating_add(d).min(end);
+fn advance(bus: &mut Bus, program: &Program, d: u64, end: u64) {
+    let until = bus.now_ns().saturating_add(d).min(end);
     // The program leaves the breakpoint it stands on, as after continue.
-    m.start_program();
-    while m.now_ns() < until && m.program().mode == RunMode::Run {
-        m.advance_to(m.now_ns().saturating_add(1_000_000).min(until));
+    bus.module_mut(0).start_program();
+    while bus.now_ns() < until && bus.module(0).program().mode == RunMode::Run {
+        bus.advance_to(bus.now_ns().saturating_add(1_000_000).min(until));
     }
-    match m.program().hit_breakpoint {
-        Some(pc) if m.program().mode != RunMode::Run => println!("breakpoint at {}", place(program, pc)),
-        _ if m.program().mode == RunMode::Stop => println!("the program has stopped"),
+    let p = bus.module(0).program();
+    match p.hit_breakpoint {
+        Some(pc) if p.mode != RunMode::Run => println!("breakpoint at {}", place(program, pc)),
+        _ if p.mode == RunMode::Stop => println!("the program has stopped"),
         _ => {}
     }
     // Time goes on to the end of the advance even when the program stopped.
-    if m.program().hit_breakpoint.is_none() {
-        m.advance_to(until);
+    if p.hit_breakpoint.is_none() {
+        bus.advance_to(until);
     }
-    m.pause_program();
-    if m.now_ns() >= end {
+    bus.module_mut(0).pause_program();
+    if bus.now_ns() >= end {
         println!("the run's end (--for) is reached");
     }
 }

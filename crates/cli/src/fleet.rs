@@ -164,7 +164,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     }
     let server = tmclsim_server::start_fleet(specs).map_err(|e| format!("cannot serve the fleet: {e}"))?;
     println!("tmclsim: fleet of {total} modules on {} links is serving", server.links().len());
-    let web = crate::serve::start_web(args, server.links())?;
+    let web = crate::ide::start_web(args, server.links())?;
     if let Some(first) = server.links().first()
         && let Some(a) = first.endpoints.pytrinamic_args()
     {
@@ -172,7 +172,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    crate::serve::wait_for_signal();
+    crate::signal::wait_for_signal();
     drop(web);
     let s = server.stats();
     println!("stats: frames {}, missed real-time deadlines {}, max lateness {} µs", s.frames, s.missed_deadlines, s.max_lateness_ns / 1000);
@@ -190,7 +190,7 @@ pub struct FleetBenchArgs {
     #[arg(long, default_value_t = 10.0, value_parser = parse_rate)]
     pub rate: f64,
     /// How long to drive the fleet.
-    #[arg(long = "for", value_name = "DURATION", default_value = "10s", value_parser = crate::run::parse_duration)]
+    #[arg(long = "for", value_name = "DURATION", default_value = "10s", value_parser = crate::duration::parse_duration)]
     pub duration: u64,
 }
 

@@ -47,7 +47,7 @@ pub fn run(args: IdeArgs) -> Result<ExitCode, String> {
     println!("open: {}", web.url());
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    crate::serve::wait_for_signal();
+    crate::signal::wait_for_signal();
     println!("tmclsim ide: stopping");
     drop(web);
     Ok(ExitCode::SUCCESS)
@@ -63,4 +63,13 @@ pub fn start(target: Arc<dyn tmclsim_web::Target>, addr: std::net::SocketAddr, p
         );
     }
     Ok(web)
+}
+
+/// `--web`: the browser IDE over the served modules; prints its URL.
+pub(crate) fn start_web(args: &crate::ServeArgs, links: &[tmclsim_server::LinkHandle]) -> Result<Option<tmclsim_web::WebHandle>, String> {
+    let Some(addr) = args.web else { return Ok(None) };
+    let target = Arc::new(tmclsim_web::VirtualTarget::new(links).with_frame_log(args.log_frames));
+    let web = start(target, addr, args.web_public)?;
+    println!("  web: {}  (the browser IDE)", web.url());
+    Ok(Some(web))
 }

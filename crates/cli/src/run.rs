@@ -2,7 +2,8 @@
 //! a trace, a plot, breakpoints and an interactive debugger.
 
 use crate::asm::assemble;
-use crate::debugger::{Debug, Debugger};
+use crate::debugger::{Debug, Debugger, inspect};
+use crate::duration::parse_duration;
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -92,35 +93,6 @@ pub(crate) fn setup(module: &mut Module, path: &std::path::Path) -> Result<(), S
     Ok(())
 }
 
-/// Parses `500ms`, `10s`, `5m`, `1h`, `2.5` (seconds) into nanoseconds.
-pub fn parse_duration(text: &str) -> Result<u64, String> {
-    let t = text.trim();
-    let (number, scale) = if let Some(n) = t.strip_suffix("ms") {
-        (n, 1e6)
-    } else if let Some(n) = t.strip_suffix("us") {
-        (n, 1e3)
-    } else if let Some(n) = t.strip_suffix('s') {
-        (n, 1e9)
-    } else if let Some(n) = t.strip_suffix('m') {
-        (n, 60e9)
-    } else if let Some(n) = t.strip_suffix('h') {
-        (n, 3600e9)
-    } else {
-        (t, 1e9)
-    };
-    let v: f64 = number.trim().parse().map_err(|_| format!("'{text}' is not a duration (use e.g. 500ms, 10s, 5m, 1h)"))?;
-    if !(v >= 0.0 && v.is_finite()) {
-        return Err(format!("'{text}' is not a duration: a finite time forward"));
-    }
-    // Refused, not capped: 2^64 ns is the end of virtual time
-    // (docs/behaviour.md rule 84).
-    let ns = v * scale;
-    if ns >= u64::MAX as f64 {
-        return Err(format!("'{text}' is too long: virtual time ends after {:.0} s (about 584 years)", u64::MAX as f64 * 1e-9));
-    }
-    Ok(ns as u64)
-}
-
 pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let (program, profile) = assemble(&args.source, &args.module)?;
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
@@ -189,9 +161,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         // program runs on past the breakpoint it stood on.
         let at_breakpoint = bus.module(0).program().hit_breakpoint.is_some() && bus.module(0).program().mode != RunMode::Run;
         if debugging || at_breakpoint {
-            let answer = debugger.session(bus.module_mut(0), &program, &mut lines, end)?;
-            // Steps moved the module; the bus follows.
-            bus.advance_to(bus.module(0).now_ns());
+            let answer = debugger.session(&mut bus, &program, &mut lines, end)?;
             match answer {
                 Debug::Continue => debugging = false,
                 Debug::Quit => break,
@@ -266,49 +236,4 @@ fn summary(m: &Module, program: &tmclsim_asm::Program, wall: std::time::Duration
     let at = crate::debugger::place(program, p.counter());
     println!("program: {:?} at {at}{}", p.mode, if p.wait.is_some() { ", waiting" } else { "" });
     inspect(m);
-}
-
-pub fn inspect(m: &Module) {
-    let r = m.registers();
-    let p = m.program();
-    println!("  accumulator {}  X {}  compare {:?}  error flags {:#04x}", r.accumulator, r.x, r.compare, r.errors);
-    println!("  stack {:?}  interrupt handler {}", p.stack, if p.handler.is_some() { "active" } else { "none" });
-    for a in 0..m.profile().module.axes as usize {
-        let axis = m.axis(a);
-        println!(
-            "  axis {a}: position {} speed {} target {} mode {:?}",
-            m.actual_position(a),
-            m.actual_speed(a),
-            axis.target_word,
-            axis.motion.mode
-        );
-    }
-    println!("  outputs {:#b}", m.outputs());
-    let vars: Vec<String> = (0..m.profile().module.user_variables as usize)
-        .filter_map(|i| {
-            let v = m.user_variable_value(i);
-            (v != 0).then(|| format!("{i}={v}"))
-        })
-        .collect();
-    if !vars.is_empty() {
-        println!("  user variables {}", vars.join(" "));
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::parse_duration;
-
-    #[test]
-    fn durations_out_of_range_are_refused_not_capped() {
-        assert_eq!(parse_duration("1.5s"), Ok(1_500_000_000));
-        assert_eq!(parse_duration("500ms"), Ok(500_000_000));
-        assert_eq!(parse_duration("1e10"), Ok(10_000_000_000_000_000_000));
-        for long in ["18446744074s", "1e12", "1e300h"] {
-            assert!(parse_duration(long).unwrap_err().contains("is too long"), "{long}");
-        }
-        for bad in ["-1s", "nan", "inf", "-inf"] {
-            assert!(parse_duration(bad).unwrap_err().contains("is not a duration"), "{bad}");
-        }
-    }
 }

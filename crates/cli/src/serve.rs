@@ -143,7 +143,7 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
     println!("connect with: an EtherCAT master on {iface}'s peer, e.g. pysoem: master.open(\"<peer interface>\")");
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    wait_for_signal();
+    crate::signal::wait_for_signal();
     println!("tmclsim: stopping");
     handle.stop();
     Ok(ExitCode::SUCCESS)
@@ -231,13 +231,13 @@ fn serve(
             "  a bus: each module answers its own address; PyTrinamic reaches module {a} with --module-id {a} in the ConnectionManager arguments, or module_id={a} in its module class"
         );
     }
-    let web = start_web(args, server.links())?;
+    let web = crate::ide::start_web(args, server.links())?;
     if let Some(a) = ep.pytrinamic_args() {
         println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    wait_for_signal();
+    crate::signal::wait_for_signal();
     drop(web);
     if let Some(path) = &args.endpoints {
         let _ = std::fs::remove_file(path);
@@ -247,35 +247,12 @@ fn serve(
     Ok(ExitCode::SUCCESS)
 }
 
-/// `--web`: the browser IDE over the served modules; prints its URL.
-pub(crate) fn start_web(args: &ServeArgs, links: &[tmclsim_server::LinkHandle]) -> Result<Option<tmclsim_web::WebHandle>, String> {
-    let Some(addr) = args.web else { return Ok(None) };
-    let target = Arc::new(tmclsim_web::VirtualTarget::new(links).with_frame_log(args.log_frames));
-    let web = crate::ide::start(target, addr, args.web_public)?;
-    println!("  web: {}  (the browser IDE)", web.url());
-    Ok(Some(web))
-}
-
 fn send_target(ep: &tmclsim_server::Endpoints) -> String {
     match (&ep.tcp, &ep.pty) {
         (Some(a), _) => format!("--tcp {a}"),
         (None, Some((link, _))) => format!("--port {}", link.display()),
         _ => String::new(),
     }
-}
-
-pub(crate) fn wait_for_signal() {
-    let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().expect("signal runtime");
-    rt.block_on(async {
-        use tokio::signal::unix::{SignalKind, signal};
-        let mut term = signal(SignalKind::terminate()).expect("SIGTERM handler");
-        let mut hup = signal(SignalKind::hangup()).expect("SIGHUP handler");
-        tokio::select! {
-            _ = tokio::signal::ctrl_c() => {}
-            _ = term.recv() => {}
-            _ = hup.recv() => {}
-        }
-    });
 }
 
 /// `--endpoints FILE`: where the server listens, as TOML, for scripts.

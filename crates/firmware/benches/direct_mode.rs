@@ -2,7 +2,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
-use tmclsim_firmware::Module;
+use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::Request;
 use tmclsim_protocol::mnemonic::parse_line;
 
@@ -36,12 +36,13 @@ fn bench(c: &mut Criterion) {
         let mut m = Module::built_in("tmcm-1141").unwrap();
         m.load_program(&words).unwrap();
         m.start_program();
-        b.iter(|| m.advance(black_box(25_000_000)))
+        let mut bus = Bus::single(m);
+        b.iter(|| bus.advance(black_box(25_000_000)))
     });
     c.bench_function("advance 1 ms while moving", |b| {
-        let mut m = Module::built_in("tmcm-1141").unwrap();
-        m.handle_frame(&frames(&["ROR 0, 1000"])[0]);
-        b.iter(|| m.advance(black_box(1_000_000)))
+        let mut bus = Bus::single(Module::built_in("tmcm-1141").unwrap());
+        bus.handle_frame(&frames(&["ROR 0, 1000"])[0]);
+        b.iter(|| bus.advance(black_box(1_000_000)))
     });
 }
 

@@ -2,8 +2,10 @@
 //! module is a bus of one) with their [`Clock`].
 //!
 //! Requests go in (9-byte frames, CAN frames, ASCII bytes), replies come
-//! out; time moves with [`Bus::advance_to`], and [`Bus::next_deadline`]
-//! says exactly when something happens next on its own. What a front end
+//! out; time moves with [`Bus::advance_to`] (and a debugger's
+//! [`Bus::step_instruction`]), and only here: a module's own time-moving
+//! methods are the firmware's. [`Bus::next_deadline`] says exactly when
+//! something happens next on its own. What a front end
 //! must carry out (EEPROM images to persist, 138 events to send) it takes
 //! with [`Bus::take_effects`]; observers look at [`Bus::snapshot`].
 
@@ -119,6 +121,33 @@ impl Bus {
         if !self.clock.is_stepped() {
             self.clock = Clock::wall_from(self.now_ns);
         }
+    }
+
+    /// Runs the program of module `index` until one more instruction has
+    /// executed (a WAIT in progress first ends), then pauses it, as a
+    /// debugger's single step; the bus is brought to now first and goes
+    /// on to where the step ended, at most `limit_ns`, in pieces of at most
+    /// `slice_ns` while a WAIT waits. False when `limit_ns` came first.
+    pub fn step_instruction(&mut self, index: usize, limit_ns: u64, slice_ns: u64) -> bool {
+        self.catch_up();
+        let done = self.modules[index].step_instruction(limit_ns, slice_ns);
+        let now = self.modules[index].now_ns();
+        self.advance_to(now);
+        if !self.clock.is_stepped() {
+            self.clock = Clock::wall_from(self.now_ns);
+        }
+        done
+    }
+
+    /// Brings the modules a frame to `address` is for to the clock's now
+    /// (the others may lag until they are next looked at): what their
+    /// programs do until now is then told apart from what the frame does.
+    pub fn catch_up_addressed(&mut self, address: u8) {
+        let now = self.now_ns();
+        for m in self.modules.iter_mut().filter(|m| m.answers_to(address)) {
+            m.advance_to(now);
+        }
+        self.now_ns = now;
     }
 
     /// The next virtual time at which something happens on its own on any

@@ -17,8 +17,9 @@ impl Module {
 
     /// Runs until one more instruction has executed (a WAIT in progress
     /// first ends), then pauses; time stops at most `slice_ns` after it.
-    /// Returns false when `limit_ns` came first.
-    pub fn step_instruction(&mut self, limit_ns: u64, slice_ns: u64) -> bool {
+    /// Returns false when `limit_ns` came first. Front ends step with
+    /// [`crate::Bus::step_instruction`].
+    pub(crate) fn step_instruction(&mut self, limit_ns: u64, slice_ns: u64) -> bool {
         let before = self.program.executed;
         self.program.single_step = true;
         self.start_program();
@@ -68,7 +69,7 @@ impl Module {
     /// still waiting is the step's instruction: its condition is looked at
     /// once, and the instruction after it waits for the next step
     /// (docs/behaviour.md rule 31).
-    pub fn step_program(&mut self) {
+    pub(crate) fn step_program(&mut self) {
         if self.program.wait.is_some() {
             self.check_wait();
             return;

@@ -3,7 +3,8 @@
 //! `tmclsim-profile` (re-exported as [`profile`]).
 //!
 //! Pure and deterministic: a [`Module`] changes only through
-//! [`Module::handle_frame`] / [`Module::execute`] and [`Module::advance`].
+//! [`Module::handle_frame`] / [`Module::execute`] and the passing of
+//! virtual time, which only a [`Bus`] moves ([`Bus::advance_to`]).
 
 pub mod ascii;
 pub mod bus;

@@ -26,8 +26,9 @@ fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
 impl Module {
     /// Advances virtual time by `dt_ns` nanoseconds: the program runs its
     /// instructions, the motors move, interrupts and events fire, each at
-    /// its own moment.
-    pub fn advance(&mut self, dt_ns: u64) {
+    /// its own moment. Only the bus moves a module's time ([`crate::Bus`],
+    /// with its clock).
+    pub(crate) fn advance(&mut self, dt_ns: u64) {
         let end = self.now_ns.saturating_add(dt_ns);
         self.look_at_inputs();
         loop {
@@ -115,7 +116,7 @@ impl Module {
     }
 
     /// Advances virtual time to an absolute time (no-op if in the past).
-    pub fn advance_to(&mut self, t_ns: u64) {
+    pub(crate) fn advance_to(&mut self, t_ns: u64) {
         if t_ns > self.now_ns {
             self.advance(t_ns - self.now_ns);
         }

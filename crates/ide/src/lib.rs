@@ -17,9 +17,4 @@ pub mod program;
 pub mod reply;
 pub mod target;
 
-pub use target::{Found, ModuleEntry, Target, TargetError};
-
-/// The status text of a reply status code.
-pub fn status_text(code: u8) -> &'static str {
-    tmclsim_protocol::Status::from_code(code).map_or("unknown status", |s| s.describe())
-}
+pub use target::{Found, ModuleEntry, Target, TargetError, status_text};

@@ -63,7 +63,7 @@ pub fn download_words(target: &dyn Target, id: usize, words: &[Instruction], pro
         let r = t.request(id, *w)?;
         if r[2] != Status::Loaded.code() {
             let _ = t.request(id, Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
-            return Err(TargetError::Failed(format!("word {a} was not stored: status {} ({})", r[2], crate::status_text(r[2]))));
+            return Err(TargetError::Failed(format!("word {a} was not stored: status {} ({})", r[2], crate::target::status_text(r[2]))));
         }
         if a % 8 == 7 || a + 1 == words.len() {
             progress(json!({"progress": a + 1, "total": total}));
@@ -111,7 +111,7 @@ pub fn read_program(target: &dyn Target, id: usize) -> Result<Vec<Instruction>, 
             if a > 0 && raw[2] == Status::InvalidValue.code() {
                 break;
             }
-            return Err(TargetError::Failed(format!("reading word {a}: status {} ({})", raw[2], crate::status_text(raw[2]))));
+            return Err(TargetError::Failed(format!("reading word {a}: status {} ({})", raw[2], crate::target::status_text(raw[2]))));
         }
         all.push(Instruction::from_bytes(raw[1..8].try_into().expect("seven bytes")));
     }

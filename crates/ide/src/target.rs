@@ -110,6 +110,11 @@ pub trait Target: Send + Sync + 'static {
 pub fn check(reply: &[u8; FRAME_LEN]) -> Result<(), TargetError> {
     match reply[2] {
         s if s >= 100 => Ok(()),
-        s => Err(TargetError::Failed(format!("the module answered status {s} ({})", crate::status_text(s)))),
+        s => Err(TargetError::Failed(format!("the module answered status {s} ({})", status_text(s)))),
     }
+}
+
+/// The status text of a reply status code.
+pub fn status_text(code: u8) -> &'static str {
+    tmclsim_protocol::Status::from_code(code).map_or("unknown status", |s| s.describe())
 }

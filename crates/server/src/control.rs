@@ -19,7 +19,7 @@ pub use tmclsim_firmware::world_command::HELP;
 /// clients at once (docs/robustness.md), each line at most
 /// `config.control_max_line` bytes, and with `config.control_token` set,
 /// only clients whose first line is `auth TOKEN`.
-pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(listener: TcpListener, bus: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
     let mut slots = Slots::new("control connection", config.control_max_connections, config.idle_timeout);
     let token: Option<Arc<str>> = config.control_token.as_deref().map(Arc::from);
     let mut failing = false;
@@ -34,7 +34,7 @@ pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: S
                     continue;
                 }
                 let activity = Arc::new(Activity::new());
-                let session = session(stream, module.clone(), token.clone(), config.control_max_line, activity.clone());
+                let session = session(stream, bus.clone(), token.clone(), config.control_max_line, activity.clone());
                 slots.spawn(peer, activity, session);
             }
             _ = slots.reap(), if !slots.is_empty() => {}
@@ -45,7 +45,7 @@ pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: S
 }
 
 /// One control client: a line in, an answer line out.
-async fn session(stream: TcpStream, module: Arc<SharedBus>, token: Option<Arc<str>>, max_line: usize, activity: Arc<Activity>) {
+async fn session(stream: TcpStream, bus: Arc<SharedBus>, token: Option<Arc<str>>, max_line: usize, activity: Arc<Activity>) {
     let (mut r, mut w) = stream.into_split();
     // A client that opens with another protocol (a web page's request) is
     // closed before anything runs (docs/behaviour.md rule 90).
@@ -92,7 +92,7 @@ async fn session(stream: TcpStream, module: Arc<SharedBus>, token: Option<Arc<st
                         }
                     }
                 }
-                match execute(&module, command) {
+                match execute(&bus, command) {
                     Ok(text) => format!("ok{}{text}\n", if text.is_empty() { "" } else { " " }),
                     Err(e) => format!("error: {e}\n"),
                 }

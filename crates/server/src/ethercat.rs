@@ -3,6 +3,8 @@
 //! the same interface, as from the last slave of a line.
 
 use crate::eeprom_file::EepromFile;
+use crate::eeprom_files::EepromFiles;
+use std::collections::BTreeMap;
 use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
@@ -99,16 +101,14 @@ fn open(iface: &str) -> io::Result<(libc::c_int, libc::c_int)> {
 pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>) -> io::Result<EthercatHandle> {
     let (fd, index) = open(iface)?;
     segment.bus.set_stepped(false);
-    let persisted: Vec<_> = segment.bus.modules().iter().map(|m| m.eeprom().clone()).collect();
+    let files = EepromFiles::new(&segment.bus, eeproms.into_iter().map(|f| f.map(Arc::new)).collect(), false);
     let stop = Arc::new(AtomicBool::new(false));
     let segment = Arc::new(Mutex::new(segment));
     let counters = Arc::new(Mutex::new((0u64, 0u64)));
     let (writes, written) = mpsc::channel::<(usize, Eeprom)>();
     let saver = {
         let segment = segment.clone();
-        std::thread::Builder::new()
-            .name("tmclsim-ethercat-eeprom".into())
-            .spawn(move || save_writes(written, eeproms, persisted, segment))?
+        std::thread::Builder::new().name("tmclsim-ethercat-eeprom".into()).spawn(move || save_writes(written, files, segment))?
     };
     let (t_stop, t_segment, t_counters) = (stop.clone(), segment.clone(), counters.clone());
     let thread = std::thread::Builder::new().name("tmclsim-ethercat".into()).spawn(move || {
@@ -189,31 +189,14 @@ fn realtime() {
 /// module when several wait. A save that fails puts the module back to
 /// what its file holds (docs/behaviour.md rule 82). Returns when the
 /// frame thread has ended and nothing waits.
-fn save_writes(
-    written: mpsc::Receiver<(usize, Eeprom)>,
-    eeproms: Vec<Option<EepromFile>>,
-    mut persisted: Vec<Eeprom>,
-    segment: Arc<Mutex<Segment>>,
-) {
+fn save_writes(written: mpsc::Receiver<(usize, Eeprom)>, mut files: EepromFiles, segment: Arc<Mutex<Segment>>) {
     while let Ok(first) = written.recv() {
-        let mut newest: Vec<Option<Eeprom>> = vec![None; persisted.len()];
-        for (i, image) in std::iter::once(first).chain(written.try_iter()) {
-            if let Some(slot) = newest.get_mut(i) {
-                *slot = Some(image);
-            }
-        }
-        for (i, image) in newest.into_iter().enumerate() {
-            let (Some(image), Some(Some(file))) = (image, eeproms.get(i)) else { continue };
-            match file.save(&image) {
-                Ok(()) => persisted[i] = image,
-                Err(e) => {
-                    eprintln!(
-                        "tmclsim: cannot write EEPROM file {}: {e}; the write is not kept (the module keeps the EEPROM the file holds)",
-                        file.named().display()
-                    );
-                    let mut seg = segment.lock().unwrap_or_else(|p| p.into_inner());
-                    seg.bus.module_mut(i).restore_eeprom(persisted[i].clone());
-                }
+        let mut newest: BTreeMap<usize, Eeprom> = BTreeMap::new();
+        newest.extend(std::iter::once(first).chain(written.try_iter()));
+        for (i, image) in newest {
+            if !files.save(i, &image) {
+                let mut seg = segment.lock().unwrap_or_else(|p| p.into_inner());
+                seg.bus.module_mut(i).restore_eeprom(files.held(i).clone());
             }
         }
     }

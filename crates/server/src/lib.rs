@@ -16,6 +16,7 @@
 mod clock;
 pub mod control;
 pub mod eeprom_file;
+mod eeprom_files;
 pub mod ethercat;
 mod faults;
 pub mod files;
@@ -135,11 +136,11 @@ impl Endpoints {
     }
 }
 
-/// One served link: its endpoints and its module(s).
+/// One served link: its endpoints and the bus of its module(s).
 #[derive(Clone)]
 pub struct LinkHandle {
     pub endpoints: Endpoints,
-    pub module: Arc<SharedBus>,
+    pub bus: Arc<SharedBus>,
 }
 
 /// A server running on its own thread; dropping it stops it.
@@ -157,9 +158,9 @@ impl ServerHandle {
         &self.links[0].endpoints
     }
 
-    /// The served module(s) of the (first) link.
-    pub fn module(&self) -> &Arc<SharedBus> {
-        &self.links[0].module
+    /// The bus of the served module(s) of the (first) link.
+    pub fn bus(&self) -> &Arc<SharedBus> {
+        &self.links[0].bus
     }
 
     /// Every link of a fleet.
@@ -169,7 +170,7 @@ impl ServerHandle {
 
     /// Frames handled and real-time deadlines missed, over all links.
     pub fn stats(&self) -> shared::Stats {
-        self.links.iter().fold(shared::Stats::default(), |acc, l| acc.merged(l.module.stats()))
+        self.links.iter().fold(shared::Stats::default(), |acc, l| acc.merged(l.bus.stats()))
     }
 
     /// Stops serving, closes the links and removes the pty symlinks.
@@ -411,19 +412,19 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
                 .collect();
             let _ = ready_tx.send(Ok((endpoints, claims)));
             let mut tasks = tokio::task::JoinSet::new();
-            for ((module, config), o) in specs.into_iter().zip(opened) {
-                tasks.spawn(clock::run(module.clone(), stop_rx.clone()));
+            for ((bus, config), o) in specs.into_iter().zip(opened) {
+                tasks.spawn(clock::run(bus.clone(), stop_rx.clone()));
                 if let Some(listener) = o.tcp {
-                    tasks.spawn(tcp::run(listener, module.clone(), config.clone(), stop_rx.clone()));
+                    tasks.spawn(tcp::run(listener, bus.clone(), config.clone(), stop_rx.clone()));
                 }
                 if let Some(p) = o.pty {
-                    tasks.spawn(pty::run(p, module.clone(), config.clone(), stop_rx.clone()));
+                    tasks.spawn(pty::run(p, bus.clone(), config.clone(), stop_rx.clone()));
                 }
                 if let Some(listener) = o.control {
-                    tasks.spawn(control::run(listener, module.clone(), config.clone(), stop_rx.clone()));
+                    tasks.spawn(control::run(listener, bus.clone(), config.clone(), stop_rx.clone()));
                 }
                 if let Some(p) = o.slcan {
-                    tasks.spawn(slcan::run(p, module.clone(), stop_rx.clone()));
+                    tasks.spawn(slcan::run(p, bus.clone(), stop_rx.clone()));
                 }
             }
             let mut stop = stop_rx.clone();
@@ -460,6 +461,6 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
             eprintln!("tmclsim: warning: {w}");
         }
     }
-    let links = endpoints.into_iter().zip(shared).map(|(endpoints, module)| LinkHandle { endpoints, module }).collect();
+    let links = endpoints.into_iter().zip(shared).map(|(endpoints, bus)| LinkHandle { endpoints, bus }).collect();
     Ok(ServerHandle { links, claims, stop: stop_tx, thread: Some(thread) })
 }

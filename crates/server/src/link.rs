@@ -78,13 +78,13 @@ fn screen<'a>(preamble: &mut Option<Preamble>, bytes: &'a [u8]) -> Screened<'a> 
 
 /// Tells the bus that a link is gone, however its task ends.
 struct Closing<'a> {
-    module: &'a SharedBus,
+    bus: &'a SharedBus,
     link: u64,
 }
 
 impl Drop for Closing<'_> {
     fn drop(&mut self) {
-        self.module.link_closed(self.link);
+        self.bus.link_closed(self.link);
     }
 }
 
@@ -96,7 +96,7 @@ impl Drop for Closing<'_> {
 pub(crate) async fn serve<R, W>(
     mut reader: R,
     mut writer: W,
-    module: Arc<SharedBus>,
+    bus: Arc<SharedBus>,
     options: &Options,
     lines: &mut LineState,
     activity: &Activity,
@@ -106,7 +106,7 @@ where
     W: AsyncWrite + Unpin,
 {
     let link = next_link_id();
-    let _closing = Closing { module: &module, link };
+    let _closing = Closing { bus: &bus, link };
     let mut preamble = options.network.map(|_| Preamble::new());
     let mut bad_frames = 0u32;
     let (events_tx, mut events) = mpsc::unbounded_channel::<[u8; FRAME_LEN]>();
@@ -137,10 +137,10 @@ where
                 };
                 let mut text = Vec::new();
                 for &byte in bytes.iter() {
-                    if module.ascii_active() {
+                    if bus.ascii_active() {
                         // ASCII mode: text in, text out; the frame
                         // assembler starts afresh afterwards.
-                        module.ascii_byte(lines, byte, &mut text);
+                        bus.ascii_byte(lines, byte, &mut text);
                         if byte == b'\r' {
                             activity.touch();
                         }
@@ -155,9 +155,9 @@ where
                     bad_frames = if checksum_ok { 0 } else { bad_frames + 1 };
                     activity.touch();
                     log(crate::frame_log::Direction::In, &frame);
-                    let (replies, pause) = module.handle(link, &events_tx, &frame);
+                    let (replies, pause) = bus.handle(link, &events_tx, &frame);
                     for reply in replies {
-                        let (reply, fault_delay) = module.outgoing(reply);
+                        let (reply, fault_delay) = bus.outgoing(reply);
                         let delay = pause + fault_delay;
                         if !delay.is_zero() {
                             tokio::time::sleep(delay).await;
@@ -179,7 +179,7 @@ where
                 writer.flush().await?;
             }
             Some(event) = events.recv() => {
-                if let (Some(event), _) = module.outgoing(event) {
+                if let (Some(event), _) = bus.outgoing(event) {
                     log(crate::frame_log::Direction::Out, &event);
                     writer.write_all(&event).await?;
                     writer.flush().await?;

@@ -211,7 +211,7 @@ impl AsyncWrite for Master {
     }
 }
 
-pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(pty: Pty, bus: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
     let (master, _slave) = match pty.into_stream() {
         Ok(v) => v,
         Err(e) => {
@@ -224,7 +224,7 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, config: ServerConfig, 
     let activity = crate::slots::Activity::new();
     let options = crate::link::Options::local(&config, "pty".into());
     loop {
-        let served = crate::link::serve(master.clone(), master.clone(), module.clone(), &options, &mut lines, &activity);
+        let served = crate::link::serve(master.clone(), master.clone(), bus.clone(), &options, &mut lines, &activity);
         tokio::select! {
             r = served => {
                 if let Err(e) = r {

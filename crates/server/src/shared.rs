@@ -4,12 +4,13 @@
 //! that receives events, link faults and counters.
 
 use crate::eeprom_file::EepromFile;
+use crate::eeprom_files::EepromFiles;
 use crate::faults::LinkFaults;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::can::CanFrame;
 use tmclsim_firmware::world_command::WorldCommand;
-use tmclsim_firmware::{Bus, Eeprom, Module};
+use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Status};
 use tokio::sync::{Notify, mpsc};
 
@@ -22,10 +23,7 @@ const UNCLAIMED_EVENTS: usize = 1024;
 struct State {
     bus: Bus,
     /// EEPROM file of each module, held (locked) while the bus has it.
-    eeproms: Vec<Option<Arc<EepromFile>>>,
-    /// The image each module's EEPROM file holds: what a module's EEPROM
-    /// goes back to when a save fails (docs/behaviour.md rule 82).
-    persisted: Vec<Eeprom>,
+    eeproms: EepromFiles,
     sink: Option<(u64, EventSink)>,
     /// Events no link has claimed yet, by module index.
     unclaimed: Vec<(usize, [u8; FRAME_LEN])>,
@@ -71,12 +69,11 @@ impl SharedBus {
     /// A bus with each module's EEPROM file (`eeproms` shorter than the
     /// bus: no file for the rest). A module's EEPROM image is taken to be
     /// what its file holds.
-    pub fn new(bus: Bus, mut eeproms: Vec<Option<Arc<EepromFile>>>) -> SharedBus {
-        eeproms.resize(bus.len(), None);
-        let persisted = bus.modules().iter().map(|m| m.eeprom().clone()).collect();
+    pub fn new(bus: Bus, eeproms: Vec<Option<Arc<EepromFile>>>) -> SharedBus {
+        let eeproms = EepromFiles::new(&bus, eeproms, true);
         let shared = SharedBus {
             stats: Mutex::new(Stats::default()),
-            state: Mutex::new(State { bus, eeproms, persisted, sink: None, unclaimed: Vec::new(), scheduled: None }),
+            state: Mutex::new(State { bus, eeproms, sink: None, unclaimed: Vec::new(), scheduled: None }),
             changed: Notify::new(),
             faults: Mutex::new(LinkFaults::default()),
             ascii: std::sync::atomic::AtomicBool::new(false),
@@ -220,9 +217,9 @@ impl SharedBus {
         let mut s = self.lock();
         s.bus.catch_up();
         Self::after_change(&mut s);
-        s.eeproms.clear();
-        s.persisted.clear();
-        std::mem::replace(&mut s.bus, Bus::new(Vec::new())).into_modules()
+        let bus = std::mem::replace(&mut s.bus, Bus::new(Vec::new()));
+        s.eeproms = EepromFiles::new(&s.bus, Vec::new(), true);
+        bus.into_modules()
     }
 
     /// Events of module `index` that no link received (an in-process user
@@ -239,16 +236,9 @@ impl SharedBus {
     pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
         self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
-        let before = Self::generations(&mut s, |bus| {
-            // The addressed modules first catch up on their own, so that
-            // what their programs store is not taken for the request's.
-            let now = bus.now_ns();
-            for i in 0..bus.len() {
-                if bus.module(i).answers_to(frame[0]) {
-                    bus.module_mut(i).advance_to(now);
-                }
-            }
-        });
+        // The addressed modules first catch up on their own, so that what
+        // their programs store is not taken for the request's.
+        let before = Self::generations(&mut s, |bus| bus.catch_up_addressed(frame[0]));
         let mut answer = s.bus.handle_frame_from(link, frame);
         let written = Self::written_since(&s, before);
         let failed = self.after_request(s, link, sink, !answer.replies.is_empty());
@@ -314,7 +304,7 @@ impl SharedBus {
     /// EEPROM file, nothing to note).
     fn generations(s: &mut State, prepare: impl FnOnce(&mut Bus)) -> Option<Vec<u64>> {
         prepare(&mut s.bus);
-        s.eeproms.iter().any(Option::is_some).then(|| s.bus.modules().iter().map(Module::eeprom_generation).collect())
+        s.eeproms.any().then(|| s.bus.modules().iter().map(Module::eeprom_generation).collect())
     }
 
     /// After a request: the modules whose EEPROM it wrote.
@@ -405,24 +395,7 @@ impl SharedBus {
                 None => {}
             }
         }
-        let mut failed = Vec::new();
-        for index in effects.eeprom_written {
-            let Some(file) = &s.eeproms[index] else { continue };
-            let image = s.bus.module(index).eeprom();
-            match file.save(image) {
-                Ok(()) => s.persisted[index] = image.clone(),
-                Err(e) => {
-                    eprintln!(
-                        "tmclsim: cannot write EEPROM file {}: {e}; the write is not kept (status 5 to the command that made it; the module keeps the EEPROM the file holds)",
-                        file.named().display()
-                    );
-                    let persisted = s.persisted[index].clone();
-                    s.bus.module_mut(index).restore_eeprom(persisted);
-                    failed.push(index);
-                }
-            }
-        }
-        failed
+        effects.eeprom_written.into_iter().filter(|&index| !s.eeproms.save_from(&mut s.bus, index)).collect()
     }
 }
 

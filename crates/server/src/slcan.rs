@@ -13,7 +13,7 @@ use tokio::sync::{mpsc, watch};
 /// Longest command line kept (an extended frame with 8 bytes is 26).
 const MAX_LINE: usize = 64;
 
-pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(pty: Pty, bus: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
     let (master, _slave) = match pty.into_stream() {
         Ok(v) => v,
         Err(e) => {
@@ -43,7 +43,7 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, mut stop: watch::Recei
                         b'\r' => {
                             let text = String::from_utf8_lossy(&line).into_owned();
                             line.clear();
-                            command(&text, &mut open, &module, link, &events_tx, &mut out);
+                            command(&text, &mut open, &bus, link, &events_tx, &mut out);
                         }
                         b'\n' => {}
                         _ if line.len() < MAX_LINE => line.push(b),
@@ -53,7 +53,7 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, mut stop: watch::Recei
             }
             Some(event) = events.recv() => {
                 if open
-                    && let Some(f) = module.event_as_can(&event) {
+                    && let Some(f) = bus.event_as_can(&event) {
                         out.push_str(&slcan::received(f.id, f.bytes()));
                     }
             }
@@ -67,7 +67,7 @@ pub(crate) async fn run(pty: Pty, module: Arc<SharedBus>, mut stop: watch::Recei
 
 /// One line from the host; the adapter's answer and any received frames
 /// are appended to `out`.
-fn command(text: &str, open: &mut bool, module: &SharedBus, link: u64, events: &mpsc::UnboundedSender<[u8; 9]>, out: &mut String) {
+fn command(text: &str, open: &mut bool, bus: &SharedBus, link: u64, events: &mpsc::UnboundedSender<[u8; 9]>, out: &mut String) {
     const OK: &str = "\r";
     const ERROR: &str = "\x07";
     match slcan::parse(text) {
@@ -92,7 +92,7 @@ fn command(text: &str, open: &mut bool, module: &SharedBus, link: u64, events: &
             if extended || remote {
                 return;
             }
-            for reply in module.handle_can(link, events, &CanFrame::new(id, &data)) {
+            for reply in bus.handle_can(link, events, &CanFrame::new(id, &data)) {
                 out.push_str(&slcan::received(reply.id, reply.bytes()));
             }
         }

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use tokio::net::TcpListener;
 use tokio::sync::watch;
 
-pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
+pub(crate) async fn run(listener: TcpListener, bus: Arc<SharedBus>, config: ServerConfig, mut stop: watch::Receiver<bool>) {
     let mut slots = Slots::new("connection", config.max_connections, config.idle_timeout);
     let mut failing = false;
     loop {
@@ -20,14 +20,14 @@ pub(crate) async fn run(listener: TcpListener, module: Arc<SharedBus>, config: S
                     continue;
                 }
                 let _ = stream.set_nodelay(true);
-                let module = module.clone();
+                let bus = bus.clone();
                 let options = crate::link::Options::network(&config, format!("tcp {peer}"));
                 let activity = Arc::new(Activity::new());
                 let seen = activity.clone();
                 slots.spawn(peer, activity, async move {
                     let (r, w) = stream.into_split();
                     let mut lines = Default::default();
-                    let _ = crate::link::serve(r, w, module, &options, &mut lines, &seen).await;
+                    let _ = crate::link::serve(r, w, bus, &options, &mut lines, &seen).await;
                 });
             }
             _ = slots.reap(), if !slots.is_empty() => {}

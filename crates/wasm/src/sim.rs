@@ -288,12 +288,8 @@ impl Sim {
     /// time moving as needed, at most 10 s), then pauses. False when the
     /// 10 s passed first.
     pub fn step(&mut self) -> bool {
-        self.bus.catch_up();
-        let m = self.bus.module_mut(0);
-        let end = m.now_ns().saturating_add(STEP_LIMIT_NS);
-        let done = m.step_instruction(end, STEP_SLICE_NS);
-        let now = m.now_ns();
-        self.bus.advance_to(now);
+        let end = self.bus.now_ns().saturating_add(STEP_LIMIT_NS);
+        let done = self.bus.step_instruction(0, end, STEP_SLICE_NS);
         self.collect_events();
         done
     }

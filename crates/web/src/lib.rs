@@ -4,6 +4,7 @@
 //! this crate's README.
 
 mod api;
+mod app;
 mod assets;
 pub mod link_target;
 mod live;
@@ -99,7 +100,7 @@ pub fn start(target: Arc<dyn Target>, config: WebConfig) -> std::io::Result<WebH
     listener.set_nonblocking(true)?;
     let addr = listener.local_addr()?;
     let (stop, stopped) = watch::channel(false);
-    let state = api::App::new(target, token.clone());
+    let state = app::App::new(target, token.clone());
     let thread = std::thread::Builder::new().name("tmclsim-web".into()).spawn(move || {
         // One thread: the app's requests are short; link targets' waits run
         // on the blocking pool.

@@ -4,7 +4,7 @@
 //! program counter (135 type 1) after every step, until it reaches one
 //! (docs/behaviour.md rule 86).
 
-use crate::target::{Found, ModuleEntry, Target, TargetError, check};
+use tmclsim_ide::target::{Found, ModuleEntry, Target, TargetError, check};
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, Weak};

@@ -2,7 +2,7 @@
 //! app subscribed to (TMCL reads through the target) at the rate it asked
 //! for, and the program's state when asked.
 
-use crate::api::App;
+use crate::app::App;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::extract::{Path, State};
 use axum::response::Response;

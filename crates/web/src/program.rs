@@ -3,7 +3,7 @@
 //! streamed as progress lines, run/stop/pause/step/continue/reset
 //! (128–131), the breakpoints, and the program's state.
 
-use crate::api::{ApiError, App, bad, blocking};
+use crate::app::{ApiError, App, bad, blocking};
 use axum::Json;
 use axum::body::Body;
 use axum::extract::{Path, State};

@@ -78,8 +78,21 @@ fn cookie(h: &HeaderMap) -> Option<String> {
         .find_map(|kv| kv.trim().strip_prefix(COOKIE).and_then(|r| r.strip_prefix('=')).map(str::to_string))
 }
 
+/// What the checks in front of every route need: the token requests must
+/// carry (non-loopback binds only) and the refused ones in a row.
+pub struct Guard {
+    token: Option<String>,
+    failures: Failures,
+}
+
+impl Guard {
+    pub fn new(token: Option<String>) -> Guard {
+        Guard { token, failures: Failures::default() }
+    }
+}
+
 /// The checks, in front of every route.
-pub async fn guard(State(app): State<crate::api::App>, req: Request, next: Next) -> Response {
+pub async fn guard(State(guard): State<std::sync::Arc<Guard>>, req: Request, next: Next) -> Response {
     let host = req.headers().get(header::HOST).and_then(|v| v.to_str().ok()).unwrap_or("").to_string();
     if let Some(origin) = req.headers().get(header::ORIGIN) {
         let origin = origin.to_str().unwrap_or("");
@@ -88,7 +101,7 @@ pub async fn guard(State(app): State<crate::api::App>, req: Request, next: Next)
             return refuse(&format!("requests from {origin} are refused: the IDE answers its own pages only"));
         }
     }
-    match &app.token {
+    match &guard.token {
         None if !is_loopback_name(host_of(&host)) => {
             return refuse(&format!("host '{host}' is not this machine's loopback (a DNS-rebinding request is refused)"));
         }
@@ -97,10 +110,10 @@ pub async fn guard(State(app): State<crate::api::App>, req: Request, next: Next)
             let given = token_of(&req);
             if !given.as_deref().is_some_and(|g| tmclsim_server::control::same_token(g, token)) {
                 // Each failure in a row waits longer before its answer.
-                tokio::time::sleep(app.failures.penalty()).await;
+                tokio::time::sleep(guard.failures.penalty()).await;
                 return refuse("this IDE needs the token printed when it started (?token=…)");
             }
-            app.failures.clear();
+            guard.failures.clear();
             let set = req.uri().query().is_some_and(|q| q.contains("token="));
             let mut response = next.run(req).await;
             if set {

@@ -3,7 +3,7 @@
 //! and a host on the link see each other's effects; observations read the
 //! model and change nothing (docs/behaviour.md rule 86).
 
-use crate::target::{ModuleEntry, Target, TargetError};
+use tmclsim_ide::target::{ModuleEntry, Target, TargetError};
 use std::sync::Arc;
 use tmclsim_firmware::snapshot::ModuleSnapshot;
 use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
@@ -30,13 +30,13 @@ impl VirtualTarget {
         let mut places = Vec::new();
         for link in links {
             let name = link_name(link);
-            for index in 0..link.module.len() {
-                let (address, profile, firmware) = link.module.with_module(index, |m| {
+            for index in 0..link.bus.len() {
+                let (address, profile, firmware) = link.bus.with_module(index, |m| {
                     let p = m.profile().clone();
                     (m.address(), p.clone(), String::from_utf8_lossy(&p.version_text()).into_owned())
                 });
                 entries.push(ModuleEntry { address, profile: Some(profile), firmware, link: name.clone() });
-                places.push(Place { bus: link.module.clone(), index });
+                places.push(Place { bus: link.bus.clone(), index });
             }
         }
         let description = match links {
@@ -155,6 +155,6 @@ impl Target for VirtualTarget {
     fn run(&self, id: usize, start: bool) -> Result<(), TargetError> {
         let kind = u8::from(start);
         let r = self.request(id, Instruction::new(opcode::RUN_APPLICATION, kind, 0, 0))?;
-        crate::target::check(&r)
+        tmclsim_ide::target::check(&r)
     }
 }

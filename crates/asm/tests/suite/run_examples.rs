@@ -3,19 +3,19 @@
 
 use crate::common;
 
-use common::{MS, assemble_path, send};
+use common::{BusOfOne, MS, assemble_path, send};
 use std::path::Path;
 use tmclsim_firmware::{Module, Profile};
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
 
-fn load(name: &str) -> (Module, tmclsim_asm::Program) {
+fn load(name: &str) -> (BusOfOne, tmclsim_asm::Program) {
     let profile = Profile::built_in("tmcm-1141").unwrap();
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/programs").join(name);
     let program = assemble_path(&path, Some(&profile)).unwrap_or_else(|d| panic!("{}", tmclsim_asm::render(&d)));
     let mut m = Module::new(profile);
     m.load_program(&program.instructions).unwrap();
-    (m, program)
+    (BusOfOne::new(m), program)
 }
 
 #[test]

@@ -1,15 +1,17 @@
 //! ASCII mode (TMCM-1141 manual 3.4): entering and leaving, the three echo
 //! modes, backspace editing, addressing, permitted commands, replies.
 
-use tmclsim_firmware::Module;
+use crate::common;
+
+use common::BusOfOne;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
 
-fn binary(m: &mut Module, line: &str) -> Option<Reply> {
+fn binary(m: &mut BusOfOne, line: &str) -> Option<Reply> {
     m.handle_frame(&Request::new(1, parse_line(line).unwrap()).encode()).map(|f| Reply::decode(&f).unwrap())
 }
 
-fn type_text(m: &mut Module, text: &str) -> String {
+fn type_text(m: &mut BusOfOne, text: &str) -> String {
     let mut out = Vec::new();
     for b in text.bytes() {
         m.ascii_byte(b, &mut out);
@@ -17,8 +19,8 @@ fn type_text(m: &mut Module, text: &str) -> String {
     String::from_utf8(out).unwrap()
 }
 
-fn ascii_module() -> Module {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+fn ascii_module() -> BusOfOne {
+    let mut m = BusOfOne::built_in("tmcm-1141");
     assert_eq!(binary(&mut m, "#139 0 0 0").unwrap().status, 100);
     assert!(m.ascii_mode());
     m
@@ -34,7 +36,7 @@ fn reply_format_and_echo_each_character() {
     assert_eq!(type_text(&mut m, "A GAP 1, 0\r"), "A GAP 1, 0\rBA 100 -5000\r");
 }
 
-fn binary_free_sap(m: &mut Module) {
+fn binary_free_sap(m: &mut BusOfOne) {
     // ASCII mode is on; set the position through ASCII too.
     let out = type_text(m, "ASAP 1, 0, -5000\r");
     assert!(out.ends_with("BA 100 -5000\r"), "{out:?}");
@@ -99,7 +101,7 @@ fn run_stop_and_bin() {
 
 #[test]
 fn start_up_in_ascii_mode_with_gp67() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     binary(&mut m, "SGP 67, 0, 1");
     assert!(!m.ascii_mode(), "takes effect at the next start");
     binary(&mut m, "#255 0 0 1234");
@@ -115,7 +117,7 @@ fn each_link_types_its_own_line() {
     let mut m = ascii_module();
     assert_eq!(type_text(&mut m, "ASGP 67, 0, 32\r"), "ASGP 67, 0, 32\rBA 100 32\r");
     let (mut a, mut b) = (AsciiLine::default(), AsciiLine::default());
-    let typed = |m: &mut Module, line: &mut AsciiLine, text: &str| {
+    let typed = |m: &mut BusOfOne, line: &mut AsciiLine, text: &str| {
         let mut out = Vec::new();
         for byte in text.bytes() {
             m.ascii_byte_on(line, byte, &mut out);

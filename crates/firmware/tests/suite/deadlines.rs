@@ -4,11 +4,10 @@
 
 use crate::common;
 
-use common::{MS, send};
-use tmclsim_firmware::Module;
+use common::{BusOfOne, MS, send};
 use tmclsim_protocol::{Instruction, mnemonic};
 
-fn program(m: &mut Module, lines: &[&str]) {
+fn program(m: &mut BusOfOne, lines: &[&str]) {
     let words: Vec<Instruction> = lines.iter().map(|l| mnemonic::parse_line(l).expect(l)).collect();
     m.load_program(&words).unwrap();
     m.start_program();
@@ -16,13 +15,13 @@ fn program(m: &mut Module, lines: &[&str]) {
 
 #[test]
 fn an_idle_module_has_no_deadline() {
-    let m = Module::built_in("tmcm-1141").unwrap();
+    let m = BusOfOne::built_in("tmcm-1141");
     assert_eq!(m.next_deadline(), None);
 }
 
 #[test]
 fn a_program_in_wait_ticks_sleeps_until_the_wait_ends() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     // Loop: WAIT TICKS, 0, 1000 (10 s).
     program(&mut m, &["WAIT TICKS, 0, 1000", "JA 0"]);
     m.advance(1);
@@ -38,7 +37,7 @@ fn a_program_in_wait_ticks_sleeps_until_the_wait_ends() {
 
 #[test]
 fn a_timer_interrupt_is_a_deadline() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     // Timer 0 every 250 ms; the main loop waits 10 s.
     program(&mut m, &["VECT 0, 4", "EI 0", "EI 255", "WAIT TICKS, 0, 1000", "RETI"]);
     send(&mut m, "SGP 0, 3, 250");
@@ -55,7 +54,7 @@ fn a_timer_interrupt_is_a_deadline() {
 
 #[test]
 fn a_move_with_a_138_event_wakes_at_the_arrival() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "#138 0 0 1");
     send(&mut m, "MVP ABS, 0, 51200");
     let d = m.next_deadline().expect("arrival");
@@ -68,7 +67,7 @@ fn a_move_with_a_138_event_wakes_at_the_arrival() {
 
 #[test]
 fn wait_refsw_ends_at_the_home_switch_edge() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     // Home switch between 100 000 and 110 000 µsteps; constant speed.
     m.world_mut().axes[0].home_switch = Some((100_000.0, 110_000.0));
     program(&mut m, &["ROR 0, 2047", "WAIT REFSW, 0, 0", "MST 0", "STOP"]);
@@ -92,7 +91,7 @@ fn a_polling_loop_leaves_when_the_move_ends_however_time_is_sliced() {
     let polling = ["MVP ABS, 0, 51200", "GAP 8, 0", "JC ZE, 1", "GGP 132, 0", "STOP"];
     let waiting = ["MVP ABS, 0, 51200", "WAIT POS, 0, 0", "GGP 132, 0", "STOP"];
     let run = |lines: &[&str], slice: u64| {
-        let mut m = Module::built_in("tmcm-1141").unwrap();
+        let mut m = BusOfOne::built_in("tmcm-1141");
         program(&mut m, lines);
         let mut t = 0;
         while t < 20_000 * MS {

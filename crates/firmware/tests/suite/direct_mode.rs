@@ -4,14 +4,13 @@
 
 use crate::common;
 
-use common::{reply, send, status};
+use common::{BusOfOne, reply, send, status};
 
-use tmclsim_firmware::Module;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Instruction, Reply, Request, Status, checksum};
 
-fn module() -> Module {
-    Module::built_in("tmcm-1141").unwrap()
+fn module() -> BusOfOne {
+    BusOfOne::built_in("tmcm-1141")
 }
 
 #[test]

@@ -3,13 +3,12 @@
 
 use crate::common;
 
-use common::{MS, load, send};
+use common::{BusOfOne, MS, load, send};
 
-use tmclsim_firmware::Module;
 use tmclsim_protocol::mnemonic::parse_line;
 
-fn module() -> Module {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+fn module() -> BusOfOne {
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SAP 6, 0, 255");
     m
 }

@@ -4,17 +4,17 @@
 
 use crate::common;
 
-use common::send;
+use common::{BusOfOne, send};
 
 use tmclsim_firmware::{Eeprom, Module, Profile};
 
-fn power_cycle(m: &Module) -> Module {
-    Module::with_eeprom(m.profile().clone(), m.eeprom().clone())
+fn power_cycle(m: &BusOfOne) -> BusOfOne {
+    BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()))
 }
 
 #[test]
 fn stap_rsap_survive_power_cycles() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SAP 4, 0, 1234");
     send(&mut m, "STAP 4, 0");
     send(&mut m, "SAP 4, 0, 99");
@@ -31,7 +31,7 @@ fn stap_rsap_survive_power_cycles() {
 
 #[test]
 fn bank0_is_stored_automatically() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SGP 75, 0, 15");
     send(&mut m, "SGP 77, 0, 1");
     let mut m = power_cycle(&m);
@@ -41,7 +41,7 @@ fn bank0_is_stored_automatically() {
 
 #[test]
 fn user_variables_and_gp85() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SGP 42, 2, 4242");
     send(&mut m, "STGP 42, 2");
     send(&mut m, "SGP 42, 2, 1");
@@ -61,7 +61,7 @@ fn user_variables_and_gp85() {
 
 #[test]
 fn restart_keeps_the_carriage_where_it_is() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     m.world_mut().axes[0].right_switch = Some(1000.0);
     send(&mut m, "MVP ABS, 0, 800");
     m.advance(5_000_000_000);
@@ -73,7 +73,7 @@ fn restart_keeps_the_carriage_where_it_is() {
 }
 
 /// `execute` a command, whatever the module's address; its status.
-fn run(m: &mut Module, line: &str) -> tmclsim_protocol::Status {
+fn run(m: &mut BusOfOne, line: &str) -> tmclsim_protocol::Status {
     m.execute(tmclsim_protocol::mnemonic::parse_line(line).unwrap_or_else(|e| panic!("{line}: {e}"))).status
 }
 
@@ -85,7 +85,7 @@ fn every_image_a_module_stores_passes_the_check_of_rule_88() {
     // the EEPROM lock. Whatever it stored, the check accepts.
     for name in Profile::names() {
         let profile = Profile::built_in(name).unwrap();
-        let mut m = Module::new(profile.clone());
+        let mut m = BusOfOne::new(Module::new(profile.clone()));
         run(&mut m, "SGP 84, 0, 1");
         for motor in 0..profile.module.axes {
             for p in profile.axis_parameters().filter(|p| p.access.eeprom) {
@@ -150,7 +150,7 @@ fn an_image_from_rust_with_values_out_of_range_powers_up_with_the_defaults() {
     image.set_axis(0, 4, i32::MIN);
     image.set_axis(0, 5, 700);
     assert!(image.check(&profile).is_err());
-    let mut m = Module::with_eeprom(profile.clone(), image);
+    let mut m = BusOfOne::new(Module::with_eeprom(profile.clone(), image));
     assert_eq!((m.reply_delay_ns(), m.address()), (0, 1));
     assert_eq!(send(&mut m, "GGP 75, 0"), 0);
     assert_eq!(send(&mut m, "GAP 4, 0"), profile.axis_parameter(4).unwrap().default as i32);

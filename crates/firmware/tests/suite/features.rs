@@ -2,6 +2,9 @@
 //! port roles) are edited makes a module that behaves as the edited data
 //! say, not as the module's name or its parameter table would suggest.
 
+use crate::common;
+
+use common::BusOfOne;
 use std::sync::Arc;
 use tmclsim_firmware::profile::BUILT_IN;
 use tmclsim_firmware::world::Load;
@@ -27,17 +30,17 @@ fn with_features(text: &str, lines: &str) -> String {
     edit(text, "\n[features]\n", &format!("\n[features]\n{lines}\n"))
 }
 
-fn module(text: &str) -> Module {
+fn module(text: &str) -> BusOfOne {
     let profile = Arc::new(Profile::from_toml(text).unwrap());
-    Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), World::free(profile.module.axes as usize))
+    BusOfOne::new(Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), World::free(profile.module.axes as usize)))
 }
 
-fn reply(m: &mut Module, line: &str) -> Reply {
+fn reply(m: &mut BusOfOne, line: &str) -> Reply {
     let f = Request::new(m.address(), parse_line(line).unwrap()).encode();
     Reply::decode(&m.handle_frame(&f).unwrap()).unwrap()
 }
 
-fn send(m: &mut Module, line: &str) -> i32 {
+fn send(m: &mut BusOfOne, line: &str) -> i32 {
     let r = reply(m, line);
     assert_eq!(r.status, 100, "{line}");
     r.value
@@ -136,7 +139,7 @@ fn eeprom_magic_follows_the_feature() {
         m.eeprom().clone()
     };
     let power_on = |text: &str| {
-        let mut m = Module::with_eeprom(Arc::new(Profile::from_toml(text).unwrap()), stored.clone());
+        let mut m = BusOfOne::new(Module::with_eeprom(Arc::new(Profile::from_toml(text).unwrap()), stored.clone()));
         (send(&mut m, "GAP 4, 0"), send(&mut m, "GGP 64, 0"))
     };
     assert_eq!(power_on(&text("tmcm-351")), (1700, 0xE4), "the magic matches: the EEPROM is kept");

@@ -6,9 +6,8 @@ use crate::common;
 #[path = "../../../../tests/golden/manual_frames.rs"]
 mod manual_frames;
 
-use common::{frame, hex};
+use common::{BusOfOne, frame, hex};
 
-use tmclsim_firmware::Module;
 use tmclsim_protocol::{Instruction, Reply, Request, Status};
 
 #[test]
@@ -20,7 +19,7 @@ fn request_frames_encode_as_printed() {
 
 #[test]
 fn replies_match_the_manual() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     // GIO 0, 1 with the analog input at 302.
     m.world_mut().set_analog(0, 302);
     assert_eq!(m.handle_frame(&frame("GIO 0, 1")), Some(hex("02 01 64 0F 00 00 01 2E A5")));
@@ -37,7 +36,7 @@ fn replies_match_the_manual() {
 
 #[test]
 fn firmware_version_replies() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     let r = m.handle_frame(&Request::new(1, Instruction::new(136, 0, 0, 0)).encode()).unwrap();
     assert_eq!(&r, b"\x021141V146");
     let r = Reply::decode(&m.handle_frame(&Request::new(1, Instruction::new(136, 1, 0, 0)).encode()).unwrap()).unwrap();

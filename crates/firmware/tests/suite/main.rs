@@ -14,6 +14,7 @@ mod motion;
 mod no_import_cycles;
 mod no_io;
 mod observers;
+mod only_the_bus_moves_time;
 mod program;
 mod reference_search;
 mod resync;

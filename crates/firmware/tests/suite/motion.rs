@@ -4,13 +4,12 @@
 
 use crate::common;
 
-use common::send;
+use common::{BusOfOne, send};
 
-use tmclsim_firmware::Module;
 use tmclsim_firmware::motion::{self, Motion, Ramp};
 
 /// Polls AP 8 every `poll` ms and returns the virtual time of arrival.
-fn time_to_reach(m: &mut Module, poll_ms: u64, limit_s: u64) -> f64 {
+fn time_to_reach(m: &mut BusOfOne, poll_ms: u64, limit_s: u64) -> f64 {
     let start = m.now_ns();
     while send(m, "GAP 8, 0") == 0 {
         m.advance(poll_ms * 1_000_000);
@@ -43,7 +42,7 @@ fn mvp_durations_match_the_closed_form() {
         (300, 2047, 1, 3, 5, 10_000),    // AP 5 above the clamp
     ];
     for (vmax, a, vmin, rd, pd, dist) in cases {
-        let mut m = Module::built_in("tmcm-1141").unwrap();
+        let mut m = BusOfOne::built_in("tmcm-1141");
         for line in [
             format!("SAP 4, 0, {vmax}"),
             format!("SAP 5, 0, {a}"),
@@ -65,7 +64,7 @@ fn mvp_durations_match_the_closed_form() {
 
 #[test]
 fn relative_and_coordinate_moves() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SAP 4, 0, 2047");
     send(&mut m, "MVP REL, 0, -10000");
     m.advance(10_000_000_000);
@@ -83,7 +82,7 @@ fn relative_and_coordinate_moves() {
 
 #[test]
 fn position_reached_flag_and_speed_during_a_move() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "MVP ABS, 0, 200000");
     m.advance(20_000_000);
     assert_eq!(send(&mut m, "GAP 8, 0"), 0);
@@ -96,7 +95,7 @@ fn position_reached_flag_and_speed_during_a_move() {
 
 #[test]
 fn velocity_mode_ramps_with_ap5() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     // a = 100 with rd 7, pd 3 → 46566 pps²; v = 1000 → 30518 pps.
     send(&mut m, "SAP 5, 0, 100");
     send(&mut m, "ROR 0, 1000");
@@ -123,7 +122,7 @@ fn velocity_mode_ramps_with_ap5() {
 
 #[test]
 fn limit_switches_stop_the_motor() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     m.world_mut().axes[0].right_switch = Some(50_000.0);
     m.world_mut().axes[0].left_switch = Some(-50_000.0);
     send(&mut m, "SAP 4, 0, 2047");
@@ -150,7 +149,7 @@ fn limit_switches_stop_the_motor() {
 
 #[test]
 fn disabled_switch_and_reversed_polarity() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     m.world_mut().axes[0].right_switch = Some(10_000.0);
     send(&mut m, "SAP 12, 0, 1");
     send(&mut m, "MVP ABS, 0, 20000");
@@ -169,7 +168,7 @@ fn disabled_switch_and_reversed_polarity() {
 
 #[test]
 fn hand_driven_switch_levels() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "ROR 0, 1000");
     m.advance(1_000_000_000);
     m.world_mut().axes[0].forced_right = Some(true);
@@ -182,7 +181,7 @@ fn hand_driven_switch_levels() {
 
 #[test]
 fn soft_mode_arrives_exactly() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SAP 138, 0, 1");
     send(&mut m, "MVP ABS, 0, 80000");
     assert_eq!(send(&mut m, "GAP 138, 0"), 1);
@@ -193,7 +192,7 @@ fn soft_mode_arrives_exactly() {
 
 #[test]
 fn thirty_two_bit_wrap_takes_the_short_way() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SAP 1, 0, 2147483000");
     send(&mut m, "MVP ABS, 0, -2147483000");
     m.advance(5_000_000_000);
@@ -203,7 +202,7 @@ fn thirty_two_bit_wrap_takes_the_short_way() {
 
 #[test]
 fn currents_follow_motion() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "SAP 6, 0, 200");
     send(&mut m, "SAP 7, 0, 40");
     send(&mut m, "SAP 200, 0, 248");
@@ -223,7 +222,7 @@ fn currents_follow_motion() {
 
 #[test]
 fn an_hour_of_motion_in_one_advance() {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1141");
     send(&mut m, "ROR 0, 2047");
     m.advance(3_600_000_000_000);
     let v = motion::velocity_pps(2047.0, 3);

@@ -1,6 +1,10 @@
-//! The crate's files depend on each other without cycles: the state files
-//! and leaf types know nothing of `Module`, and only the `impl Module`
-//! files depend on `module.rs`.
+//! The files of a crate depend on each other without cycles, so that each
+//! crate reads top-down: a module uses only modules below it, and what two
+//! modules share lies in a module of its own below both. Checked for the
+//! firmware and the crates around it (protocol, ethercat, host, server,
+//! web, cli, wasm). In the firmware, besides, the state files and leaf
+//! types know nothing of `Module`, and only the `impl Module` files depend
+//! on `module.rs`.
 //!
 //! The graph is read from the sources: a file depends on every file whose
 //! module a `use` (with `crate::`, `super::`, `self::` or a child module)
@@ -104,8 +108,9 @@ fn dependencies(text: &str, module: &str, files: &BTreeSet<String>) -> BTreeSet<
     deps
 }
 
-fn crate_graph() -> Graph {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+/// The graph of crate `krate` (a directory under crates/).
+fn crate_graph(krate: &str) -> Graph {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(krate).join("src");
     let mut paths = Vec::new();
     rust_files(&src, &mut paths);
     let files: BTreeSet<String> = paths.iter().map(|p| module_of(&src, p)).collect();
@@ -148,6 +153,19 @@ fn find_cycle(graph: &Graph) -> Option<Vec<String>> {
     graph.keys().find_map(|n| visit(n, graph, &mut done, &mut Vec::new()))
 }
 
+/// Cycles of the graph, one for each edge that breaks one: every cycle
+/// found, its last edge taken out, until none is left.
+fn cycles(graph: &Graph) -> Vec<Vec<String>> {
+    let mut graph = graph.clone();
+    let mut found = Vec::new();
+    while let Some(cycle) = find_cycle(&graph) {
+        let [.., from, to] = &cycle[..] else { unreachable!("a cycle has an edge") };
+        graph.get_mut(from).expect("a node of the graph").remove(to);
+        found.push(cycle);
+    }
+    found
+}
+
 fn reaches(graph: &Graph, from: &str, to: &str) -> bool {
     let mut seen = BTreeSet::new();
     let mut todo = vec![from.to_string()];
@@ -162,18 +180,26 @@ fn reaches(graph: &Graph, from: &str, to: &str) -> bool {
     false
 }
 
+/// The crates checked.
+const CRATES: [&str; 9] = ["protocol", "firmware", "ethercat", "host", "ide", "server", "web", "cli", "wasm"];
+
 #[test]
-fn the_crate_has_no_import_cycles() {
-    let graph = crate_graph();
-    if let Some(cycle) = find_cycle(&graph) {
-        let cycle: Vec<&str> = cycle.iter().map(|m| name(m)).collect();
-        panic!("import cycle: {}", cycle.join(" → "));
+fn no_crate_has_import_cycles() {
+    let mut found = Vec::new();
+    for krate in CRATES {
+        let graph = crate_graph(krate);
+        assert!(graph.len() > 1, "the sources of crates/{krate} are found");
+        for cycle in self::cycles(&graph) {
+            let cycle: Vec<&str> = cycle.iter().map(|m| name(m)).collect();
+            found.push(format!("crates/{krate}: {}", cycle.join(" → ")));
+        }
     }
+    assert!(found.is_empty(), "import cycles (move what both sides use down into a module of its own):\n{}", found.join("\n"));
 }
 
 #[test]
 fn state_and_leaf_types_do_not_depend_on_module() {
-    let graph = crate_graph();
+    let graph = crate_graph("firmware");
     let leaves = ["outcome", "parameter_numbers", "program", "motion", "reference_search", "eeprom", "world", "world_file", "world_rules"];
     let checked: Vec<&String> = graph.keys().filter(|m| m.starts_with("state") || leaves.contains(&m.as_str())).collect();
     assert!(checked.iter().any(|m| m.starts_with("state::")), "the state files are found");
@@ -184,7 +210,7 @@ fn state_and_leaf_types_do_not_depend_on_module() {
 
 #[test]
 fn the_graph_sees_the_dependencies() {
-    let graph = crate_graph();
+    let graph = crate_graph("firmware");
     let deps = |m: &str| graph.get(m).unwrap_or_else(|| panic!("no file {m}"));
     assert!(deps("commands::motion").contains("module"), "use crate::module::Module");
     assert!(deps("module").contains("state::axis"), "pub use crate::state::axis::Axis");
@@ -200,4 +226,10 @@ fn a_cycle_is_found() {
     assert_eq!(c, ["a".to_string(), "b".to_string()].into(), "super in an inline module names the file itself");
     let graph: Graph = [("a".to_string(), a), ("b::c".to_string(), c)].into();
     assert_eq!(find_cycle(&graph), Some(vec!["a".to_string(), "b::c".to_string(), "a".to_string()]));
+    assert_eq!(cycles(&graph).len(), 1, "one edge out breaks it");
+    let two: Graph = [("a", vec!["b", "c"]), ("b", vec!["a"]), ("c", vec!["a"])]
+        .into_iter()
+        .map(|(n, d)| (n.to_string(), d.into_iter().map(String::from).collect()))
+        .collect();
+    assert_eq!(cycles(&two).len(), 2, "every cycle is reported");
 }

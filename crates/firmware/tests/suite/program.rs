@@ -3,23 +3,23 @@
 
 use crate::common;
 
-use common::{MS, reply, send};
+use common::{BusOfOne, MS, reply, send};
 
 use tmclsim_firmware::Module;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Instruction, Request};
 
-fn module() -> Module {
-    Module::built_in("tmcm-1141").unwrap()
+fn module() -> BusOfOne {
+    BusOfOne::built_in("tmcm-1141")
 }
 
-fn raw(m: &mut Module, ins: Instruction) -> [u8; 9] {
+fn raw(m: &mut BusOfOne, ins: Instruction) -> [u8; 9] {
     m.handle_frame(&Request::new(1, ins).encode()).expect("reply")
 }
 
 /// Downloads source lines (numeric operands) over frames, like the IDE.
-fn download(m: &mut Module, lines: &[&str]) {
+fn download(m: &mut BusOfOne, lines: &[&str]) {
     assert_eq!(reply(m, "#132 0 0 0").status, 100);
     for l in lines {
         let r = reply(m, l);
@@ -28,13 +28,13 @@ fn download(m: &mut Module, lines: &[&str]) {
     assert_eq!(reply(m, "#133 0 0 0").status, 100);
 }
 
-fn run(m: &mut Module, lines: &[&str], for_ms: u64) {
+fn run(m: &mut BusOfOne, lines: &[&str], for_ms: u64) {
     download(m, lines);
     assert_eq!(reply(m, "#129 1 0 0").status, 100);
     m.advance(for_ms * MS);
 }
 
-fn var(m: &mut Module, n: u8) -> i32 {
+fn var(m: &mut BusOfOne, n: u8) -> i32 {
     send(m, &format!("GGP {n}, 2"))
 }
 
@@ -348,7 +348,7 @@ fn programs_persist_and_autostart() {
     reply(&mut m, "#255 0 0 1234");
     m.advance(10 * MS);
     assert_eq!(var(&mut m, 3), 1, "autostarted after the reset");
-    let mut m2 = Module::with_eeprom(m.profile().clone(), m.eeprom().clone());
+    let mut m2 = BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()));
     m2.advance(10 * MS);
     assert_eq!(var(&mut m2, 3), 1);
     assert_eq!(raw(&mut m2, Instruction::new(134, 0, 0, 0))[1], 45, "CALCV stored");
@@ -426,7 +426,7 @@ fn one_long_advance_equals_many_short_ones() {
         ];
         let stage = || {
             let profile = tmclsim_firmware::Profile::built_in("tmcm-1141").unwrap();
-            Module::with_world(profile, tmclsim_firmware::Eeprom::new("TMCM-1141"), tmclsim_firmware::World::stage(1))
+            BusOfOne::new(Module::with_world(profile, tmclsim_firmware::Eeprom::new("TMCM-1141"), tmclsim_firmware::World::stage(1)))
         };
         let mut long = stage();
         run(&mut long, &program, 0);

@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::{MS, send};
+use common::{BusOfOne, MS, send};
 
 use tmclsim_firmware::Module;
 use tmclsim_protocol::mnemonic::parse_line;
@@ -11,8 +11,8 @@ use tmclsim_protocol::{Reply, Request};
 
 /// Left stop switch pressed from −20000 down to −22000, right from 30000
 /// up to 32000, home switch between 5000 and 6000.
-fn stage(start: i32) -> Module {
-    let mut m = Module::built_in("tmcm-1141").unwrap();
+fn stage(start: i32) -> BusOfOne {
+    let mut m = BusOfOne::built_in("tmcm-1141");
     let w = &mut m.world_mut().axes[0];
     w.left_switch = Some(-20_000.0);
     w.left_width = Some(2_000.0);
@@ -33,7 +33,7 @@ fn stage(start: i32) -> Module {
 
 /// Runs a search; returns the signs of the velocity in the order they
 /// occurred.
-fn search(m: &mut Module, mode: i32) -> Vec<i32> {
+fn search(m: &mut BusOfOne, mode: i32) -> Vec<i32> {
     send(m, &format!("SAP 193, 0, {mode}"));
     send(m, "RFS START, 0");
     let mut dirs = vec![];
@@ -50,7 +50,7 @@ fn search(m: &mut Module, mode: i32) -> Vec<i32> {
     panic!("mode {mode}: the search did not end");
 }
 
-fn zero_point(m: &Module) -> f64 {
+fn zero_point(m: &BusOfOne) -> f64 {
     m.mechanical_position(0)
 }
 
@@ -163,7 +163,7 @@ fn mode_8_from_far_below_in_one_long_advance() {
         let profile = tmclsim_firmware::Profile::built_in("tmcm-1141").unwrap();
         let mut world = tmclsim_firmware::World::stage(1);
         world.axes[0].start = -500_000.0;
-        let mut m = Module::with_world(profile, tmclsim_firmware::Eeprom::new("TMCM-1141"), world);
+        let mut m = BusOfOne::new(Module::with_world(profile, tmclsim_firmware::Eeprom::new("TMCM-1141"), world));
         send(&mut m, "SAP 193, 0, 8");
         send(&mut m, "RFS START, 0");
         if stepped {

@@ -4,14 +4,14 @@
 
 use crate::common;
 
-use common::{MS, reply, send};
+use common::{BusOfOne, MS, reply, send};
 
 use tmclsim_firmware::Module;
 use tmclsim_firmware::world::Load;
 
 const SIBLINGS: [(&str, u8); 3] = [("tmcm-1140", 1), ("tmcm-3110", 3), ("tmcm-6110", 6)];
 
-fn stall(m: &mut Module, axis: u8) {
+fn stall(m: &mut BusOfOne, axis: u8) {
     send(m, &format!("SAP 6, {axis}, 255"));
     send(m, &format!("SAP 181, {axis}, 300"));
     send(m, &format!("ROR {axis}, 500"));
@@ -24,7 +24,7 @@ fn stall(m: &mut Module, axis: u8) {
 fn a_stall_sets_ap207_of_its_axis_only_and_reading_clears_it() {
     for (name, axes) in SIBLINGS {
         let last = axes - 1;
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         for a in 0..axes {
             assert_eq!(send(&mut m, &format!("GAP 207, {a}")), 0, "{name} axis {a} after start");
         }
@@ -41,7 +41,7 @@ fn a_stall_sets_ap207_of_its_axis_only_and_reading_clears_it() {
 #[test]
 fn stored_user_variables_survive_a_power_cycle_and_the_others_do_not() {
     for (name, _) in SIBLINGS {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         for (n, v) in [(0, 7), (17, -123456), (55, 2147483647), (56, 99), (255, 5)] {
             send(&mut m, &format!("SGP {n}, 2, {v}"));
         }
@@ -49,8 +49,8 @@ fn stored_user_variables_survive_a_power_cycle_and_the_others_do_not() {
             send(&mut m, &format!("STGP {n}, 2"));
         }
         // Power cycle: a new module with the old one's EEPROM.
-        let mut again = Module::with_eeprom(m.profile().clone(), m.eeprom().clone());
-        let read = |m: &mut Module, n: u8| send(m, &format!("GGP {n}, 2"));
+        let mut again = BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()));
+        let read = |m: &mut BusOfOne, n: u8| send(m, &format!("GGP {n}, 2"));
         assert_eq!(
             [0, 17, 55, 56, 255].map(|n| read(&mut again, n)),
             [7, -123456, 2147483647, 0, 0],
@@ -58,7 +58,7 @@ fn stored_user_variables_survive_a_power_cycle_and_the_others_do_not() {
         );
         // GP 85 = 1: the stored values are not restored at start.
         send(&mut again, "SGP 85, 0, 1");
-        let mut third = Module::with_eeprom(again.profile().clone(), again.eeprom().clone());
+        let mut third = BusOfOne::new(Module::with_eeprom(again.profile().clone(), again.eeprom().clone()));
         assert_eq!(read(&mut third, 17), 0, "{name}: GP 85 = 1");
     }
 }
@@ -68,7 +68,7 @@ fn every_sibling_answers_the_supply_voltage_at_gio_8_bank_1() {
     // An unchanged host driver reads the supply at GIO 8, 1 on each of them
     // (the family's port, TMCM-1141 manual V1.46 section 3.7.15).
     for (name, _) in SIBLINGS {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         assert_eq!(send(&mut m, "GIO 8, 1"), 240, "{name}: 24.0 V supply");
     }
 }
@@ -76,7 +76,7 @@ fn every_sibling_answers_the_supply_voltage_at_gio_8_bank_1() {
 #[test]
 fn the_tmcm_6110_downloads_2048_words() {
     // TMCM-6110 manual V1.31, section 4: up to 2048 TMCL instructions.
-    let mut m = Module::built_in("tmcm-6110").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-6110");
     assert_eq!(reply(&mut m, "#132 0 0 2047").status, 100);
     assert_eq!(reply(&mut m, "MST 0").status, 101, "the last word is stored");
     assert_eq!(reply(&mut m, "MST 0").status, 4, "past the end of memory");

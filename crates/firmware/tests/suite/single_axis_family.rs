@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use common::{MS, load, reply, send, status};
+use common::{BusOfOne, MS, load, reply, send, status};
 
 use tmclsim_firmware::Module;
 use tmclsim_protocol::{Instruction, Reply, Request, Status};
@@ -15,7 +15,7 @@ const MODULES: [(&str, &[u8; 8]); 3] = [("tmcm-1110", b"1110V109"), ("tmcm-1140"
 #[test]
 fn command_136_names_each_module_and_its_firmware() {
     for (name, version) in MODULES {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         let text = m.handle_frame(&Request::new(1, Instruction::new(136, 0, 0, 0)).encode()).unwrap();
         assert_eq!(&text[1..], version, "{name}");
         let r = Reply::decode(&m.handle_frame(&Request::new(1, Instruction::new(136, 1, 0, 0)).encode()).unwrap()).unwrap();
@@ -25,10 +25,10 @@ fn command_136_names_each_module_and_its_firmware() {
 
 #[test]
 fn power_up_values_are_the_profiles_defaults() {
-    let mut m = Module::built_in("tmcm-1110").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1110");
     assert_eq!(["GAP 5, 0", "GAP 6, 0", "GAP 7, 0", "GAP 153, 0", "GAP 154, 0"].map(|c| send(&mut m, c)), [500, 255, 32, 3, 2]);
     for name in ["tmcm-1140", "tmcm-1160"] {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         assert_eq!(["GAP 5, 0", "GAP 153, 0", "GAP 154, 0", "GAP 140, 0"].map(|c| send(&mut m, c)), [1000, 7, 3, 8], "{name}");
         assert_eq!(send(&mut m, "GGP 71, 0"), 1, "{name}: CAN ID");
     }
@@ -37,25 +37,25 @@ fn power_up_values_are_the_profiles_defaults() {
 #[test]
 fn parameters_a_module_lacks_answer_wrong_type() {
     let wrong = Status::WrongType.code();
-    let mut m = Module::built_in("tmcm-1110").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1110");
     for c in ["GAP 150, 0", "GAP 200, 0", "GAP 207, 0", "GAP 215, 0", "GGP 67, 0", "GGP 131, 0"] {
         assert_eq!(status(&mut m, c), wrong, "TMCM-1110 {c}");
     }
     assert_eq!(send(&mut m, "GAP 213, 0"), 0, "the group index is held");
-    let mut m = Module::built_in("tmcm-1160").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1160");
     assert_eq!(send(&mut m, "GAP 254, 0"), 0);
     assert_eq!(status(&mut m, "GGP 131, 0"), wrong);
-    let mut m = Module::built_in("tmcm-1140").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1140");
     assert_eq!(status(&mut m, "GAP 254, 0"), wrong);
 }
 
 #[test]
 fn the_steprocker_has_no_ascii_mode_and_the_others_do() {
-    let mut m = Module::built_in("tmcm-1110").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1110");
     assert_eq!(status(&mut m, "#139 0 0 0"), Status::InvalidCommand.code());
     assert!(!m.ascii_mode());
     for name in ["tmcm-1140", "tmcm-1160"] {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         assert_eq!(status(&mut m, "#139 0 0 0"), Status::Ok.code(), "{name}");
         assert!(m.ascii_mode(), "{name}");
     }
@@ -64,7 +64,7 @@ fn the_steprocker_has_no_ascii_mode_and_the_others_do() {
 #[test]
 fn inputs_and_outputs_of_each_module() {
     for (name, inputs, outputs) in [("tmcm-1110", 7, 8), ("tmcm-1140", 4, 2), ("tmcm-1160", 2, 2)] {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         for i in 0..inputs {
             assert!((0..=1).contains(&send(&mut m, &format!("GIO {i}, 0"))), "{name} IN{i}");
         }
@@ -76,14 +76,14 @@ fn inputs_and_outputs_of_each_module() {
         assert_ne!(status(&mut m, &format!("SIO {outputs}, 2, 1")), 100, "{name}: no OUT{outputs}");
     }
     // The TMCM-1140 reads the supply at GIO 8, 1 (24.0 V in the default world).
-    let mut m = Module::built_in("tmcm-1140").unwrap();
+    let mut m = BusOfOne::built_in("tmcm-1140");
     assert_eq!(send(&mut m, "GIO 8, 1"), 240);
 }
 
 #[test]
 fn each_moves_and_stops_on_a_stall() {
     for (name, _) in MODULES {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         send(&mut m, "MVP ABS, 0, 20000");
         m.advance(5000 * MS);
         assert_eq!(send(&mut m, "GAP 1, 0"), 20000, "{name}");
@@ -113,7 +113,7 @@ fn each_moves_and_stops_on_a_stall() {
 #[test]
 fn stored_parameters_survive_a_power_cycle() {
     for (name, _) in MODULES {
-        let mut m = Module::built_in(name).unwrap();
+        let mut m = BusOfOne::built_in(name);
         send(&mut m, "SAP 4, 0, 1234");
         send(&mut m, "STAP 4, 0");
         send(&mut m, "SGP 7, 2, -42");

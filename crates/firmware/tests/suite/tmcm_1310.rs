@@ -4,17 +4,17 @@
 
 use crate::common;
 
-use common::{MS, load, reply, send};
+use common::{BusOfOne, MS, load, reply, send};
 
 use tmclsim_firmware::{Eeprom, Module, Profile, World};
 use tmclsim_protocol::mnemonic::parse_line;
 
-fn module() -> Module {
+fn module() -> BusOfOne {
     let p = Profile::built_in("tmcm-1310").unwrap();
-    Module::with_world(p, Eeprom::new("TMCM-1310"), World::free(1))
+    BusOfOne::new(Module::with_world(p, Eeprom::new("TMCM-1310"), World::free(1)))
 }
 
-fn setup(m: &mut Module, closed: bool) {
+fn setup(m: &mut BusOfOne, closed: bool) {
     send(m, "SAP 6, 0, 128"); // open loop: 50 % current
     send(m, &format!("SAP 129, 0, {}", closed as i32));
     send(m, "SAP 113, 0, 10");
@@ -97,7 +97,7 @@ fn torque_mode_produces_the_set_current() {
 fn status_word_bits_follow_the_state() {
     let mut m = module();
     setup(&mut m, true);
-    let word = |m: &mut Module| send(m, "GAP 18, 0");
+    let word = |m: &mut BusOfOne| send(m, "GAP 18, 0");
     assert_eq!(word(&mut m) & 0b111101, 0b1101, "target reached, closed loop, position mode");
     send(&mut m, "ROR 0, 500");
     m.advance(1000 * MS);
@@ -137,7 +137,7 @@ fn incremental_and_absolute_encoders() {
     let p = Profile::built_in("tmcm-1310").unwrap();
     let mut w = World::free(1);
     w.axes[0].start = 51_200.0;
-    let mut m = Module::with_world(p, Eeprom::new("TMCM-1310"), w);
+    let mut m = BusOfOne::new(Module::with_world(p, Eeprom::new("TMCM-1310"), w));
     setup(&mut m, true);
     assert_eq!(send(&mut m, "GAP 209, 0"), 0, "ABN counts from power-up");
     send(&mut m, "SAP 201, 0, 1");

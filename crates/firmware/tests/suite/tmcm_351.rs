@@ -5,15 +5,15 @@
 
 use crate::common;
 
-use common::{MS, hex, reply, send};
+use common::{BusOfOne, MS, hex, reply, send};
 
 use tmclsim_firmware::world::Load;
 use tmclsim_firmware::{Module, World};
 use tmclsim_protocol::Request;
 use tmclsim_protocol::mnemonic::parse_line;
 
-fn module() -> Module {
-    Module::built_in("tmcm-351").unwrap()
+fn module() -> BusOfOne {
+    BusOfOne::built_in("tmcm-351")
 }
 
 #[test]
@@ -186,7 +186,7 @@ fn eeprom_lock_and_magic() {
     assert_eq!(reply(&mut m, "#132 0 0 0").status, 5, "no download while locked");
     assert_eq!(reply(&mut m, "SGP 73, 0, 77").status, 4);
     // The lock survives a power cycle; 4321 unlocks.
-    let mut m = Module::with_eeprom(m.profile().clone(), m.eeprom().clone());
+    let mut m = BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()));
     assert_eq!(send(&mut m, "GGP 73, 0"), 1);
     send(&mut m, "SGP 73, 0, 4321");
     assert_eq!(send(&mut m, "STAP 4, 0"), 0);
@@ -194,7 +194,7 @@ fn eeprom_lock_and_magic() {
     send(&mut m, "SAP 4, 0, 1700");
     send(&mut m, "STAP 4, 0");
     send(&mut m, "SGP 64, 0, 0");
-    let mut m = Module::with_eeprom(m.profile().clone(), m.eeprom().clone());
+    let mut m = BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()));
     assert_eq!(send(&mut m, "GAP 4, 0"), 1000, "factory value");
     assert_eq!(send(&mut m, "GGP 64, 0"), 0xE4);
 }
@@ -274,11 +274,11 @@ fn stall_detection_ap205_ap206() {
 
 #[test]
 fn encoder_prescaler_and_deviation_stop() {
-    let mut m = Module::with_world(
+    let mut m = BusOfOne::new(Module::with_world(
         tmclsim_firmware::Profile::built_in("tmcm-351").unwrap(),
         tmclsim_firmware::Eeprom::new("TMCM-351"),
         World::free(3),
-    );
+    ));
     // The manual's encoder demo setup: 2000-line encoder, 64 µsteps, 68672 = ×6.4.
     send(&mut m, "SAP 210, 0, 68672");
     send(&mut m, "SAP 209, 0, 0");

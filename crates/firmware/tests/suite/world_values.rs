@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use common::{MS, send};
+use common::{BusOfOne, MS, send};
 use tmclsim_firmware::world_command::Addressed;
 use tmclsim_firmware::{Bus, Module, World};
 
@@ -104,7 +104,7 @@ fn end_stops_set_around_the_rules_do_not_panic() {
     // Rust code may write the world directly; the motion holds the carriage
     // somewhere instead of panicking.
     for travel in [(10.0, -10.0), (f64::NAN, 5.0), (f64::NAN, f64::NAN), (0.0, f64::INFINITY)] {
-        let mut m = Module::built_in("tmcm-1141").unwrap();
+        let mut m = BusOfOne::built_in("tmcm-1141");
         m.world_mut().axes[0].travel = Some(travel);
         send(&mut m, "ROR 0, 500");
         m.advance(200 * MS);

@@ -142,12 +142,12 @@ fn eeprom_file_is_written_on_store() {
 #[test]
 fn stepped_virtual_time() {
     let server = serve_tcp();
-    server.module().set_stepped(true);
+    server.bus().set_stepped(true);
     let mut s = connect(&server);
     ask(&mut s, "ROR 0, 1000");
     std::thread::sleep(Duration::from_millis(100));
     assert_eq!(ask(&mut s, "GAP 1, 0").value, 0, "time stands still");
-    server.module().advance(3_600_000_000_000);
+    server.bus().advance(3_600_000_000_000);
     assert_eq!(ask(&mut s, "GAP 3, 0").value, 1000);
     let p = ask(&mut s, "GAP 1, 0").value;
     assert!(p > 100_000_000, "an hour of motion: {p}");
@@ -155,10 +155,10 @@ fn stepped_virtual_time() {
     ask(&mut s, "SAP 4, 0, 2047");
     ask(&mut s, "#138 0 0 1");
     ask(&mut s, "MVP REL, 0, 100000");
-    server.module().advance(10_000_000_000);
+    server.bus().advance(10_000_000_000);
     let event = read_reply(&mut s);
     assert_eq!((event.status, event.opcode), (128, 138));
-    server.module().set_stepped(false);
+    server.bus().set_stepped(false);
     ask(&mut s, "ROR 0, 1000");
     std::thread::sleep(Duration::from_millis(50));
     assert_ne!(ask(&mut s, "GAP 1, 0").value, 0, "back on the wall clock");

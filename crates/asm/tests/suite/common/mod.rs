@@ -5,12 +5,40 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use tmclsim_asm::{Diagnostic, MemoryResolver, NoIncludes, Profile, Program, assemble};
-use tmclsim_firmware::Module;
+use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
 
 /// One millisecond of virtual time.
 pub const MS: u64 = 1_000_000;
+
+/// A module on a bus of its own, as the tests drive it: requests and
+/// looks go to the module (it derefs to it), time moves on the bus.
+pub struct BusOfOne(Bus);
+
+impl BusOfOne {
+    pub fn new(module: Module) -> BusOfOne {
+        BusOfOne(Bus::single(module))
+    }
+
+    /// Moves virtual time on by `dt_ns`.
+    pub fn advance(&mut self, dt_ns: u64) {
+        self.0.advance(dt_ns);
+    }
+}
+
+impl std::ops::Deref for BusOfOne {
+    type Target = Module;
+    fn deref(&self) -> &Module {
+        self.0.module(0)
+    }
+}
+
+impl std::ops::DerefMut for BusOfOne {
+    fn deref_mut(&mut self) -> &mut Module {
+        self.0.module_mut(0)
+    }
+}
 
 pub fn tmcm_1141() -> Arc<Profile> {
     Profile::built_in("tmcm-1141").expect("built-in profile")

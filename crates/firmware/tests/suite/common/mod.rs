@@ -1,14 +1,55 @@
-//! Helpers shared by the firmware's integration tests: commands by
-//! mnemonic (or `#op type motor value`) sent as frames to module address 1.
+//! Helpers shared by the firmware's integration tests: a module on a bus
+//! of its own, and commands by mnemonic (or `#op type motor value`) sent
+//! as frames to module address 1.
 #![allow(dead_code)]
 
-use tmclsim_firmware::Module;
+use std::ops::{Deref, DerefMut};
 use tmclsim_firmware::world::Load;
+use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::mnemonic::parse_line;
 use tmclsim_protocol::{Reply, Request};
 
 /// One millisecond of virtual time.
 pub const MS: u64 = 1_000_000;
+
+/// A module on a bus of its own, as the tests drive it: requests and
+/// looks go to the module (it derefs to it), time moves on the bus.
+#[derive(Clone, Debug)]
+pub struct BusOfOne(Bus);
+
+impl BusOfOne {
+    pub fn new(module: Module) -> BusOfOne {
+        BusOfOne(Bus::single(module))
+    }
+
+    /// A built-in module by profile name.
+    pub fn built_in(profile: &str) -> BusOfOne {
+        BusOfOne::new(Module::built_in(profile).unwrap())
+    }
+
+    /// Moves virtual time on by `dt_ns`.
+    pub fn advance(&mut self, dt_ns: u64) {
+        self.0.advance(dt_ns);
+    }
+
+    /// Moves virtual time to `t_ns` (no-op for the past).
+    pub fn advance_to(&mut self, t_ns: u64) {
+        self.0.advance_to(t_ns);
+    }
+}
+
+impl Deref for BusOfOne {
+    type Target = Module;
+    fn deref(&self) -> &Module {
+        self.0.module(0)
+    }
+}
+
+impl DerefMut for BusOfOne {
+    fn deref_mut(&mut self) -> &mut Module {
+        self.0.module_mut(0)
+    }
+}
 
 /// The request frame of a command to address 1.
 pub fn frame(line: &str) -> [u8; 9] {

@@ -1,5 +1,5 @@
 //! Rust source read as tokens, for the tests that check the crates'
-//! sources (no_import_cycles.rs, no_io.rs).
+//! sources (no_import_cycles.rs, no_io.rs, only_the_bus_moves_time.rs).
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
