@@ -138,6 +138,7 @@ def free_port():
         return s.getsockname()[1]
 
 
+@pytest.mark.slow
 def test_a_real_scheduler_and_two_workers_give_the_serial_table():
     dask = os.path.join(os.path.dirname(sys.executable), "dask")
     port = free_port()
@@ -647,6 +648,7 @@ def test_a_world_value_no_world_file_holds_is_a_setup_failure():
     assert t.failed_check[1] == "setup" and t.error[1].startswith("world: ")
 
 
+@pytest.mark.slow
 def test_a_sweep_keeps_no_row_and_no_failure_file(monkeypatch):
     # The engine and the table alone (each scenario a row made up, a third
     # of them failures): memory of the sweep in this process grows by the

@@ -483,12 +483,18 @@ def test_a_breakpoint_stops_the_loop_every_time_and_a_waiting_wait_is_the_curren
     page.locator(".CodeMirror-linenumber").get_by_text("3", exact=True).click()
     page.locator("[data-testid=breakpoint]").wait_for()
     page.click("[data-testid=prog-run]")
+    # The break itself is what to wait for: a running program passes
+    # address 2 (line 3) on every turn, on a link between two steps too,
+    # and the accumulator has its value during the WAIT before the break.
+    at_break = (
+        "acc => document.querySelector('[data-testid=ps-break]').textContent === 'at address 2'"
+        " && document.querySelector('[data-testid=ps-acc]').textContent === acc"
+    )
     for acc in ["1", "12", "23"]:
-        page.wait_for_function(f"document.querySelector('[data-testid=ps-acc]').textContent === '{acc}'")
+        page.wait_for_function(at_break, arg=acc)
         current_line(page, 3)
-        assert page.inner_text("[data-testid=ps-break]") == "at address 2"
         page.click("[data-testid=prog-continue]")
-    page.wait_for_function("document.querySelector('[data-testid=ps-acc]').textContent === '34'")
+    page.wait_for_function(at_break, arg="34")
     # Single steps: onto the WAIT, then into it; while it waits the WAIT's
     # line is the current one (the counter holds its address, rule 35).
     page.click("[data-testid=prog-step]")
