@@ -42,8 +42,9 @@ fn reference_modes(family: ReferenceSearchFamily) -> Vec<(i64, &'static str)> {
             (4, "4: left stop switch from both sides"),
             (5, "5: home switch, negative direction, reverse at the left stop switch"),
             (6, "6: home switch, positive direction, reverse at the right stop switch"),
-            (7, "7: home switch, positive direction, end switches ignored"),
-            (8, "8: home switch, negative direction, end switches ignored"),
+            // Chapter 7.1's directions (docs/behaviour.md rule 49).
+            (7, "7: home switch, negative direction, end switches ignored"),
+            (8, "8: home switch, positive direction, end switches ignored"),
             (65, "65: right stop switch only (1 + 64)"),
             (66, "66: left stop switch, then right stop switch (2 + 64)"),
             (67, "67: left stop switch, then right stop switch from both sides (3 + 64)"),
@@ -83,4 +84,34 @@ pub fn of(profile: &Profile) -> Value {
         "inputs": port(PortDirection::Input), "outputs": port(PortDirection::Output),
         "reference_modes": reference_modes(profile.features.reference_search).into_iter().map(|(v, n)| json!({"value": v, "name": n})).collect::<Vec<_>>(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tmclsim_firmware::{Bus, Module};
+    use tmclsim_protocol::{Instruction, Reply, Request, opcode};
+
+    fn value(bus: &mut Bus, ins: Instruction) -> i32 {
+        let reply = bus.handle_frame(&Request::new(1, ins).encode()).replies[0];
+        Reply::decode(&reply).unwrap().value
+    }
+
+    /// The names of modes 7 and 8 say the direction the firmware searches
+    /// in (docs/behaviour.md rule 49), from the middle of the stage.
+    #[test]
+    fn the_home_search_modes_are_named_by_the_direction_they_move() {
+        for (mode, name) in reference_modes(ReferenceSearchFamily::Tmc429) {
+            if !(7..=8).contains(&mode) {
+                continue;
+            }
+            let mut bus = Bus::single(Module::built_in("tmcm-1141").unwrap());
+            value(&mut bus, Instruction::new(opcode::SAP, 193, 0, mode as i32));
+            value(&mut bus, Instruction::new(opcode::RFS, 0, 0, 0));
+            bus.advance(200_000_000);
+            let speed = value(&mut bus, Instruction::new(opcode::GAP, 3, 0, 0));
+            let named = if name.contains("negative") { -1 } else { 1 };
+            assert_eq!(speed.signum(), named, "mode {mode} ({name}) moves at {speed}");
+        }
+    }
 }
