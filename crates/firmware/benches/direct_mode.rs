@@ -1,4 +1,5 @@
-//! Direct-mode commands through `Module::handle_frame`, in-process.
+//! Direct-mode commands through `Module::handle_frame`, in-process, and
+//! programs running in virtual time.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -30,15 +31,27 @@ fn bench(c: &mut Criterion) {
         });
     }
     g.finish();
-    c.bench_function("program: 1000 instructions of a compute loop", |b| {
-        // CALC ADD 1; COMP 2^31-1; JC LT 0
-        let words = ["CALC ADD, 1", "COMP 2147483647", "JC LT, 0"].map(|l| parse_line(l).unwrap());
+    // Programs: 1000 instructions (25 ms of virtual time at 25 µs each)
+    // per iteration. The polling loop asks for AP 8 (position reached)
+    // while the motor moves, so each of its GAPs sees the world of its own
+    // moment; the compute loop never looks at the world.
+    let mut g = c.benchmark_group("program");
+    g.throughput(Throughput::Elements(1000));
+    for (name, lines) in [
+        ("compute loop (CALC/COMP/JC)", &["CALC ADD, 1", "COMP 2147483647", "JC LT, 0"][..]),
+        (
+            "polling motion loop (GAP 8/JC)",
+            &["MVP ABS, 0, 512000", "GAP 8, 0", "JC ZE, 1", "MVP ABS, 0, 0", "GAP 8, 0", "JC ZE, 4", "JA 0"][..],
+        ),
+    ] {
+        let words: Vec<_> = lines.iter().map(|l| parse_line(l).unwrap()).collect();
         let mut m = Module::built_in("tmcm-1141").unwrap();
         m.load_program(&words).unwrap();
         m.start_program();
         let mut bus = Bus::single(m);
-        b.iter(|| bus.advance(black_box(25_000_000)))
-    });
+        g.bench_function(name, |b| b.iter(|| bus.advance(black_box(25_000_000))));
+    }
+    g.finish();
     c.bench_function("advance 1 ms while moving", |b| {
         let mut bus = Bus::single(Module::built_in("tmcm-1141").unwrap());
         bus.handle_frame(&frames(&["ROR 0, 1000"])[0]);

@@ -60,8 +60,10 @@ impl Module {
         }
     }
 
-    /// Executes a decoded command: hands it to its family (`commands/`).
-    /// The value is what a direct-mode reply carries.
+    /// Executes a decoded command: hands it to its family (`commands/`);
+    /// the parameter commands, the most frequent in a polling program, go
+    /// straight to their own methods. The value is what a direct-mode reply
+    /// carries.
     pub(crate) fn run_command(&mut self, cmd: Command, ins: Instruction, origin: Origin) -> Exec {
         use Command::*;
         let echo = ins.value;
@@ -69,16 +71,22 @@ impl Module {
             Ror { .. } | Rol { .. } | Mst { .. } | Mvp { .. } | Mvpa { .. } | Rora { .. } | Rola { .. } | Rfs { .. } => {
                 self.motion_command(cmd, echo)
             }
-            Sap { .. }
-            | Gap { .. }
-            | Stap { .. }
-            | Rsap { .. }
-            | Aap { .. }
-            | Sgp { .. }
-            | Ggp { .. }
-            | Stgp { .. }
-            | Rsgp { .. }
-            | Agp { .. } => self.parameter_command(cmd, echo, origin),
+            Sap { param, motor, value } => self.set_axis_parameter(param, motor, value).map(|_| echo),
+            Aap { param, motor } => self.set_axis_parameter(param, motor, self.registers.accumulator).map(|_| echo),
+            Gap { param, motor } => {
+                let v = self.get_axis_parameter(param, motor)?;
+                Ok(self.loaded(v, origin))
+            }
+            Stap { param, motor } => self.store_axis_parameter(param, motor).map(|_| echo),
+            Rsap { param, motor } => self.restore_axis_parameter(param, motor).map(|_| echo),
+            Sgp { param, bank, value } => self.set_global_parameter(param, bank, value).map(|_| echo),
+            Agp { param, bank } => self.set_global_parameter(param, bank, self.registers.accumulator).map(|_| echo),
+            Ggp { param, bank } => {
+                let v = self.get_global_parameter(param, bank)?;
+                Ok(self.loaded(v, origin))
+            }
+            Stgp { param, bank } => self.store_global_parameter(param, bank).map(|_| echo),
+            Rsgp { param, bank } => self.restore_global_parameter(param, bank).map(|_| echo),
             Calc { .. }
             | Comp { .. }
             | CalcX { .. }

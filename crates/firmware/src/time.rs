@@ -31,8 +31,12 @@ impl Module {
     pub(crate) fn advance(&mut self, dt_ns: u64) {
         let end = self.now_ns.saturating_add(dt_ns);
         self.look_at_inputs();
+        // The world's next event, when a batch that left the world as it
+        // was has just computed it.
+        let mut known = None;
         loop {
             let timer = self.run_timers();
+            let world = known.take();
             if self.program.is_running() {
                 if self.program.wait.is_some() {
                     self.check_wait();
@@ -44,8 +48,10 @@ impl Module {
                 if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
                     // Pure instructions run ahead of the world only up to
                     // the world's next event.
-                    let limit = self.world_deadline(timer).map_or(end, |d| d.min(end));
-                    self.run_batch(limit);
+                    let world = self.world_deadline(timer);
+                    if self.run_batch(world.map_or(end, |d| d.min(end))) {
+                        known = Some(world);
+                    }
                     continue;
                 }
             }
@@ -53,7 +59,8 @@ impl Module {
                 break;
             }
             // The next moment something happens on its own.
-            let t = self.deadline_after(timer).filter(|&d| d > self.now_ns).map_or(end, |d| d.min(end));
+            let world = world.unwrap_or_else(|| self.world_deadline(timer));
+            let t = earliest(world, self.program_deadline()).filter(|&d| d > self.now_ns).map_or(end, |d| d.min(end));
             self.step_world(t);
         }
     }
@@ -140,7 +147,13 @@ impl Module {
 
     /// [`Module::next_deadline`] with the timers' next firing given.
     fn deadline_after(&self, timer: Option<u64>) -> Option<u64> {
-        let program = if !self.program.is_running() {
+        earliest(self.world_deadline(timer), self.program_deadline())
+    }
+
+    /// The program's next instruction, or when its WAIT must be looked at
+    /// again; `None` while it does not run.
+    fn program_deadline(&self) -> Option<u64> {
+        if !self.program.is_running() {
             None
         } else if self.program.wait.is_none() {
             Some(self.program.next_ns)
@@ -149,8 +162,7 @@ impl Module {
             Some(self.now_ns)
         } else {
             self.wait_horizon()
-        };
-        earliest(self.world_deadline(timer), program)
+        }
     }
 
     /// The next event of the world and the interrupt system (everything but
@@ -306,8 +318,10 @@ impl Module {
 
     /// Runs instructions due at `now` (and pure ones after them, up to
     /// `limit`) without moving the world; returns when the world must catch
-    /// up, the program stops or waits.
-    pub(crate) fn run_batch(&mut self, limit: u64) {
+    /// up, the program stops or waits: true when the program still runs,
+    /// does not wait and every instruction left the world as it was (its
+    /// next event is still the one `limit` came from).
+    pub(crate) fn run_batch(&mut self, limit: u64) -> bool {
         loop {
             self.take_interrupt();
             let pc = self.program.pc;
@@ -317,25 +331,28 @@ impl Module {
             {
                 self.program.hit_breakpoint = Some(pc);
                 self.program.mode = RunMode::Step;
-                return;
+                return false;
             }
             self.program.hit_breakpoint = None;
             let Some(ins) = self.program.memory.get(pc as usize).copied() else {
                 self.program.mode = RunMode::Stop;
-                return;
+                return false;
             };
             // With the trace on, every instruction sees the world of its
             // own moment (positions in the trace are exact).
             let traced = self.program.trace.is_some();
             let pure = is_pure(ins) && !traced;
             if !pure && self.program.next_ns > self.now_ns {
-                return;
+                return true;
             }
             self.execute_next();
             // After an instruction that changed the world, `limit` is stale.
             let world_unchanged = pure || (observes_only(ins) && !traced);
-            if !self.program.is_running() || self.program.wait.is_some() || !world_unchanged || self.program.next_ns > limit {
-                return;
+            if !self.program.is_running() || self.program.wait.is_some() || !world_unchanged {
+                return false;
+            }
+            if self.program.next_ns > limit {
+                return true;
             }
         }
     }

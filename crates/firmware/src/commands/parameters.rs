@@ -1,70 +1,56 @@
 //! The parameter commands: SAP, GAP, STAP, RSAP, AAP for axis parameters
 //! and SGP, GGP, STGP, RSGP, AGP for global parameters — their access and
 //! range checks, the side effects of writes and the measured values reads
-//! compute.
+//! compute. The executor hands each command straight to its method here.
 
 use crate::closed_loop::cl;
-use crate::commands::Exec;
 use crate::module::Module;
 use crate::motion::{self, RampMode};
-use crate::outcome::Origin;
 use crate::parameter_numbers::{ap, gp};
 use tmclsim_profile::{Access, Parameter};
-use tmclsim_protocol::{Command, Instruction, Status};
+use tmclsim_protocol::{Instruction, Status};
 
 impl Module {
-    /// SAP, GAP, STAP, RSAP, AAP, SGP, GGP, STGP, RSGP, AGP.
-    pub(crate) fn parameter_command(&mut self, cmd: Command, echo: i32, origin: Origin) -> Exec {
-        use Command::*;
-        match cmd {
-            Sap { param, motor, value } => self.set_axis_parameter(param, motor, value).map(|_| echo),
-            Aap { param, motor } => self.set_axis_parameter(param, motor, self.registers.accumulator).map(|_| echo),
-            Gap { param, motor } => {
-                let v = self.get_axis_parameter(param, motor)?;
-                Ok(self.loaded(v, origin))
-            }
-            Stap { param, motor } => {
-                let m = self.motor(motor)?;
-                self.axis_spec(param, |a| a.eeprom)?;
-                if self.eeprom_locked() {
-                    return Err(Status::EepromLocked);
-                }
-                let v = self.axes[m].params[param as usize];
-                self.persistence.eeprom.set_axis(motor, param, v);
-                self.persistence.mark_written();
-                Ok(echo)
-            }
-            Rsap { param, motor } => {
-                let m = self.motor(motor)?;
-                let spec = self.axis_spec(param, |a| a.eeprom)?;
-                // As at power-up: a stored value out of range is not taken (rule 88).
-                let v = self.persistence.eeprom.axis(motor, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
-                self.write_axis_parameter(m, param, v);
-                Ok(echo)
-            }
-            Sgp { param, bank, value } => self.set_global_parameter(param, bank, value).map(|_| echo),
-            Agp { param, bank } => self.set_global_parameter(param, bank, self.registers.accumulator).map(|_| echo),
-            Ggp { param, bank } => {
-                let v = self.get_global_parameter(param, bank)?;
-                Ok(self.loaded(v, origin))
-            }
-            Stgp { param, bank } => {
-                self.global_spec(param, bank, |a| a.eeprom)?;
-                if self.eeprom_locked() {
-                    return Err(Status::EepromLocked);
-                }
-                let v = self.globals[bank as usize][param as usize];
-                self.persistence.store_global(bank, param, v);
-                Ok(echo)
-            }
-            Rsgp { param, bank } => {
-                let spec = self.global_spec(param, bank, |a| a.eeprom)?;
-                let v = self.persistence.eeprom.global(bank, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
-                self.globals[bank as usize][param as usize] = v;
-                Ok(echo)
-            }
-            _ => unreachable!("not a parameter command: {cmd:?}"),
+    /// STAP: stores an axis parameter's value in the EEPROM.
+    pub(crate) fn store_axis_parameter(&mut self, param: u8, motor: u8) -> Result<(), Status> {
+        let m = self.motor(motor)?;
+        self.axis_spec(param, |a| a.eeprom)?;
+        if self.eeprom_locked() {
+            return Err(Status::EepromLocked);
         }
+        let v = self.axes[m].params[param as usize];
+        self.persistence.eeprom.set_axis(motor, param, v);
+        self.persistence.mark_written();
+        Ok(())
+    }
+
+    /// RSAP: an axis parameter takes its value from the EEPROM again.
+    pub(crate) fn restore_axis_parameter(&mut self, param: u8, motor: u8) -> Result<(), Status> {
+        let m = self.motor(motor)?;
+        let spec = self.axis_spec(param, |a| a.eeprom)?;
+        // As at power-up: a stored value out of range is not taken (rule 88).
+        let v = self.persistence.eeprom.axis(motor, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
+        self.write_axis_parameter(m, param, v);
+        Ok(())
+    }
+
+    /// STGP: stores a global parameter's value in the EEPROM.
+    pub(crate) fn store_global_parameter(&mut self, param: u8, bank: u8) -> Result<(), Status> {
+        self.global_spec(param, bank, |a| a.eeprom)?;
+        if self.eeprom_locked() {
+            return Err(Status::EepromLocked);
+        }
+        let v = self.globals[bank as usize][param as usize];
+        self.persistence.store_global(bank, param, v);
+        Ok(())
+    }
+
+    /// RSGP: a global parameter takes its value from the EEPROM again.
+    pub(crate) fn restore_global_parameter(&mut self, param: u8, bank: u8) -> Result<(), Status> {
+        let spec = self.global_spec(param, bank, |a| a.eeprom)?;
+        let v = self.persistence.eeprom.global(bank, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
+        self.globals[bank as usize][param as usize] = v;
+        Ok(())
     }
 
     pub fn set_axis_parameter(&mut self, param: u8, motor: u8, value: i32) -> Result<(), Status> {
