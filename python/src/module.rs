@@ -320,6 +320,13 @@ impl Module {
         self.profile.features.list().into_iter().collect()
     }
 
+    /// How the module detects a stall, as its profile's data names it:
+    /// ``"stallguard2"``, ``"tmc249"`` or ``"none"``.
+    #[getter]
+    fn stall_detection(&self) -> &'static str {
+        self.profile.features.stall_detection.name()
+    }
+
     /// How many motors the module has.
     #[getter]
     fn axes(&self) -> u8 {

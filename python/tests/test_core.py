@@ -13,6 +13,12 @@ def test_features_come_from_the_profile():
     assert f351["eeprom_lock"] == "GP 73"
     assert f351["can"].startswith("own identifiers: GP 71")
     assert tmclsim.Module("tmcm-1310").features["closed_loop"] == "yes"
+
+
+def test_stall_detection_is_the_profile_data_not_its_description():
+    assert tmclsim.Module("tmcm-1141").stall_detection == "stallguard2"
+    assert tmclsim.Module("tmcm-351").stall_detection == "tmc249"
+    assert tmclsim.Module("tmcm-1141").features["stall_detection"].startswith("stallGuard2 (")
     assert tmclsim.Module("tmcm-1141").features["closed_loop"] == "no"
 
 

@@ -156,6 +156,9 @@ class Module:
     def features(self) -> Dict[str, str]:
         """The profile's ``[features]`` table (reference search family, closed loop, CAN ids, …)."""
     @property
+    def stall_detection(self) -> str:
+        """How the module detects a stall: ``"stallguard2"``, ``"tmc249"`` or ``"none"`` (profile data)."""
+    @property
     def axes(self) -> int: ...
     @property
     def address(self) -> int:

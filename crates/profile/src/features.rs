@@ -36,6 +36,17 @@ pub enum StallDetection {
     None,
 }
 
+impl StallDetection {
+    /// The name a profile's `[features]` table gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            StallDetection::Stallguard2 => "stallguard2",
+            StallDetection::Tmc249 => "tmc249",
+            StallDetection::None => "none",
+        }
+    }
+}
+
 /// The encoder input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -312,6 +323,10 @@ mod tests {
         let f = &p.features;
         assert_eq!(f.reference_search, ReferenceSearchFamily::Tmc428);
         assert_eq!(f.stall_detection, StallDetection::Tmc249);
+        for kind in [StallDetection::Stallguard2, StallDetection::Tmc249, StallDetection::None] {
+            let read: StallDetection = toml::Value::String(kind.name().into()).try_into().unwrap();
+            assert_eq!(read, kind, "{} names what the profile data names", kind.name());
+        }
         assert!(!f.coolstep);
         assert!(!f.closed_loop);
         assert_eq!(f.encoder, Encoder::Tmc423);

@@ -215,7 +215,7 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
     watch_end_stop = "no_end_stop" in kinds or "end_stop" in mx.metrics
     watch_switches = "no_limit_switch" in kinds or "limit_switch" in mx.metrics
     watch_stall = "no_stall" in kinds or "stalled" in mx.metrics
-    stallguard = m.features.get("stall_detection", "").startswith("stallGuard2")
+    stallguard = m.stall_detection == "stallguard2"
     watch_load = "max_load" in mx.metrics
     watch_any = watch_speed or watch_end_stop or watch_switches or watch_stall or watch_load
 
