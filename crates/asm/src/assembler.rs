@@ -11,7 +11,6 @@ use std::rc::Rc;
 use tmclsim_profile::Profile;
 use tmclsim_protocol::{Instruction, opcode as op};
 
-use crate::Program;
 use crate::check::check;
 use crate::diagnostic::{Diagnostic, Loc, Reporter};
 use crate::encoder::{encode, encode_raw};
@@ -20,6 +19,7 @@ use crate::include::{IncludeResolver, built_in};
 use crate::lexer::Lines;
 use crate::limits::{MAX_LINE_BYTES, MAX_STATEMENTS, MAX_TOTAL_SOURCE_BYTES};
 use crate::parser::{Body, Line, parse_line};
+use crate::program::Program;
 use crate::source_map::SourceLine;
 
 /// How deeply includes may nest (a cycle is reported before this).

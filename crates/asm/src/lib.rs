@@ -23,6 +23,7 @@
 //! - `check.rs`: checks against a module profile;
 //! - `assembler.rs`: the passes that tie these together;
 //! - `binary.rs`, `symbol_file.rs`: output formats;
+//! - `program.rs`: the assembled program and what it gives;
 //! - `source_map.rs`: the source line of every instruction;
 //! - `disasm.rs`: the disassembler;
 //! - `diagnostic.rs`: error messages with file, line and column;
@@ -40,62 +41,15 @@ pub mod include;
 mod lexer;
 pub mod limits;
 mod parser;
+mod program;
 pub mod source_map;
 pub mod symbol_file;
-
-use std::collections::BTreeMap;
 
 pub use assembler::assemble;
 pub use diagnostic::{Diagnostic, render};
 pub use disasm::disassemble;
 pub use include::{IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
+pub use program::Program;
 pub use source_map::{LinePlace, SourceLine};
 pub use tmclsim_profile::Profile;
 pub use tmclsim_protocol::Instruction;
-
-/// An assembled program.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Program {
-    /// One instruction per program memory word, from address 0.
-    pub instructions: Vec<Instruction>,
-    /// Label → address.
-    pub symbols: BTreeMap<String, u32>,
-    /// Constant → value (those of included files too).
-    pub constants: BTreeMap<String, i64>,
-    /// The source of every instruction, same index as `instructions`;
-    /// empty for a program read from a binary.
-    pub source_map: Vec<SourceLine>,
-}
-
-impl Program {
-    /// The binary image: 8 bytes per instruction (see [`binary`]).
-    pub fn to_binary(&self) -> Vec<u8> {
-        binary::encode(&self.instructions)
-    }
-
-    /// Reads a binary image (length a multiple of 8, checksums checked).
-    pub fn from_binary(bytes: &[u8]) -> Result<Vec<Instruction>, String> {
-        binary::decode(bytes)
-    }
-
-    /// The symbol file: `label address` per line, sorted by address, then
-    /// the source map.
-    pub fn symbol_file(&self) -> String {
-        symbol_file::write(&self.symbols, &self.source_map)
-    }
-
-    /// The source line of the instruction at `address`, if known.
-    pub fn source_of(&self, address: u32) -> Option<&SourceLine> {
-        self.source_map.get(address as usize)
-    }
-
-    /// Reads a symbol file written by [`Program::symbol_file`].
-    pub fn parse_symbol_file(text: &str) -> Result<BTreeMap<String, u32>, String> {
-        symbol_file::parse(text)
-    }
-
-    /// Source text for this program, with its own labels.
-    pub fn disassemble(&self) -> String {
-        disassemble(&self.instructions, Some(&self.symbols))
-    }
-}

@@ -416,7 +416,7 @@ impl Profile {
             opcode_set,
             ascii_set,
         };
-        profile.features.check(&profile)?;
+        check_features(&profile)?;
         Ok(profile)
     }
 
@@ -522,6 +522,54 @@ impl Profile {
     pub fn position_bits(&self) -> u32 {
         self.module.position_bits as u32
     }
+}
+
+/// GP 65: the baud rate code that the features' `baud_rates` is indexed by.
+const BAUD_RATE: u8 = 65;
+
+/// Checks a profile's features against the rest of it: every global
+/// parameter they name exists, and the lists fit.
+fn check_features(profile: &Profile) -> Result<(), String> {
+    let f = &profile.features;
+    let named = [
+        ("shutdown_pin", f.shutdown_pin),
+        ("eeprom_lock", f.eeprom_lock),
+        ("eeprom_magic.parameter", f.eeprom_magic.map(|m| m.parameter)),
+        ("can.id", f.can.map(|c| c.id)),
+        ("can.reply_id", f.can.map(|c| c.reply_id)),
+        ("can.secondary_id", f.can.map(|c| c.secondary_id)),
+    ];
+    for (key, n) in named {
+        if let Some(n) = n
+            && profile.global_parameter(0, n).is_none()
+        {
+            return Err(format!("features.{key} names global parameter {n}, which the profile does not have (bank 0)"));
+        }
+    }
+    if f.baud_rates.is_empty() {
+        return Err("features.baud_rates is empty: it needs at least the rate of code 0".into());
+    }
+    if let Some(p) = profile.global_parameter(0, BAUD_RATE)
+        && p.max + 1 != f.baud_rates.len() as i64
+    {
+        return Err(format!(
+            "features.baud_rates has {} rates, but GP {BAUD_RATE} ({}) takes codes {}…{}",
+            f.baud_rates.len(),
+            p.name,
+            p.min,
+            p.max
+        ));
+    }
+    if f.full_scale_current_ma == 0 {
+        return Err("features.full_scale_current_ma is 0".into());
+    }
+    if f.motion_clock_hz == 0 {
+        return Err("features.motion_clock_hz is 0".into());
+    }
+    if f.encoder_deviation_stop && f.encoder == Encoder::None {
+        return Err("features.encoder_deviation_stop needs an encoder (features.encoder is \"none\")".into());
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -675,5 +723,173 @@ mod tests {
         }
         let bad = text("tmcm-1141").replace("ranges = [[1, 8], [65, 68], [133, 136]]", "ranges = [[1, 8], [65, 200]]");
         assert!(Profile::from_toml(&bad).unwrap_err().contains("ranges must lie within 1…136"));
+    }
+}
+
+/// The features of the built-in profiles and the checks of `[features]`
+/// tables (here, beside the profile they are checked against).
+#[cfg(test)]
+mod feature_tests {
+    use super::*;
+    use crate::features::*;
+
+    fn text(name: &str) -> &'static str {
+        BUILT_IN.iter().find(|(n, _)| *n == name).unwrap().1
+    }
+
+    /// The built-in profile's text with its `[features]` header followed by
+    /// `extra`.
+    fn with_features(name: &str, extra: &str) -> String {
+        let t = text(name);
+        assert_eq!(t.matches("\n[features]\n").count(), 1);
+        t.replace("\n[features]\n", &format!("\n[features]\n{extra}\n"))
+    }
+
+    /// The built-in profile's text with one feature line replaced.
+    fn replacing(name: &str, line: &str, by: &str) -> String {
+        let t = text(name);
+        assert_eq!(t.matches(line).count(), 1, "{line}");
+        t.replace(line, by)
+    }
+
+    #[test]
+    fn tmcm_1141_features() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        let f = &p.features;
+        assert_eq!(f.reference_search, ReferenceSearchFamily::Tmc429);
+        assert_eq!(f.stall_detection, StallDetection::Stallguard2);
+        assert!(f.coolstep);
+        assert!(!f.closed_loop);
+        assert_eq!(f.ethercat, None);
+        assert_eq!(f.encoder, Encoder::None);
+        assert_eq!(f.can, None, "CAN identifiers are the serial addresses");
+        assert_eq!(f.eeprom_lock, None);
+        assert_eq!(f.eeprom_magic, None);
+        assert_eq!(f.shutdown_pin, None);
+        assert_eq!(f.full_scale_current_ma, 1100);
+        assert_eq!(f.motion_clock_hz, 16_000_000, "manual 6.1.1");
+        // GP 65 codes → bit/s; codes the module lacks fall back to code 0.
+        assert_eq!(p.baud_rate(0), 9600);
+        assert_eq!(p.baud_rate(7), 115_200);
+        assert_eq!(p.baud_rate(8), 230_400);
+        assert_eq!(p.baud_rate(9), 9600);
+        assert_eq!(p.baud_rate(-1), 9600);
+    }
+
+    #[test]
+    fn tmcm_351_features() {
+        let p = Profile::built_in("tmcm-351").unwrap();
+        let f = &p.features;
+        assert_eq!(f.reference_search, ReferenceSearchFamily::Tmc428);
+        assert_eq!(f.stall_detection, StallDetection::Tmc249);
+        for kind in [StallDetection::Stallguard2, StallDetection::Tmc249, StallDetection::None] {
+            let read: StallDetection = toml::Value::String(kind.name().into()).try_into().unwrap();
+            assert_eq!(read, kind, "{} names what the profile data names", kind.name());
+        }
+        assert!(!f.coolstep);
+        assert!(!f.closed_loop);
+        assert_eq!(f.encoder, Encoder::Tmc423);
+        assert!(f.encoder_deviation_stop);
+        assert!(f.motion_groups);
+        assert_eq!(f.can, Some(CanIds { id: 71, reply_id: 70, secondary_id: 83 }));
+        assert_eq!(f.eeprom_lock, Some(73));
+        assert_eq!(f.eeprom_magic, Some(EepromMagic { parameter: 64, value: 0xE4 }));
+        assert_eq!(f.shutdown_pin, Some(80));
+        assert_eq!(f.full_scale_current_ma, 2800);
+        assert_eq!(p.baud_rate(8), 230_400);
+        assert_eq!(p.baud_rate(11), 1_000_000);
+        assert_eq!(p.baud_rate(12), 9600);
+    }
+
+    #[test]
+    fn tmcm_1310_features() {
+        let p = Profile::built_in("tmcm-1310").unwrap();
+        let f = &p.features;
+        assert!(f.closed_loop);
+        let e = f.ethercat.as_ref().expect("an EtherCAT slave");
+        assert_eq!((e.vendor_id, e.product_code, e.order_code.as_str(), e.group.as_str()), (0x286, 1310, "TMCM-1310-CL", "Stepper"));
+        assert_eq!(f.encoder, Encoder::AbnSsi);
+        assert_eq!(f.reference_search, ReferenceSearchFamily::Tmc429);
+        assert_eq!(f.can, None);
+        assert_eq!(f.full_scale_current_ma, 3000);
+        // No GP 65: every code gives the one rate.
+        assert_eq!(p.baud_rate(0), 9600);
+        assert_eq!(p.baud_rate(5), 9600);
+    }
+
+    #[test]
+    fn only_the_1310_is_an_ethercat_slave_or_runs_closed_loop() {
+        for name in Profile::names() {
+            let p = Profile::built_in(name).unwrap();
+            assert_eq!(p.features.ethercat.is_some(), name == "tmcm-1310", "{name}");
+            assert_eq!(p.features.closed_loop, name == "tmcm-1310", "{name}");
+        }
+    }
+
+    #[test]
+    fn supply_channels_have_the_supply_role() {
+        for (name, bank, number) in [("tmcm-1141", 1, 8), ("tmcm-1310", 1, 8)] {
+            let p = Profile::built_in(name).unwrap();
+            assert_eq!(p.port(PortDirection::Input, bank, number).unwrap().role, Some(PortRole::Supply), "{name}");
+            assert_eq!(p.ports.iter().filter(|q| q.role == Some(PortRole::Supply)).count(), 1, "{name}");
+        }
+        // The TMCM-351's profile has no supply channel.
+        assert!(Profile::built_in("tmcm-351").unwrap().ports.iter().all(|q| q.role.is_none()));
+    }
+
+    #[test]
+    fn an_unknown_feature_is_rejected_by_name() {
+        let e = Profile::from_toml(&with_features("tmcm-1141", "teleport = true")).unwrap_err();
+        assert!(e.contains("unknown field") && e.contains("teleport"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-351", "secondary_id = 83\n", "secondary_id = 83\nbroadcast_id = 1\n")).unwrap_err();
+        assert!(e.contains("unknown field") && e.contains("broadcast_id"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-1141", "reference_search = \"tmc429\"", "reference_search = \"tmc430\"")).unwrap_err();
+        assert!(e.contains("tmc430"), "{e}");
+    }
+
+    #[test]
+    fn the_features_table_is_required() {
+        let t = text("tmcm-1141");
+        let start = t.find("\n[features]\n").unwrap();
+        let end = start + t[start..].find("\n# ---").unwrap();
+        let e = Profile::from_toml(&format!("{}{}", &t[..start], &t[end..])).unwrap_err();
+        assert!(e.contains("features"), "{e}");
+        // So is every key that is not optional.
+        let e = Profile::from_toml(&replacing("tmcm-1141", "coolstep = true", "")).unwrap_err();
+        assert!(e.contains("coolstep"), "{e}");
+    }
+
+    #[test]
+    fn features_must_name_parameters_the_profile_has() {
+        // The TMCM-1141 has no GP 73.
+        let e = Profile::from_toml(&with_features("tmcm-1141", "eeprom_lock = 73")).unwrap_err();
+        assert!(e.contains("features.eeprom_lock") && e.contains("73"), "{e}");
+        let e = Profile::from_toml(&with_features("tmcm-1141", "can = { id = 71, reply_id = 70, secondary_id = 83 }")).unwrap_err();
+        assert!(e.contains("features.can.id"), "{e}");
+        // One rate per GP 65 code.
+        let e = Profile::from_toml(&replacing("tmcm-1141", ", 230400]", "]")).unwrap_err();
+        assert!(e.contains("baud_rates") && e.contains("0…8"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-1310", "baud_rates = [9600]", "baud_rates = []")).unwrap_err();
+        assert!(e.contains("baud_rates"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-1141", "encoder_deviation_stop = false", "encoder_deviation_stop = true")).unwrap_err();
+        assert!(e.contains("needs an encoder"), "{e}");
+    }
+
+    #[test]
+    fn every_listed_feature_is_documented() {
+        let readme = include_str!("../../../profiles/README.md");
+        let p = Profile::built_in("tmcm-351").unwrap();
+        let list = p.features.list();
+        assert_eq!(list.len(), 16);
+        for (key, value) in &list {
+            let row = if matches!(*key, "can" | "ethercat") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };
+            assert!(readme.contains(&row), "{key} has no row in the README's features table");
+            assert!(!value.is_empty(), "{key}");
+        }
+        let get = |k: &str| list.iter().find(|(key, _)| *key == k).unwrap().1.clone();
+        assert_eq!(get("eeprom_magic"), "GP 64 = 0xE4");
+        assert_eq!(get("full_scale_current_ma"), "2800 mA RMS");
+        assert_eq!(get("motion_clock_hz"), "16000000 Hz");
+        assert!(get("baud_rates").contains("codes 0…11"));
     }
 }

@@ -181,7 +181,7 @@ fn reaches(graph: &Graph, from: &str, to: &str) -> bool {
 }
 
 /// The crates checked.
-const CRATES: [&str; 9] = ["protocol", "firmware", "ethercat", "host", "ide", "server", "web", "cli", "wasm"];
+const CRATES: [&str; 11] = ["protocol", "profile", "asm", "firmware", "ethercat", "host", "ide", "server", "web", "cli", "wasm"];
 
 #[test]
 fn no_crate_has_import_cycles() {

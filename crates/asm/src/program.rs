@@ -1,0 +1,55 @@
+//! An assembled program: its words, labels, constants and source map, and
+//! the files it is written as.
+
+use crate::disasm::disassemble;
+use crate::source_map::SourceLine;
+use crate::{binary, symbol_file};
+use std::collections::BTreeMap;
+use tmclsim_protocol::Instruction;
+
+/// An assembled program.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Program {
+    /// One instruction per program memory word, from address 0.
+    pub instructions: Vec<Instruction>,
+    /// Label → address.
+    pub symbols: BTreeMap<String, u32>,
+    /// Constant → value (those of included files too).
+    pub constants: BTreeMap<String, i64>,
+    /// The source of every instruction, same index as `instructions`;
+    /// empty for a program read from a binary.
+    pub source_map: Vec<SourceLine>,
+}
+
+impl Program {
+    /// The binary image: 8 bytes per instruction (see [`binary`]).
+    pub fn to_binary(&self) -> Vec<u8> {
+        binary::encode(&self.instructions)
+    }
+
+    /// Reads a binary image (length a multiple of 8, checksums checked).
+    pub fn from_binary(bytes: &[u8]) -> Result<Vec<Instruction>, String> {
+        binary::decode(bytes)
+    }
+
+    /// The symbol file: `label address` per line, sorted by address, then
+    /// the source map.
+    pub fn symbol_file(&self) -> String {
+        symbol_file::write(&self.symbols, &self.source_map)
+    }
+
+    /// The source line of the instruction at `address`, if known.
+    pub fn source_of(&self, address: u32) -> Option<&SourceLine> {
+        self.source_map.get(address as usize)
+    }
+
+    /// Reads a symbol file written by [`Program::symbol_file`].
+    pub fn parse_symbol_file(text: &str) -> Result<BTreeMap<String, u32>, String> {
+        symbol_file::parse(text)
+    }
+
+    /// Source text for this program, with its own labels.
+    pub fn disassemble(&self) -> String {
+        disassemble(&self.instructions, Some(&self.symbols))
+    }
+}
