@@ -1,13 +1,13 @@
 //! The app's state shared by every route ([`App`]: the target, the token,
 //! downloads under way) and the error answer of a request.
 
-use tmclsim_ide::target::{Target, TargetError};
 use axum::Json;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use serde_json::json;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use tmclsim_ide::target::{Target, TargetError};
 use tmclsim_profile::Profile;
 
 /// Assemblies at once (`/api/assemble` and downloads); another request

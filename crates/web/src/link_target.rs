@@ -4,13 +4,13 @@
 //! program counter (135 type 1) after every step, until it reaches one
 //! (docs/behaviour.md rule 86).
 
-use tmclsim_ide::target::{Found, ModuleEntry, Target, TargetError, check};
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::time::{Duration, Instant};
 use tmclsim_host::Client;
 use tmclsim_host::client::profile_of_version;
+use tmclsim_ide::target::{Found, ModuleEntry, Target, TargetError, check};
 use tmclsim_protocol::{FRAME_LEN, Instruction, opcode};
 
 #[derive(Default)]

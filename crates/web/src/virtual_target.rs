@@ -3,9 +3,9 @@
 //! and a host on the link see each other's effects; observations read the
 //! model and change nothing (docs/behaviour.md rule 86).
 
-use tmclsim_ide::target::{ModuleEntry, Target, TargetError};
 use std::sync::Arc;
 use tmclsim_firmware::snapshot::ModuleSnapshot;
+use tmclsim_ide::target::{ModuleEntry, Target, TargetError};
 use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
 use tmclsim_server::frame_log::{self, Direction};
 use tmclsim_server::{LinkHandle, SharedBus};
