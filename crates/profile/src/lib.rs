@@ -553,6 +553,22 @@ mod tests {
     }
 
     #[test]
+    fn a_range_rows_parameters_are_each_named_by_their_number() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        let v = p.global_parameter(2, 17).unwrap();
+        assert_eq!((v.label(), v.name.as_str()), ("User variable 17", "User variables #0…#55"));
+        assert_eq!(p.global_parameter(2, 200).unwrap().label(), "User variable 200");
+        assert_eq!(p.axis_parameter(1).unwrap().label(), "Actual position");
+        // `each` needs a range and a place for the number.
+        let t = text("tmcm-1141");
+        let no_number = t.replacen("each = \"User variable {}\"", "each = \"User variable\"", 1);
+        let no_range = t.replacen("last = 55\n", "", 1);
+        for broken in [no_number, no_range] {
+            assert!(Profile::from_toml(&broken).unwrap_err().contains("`each`"));
+        }
+    }
+
+    #[test]
     fn every_profile_file_is_built_in_sorted_by_name() {
         // build.rs compiles in profiles/*.toml: a new module needs no Rust.
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../profiles");
