@@ -7,6 +7,7 @@ link (`tmclsim ide --tcp`), its world changed over the control socket."""
 
 import json
 import subprocess
+import time
 import urllib.request
 
 import pytest
@@ -151,8 +152,6 @@ def test_a_long_error_wraps_and_the_page_stays_within_the_window(served, page):
 
 def rotates(served, speed, seconds=1.5):
     """Whether the motor still runs `seconds` after ROR at `speed`; then stopped."""
-    import time
-
     tmcl(served, 1, 0, 0, speed)
     time.sleep(seconds)
     running = tmcl(served, 6, 3, 0) != 0
