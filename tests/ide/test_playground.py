@@ -196,3 +196,25 @@ def test_an_example_opens_from_its_address(playground, page):
     page.wait_for_function("() => window.tmclEditor.getValue().includes('Homing by reference search')")
     assert page.locator("[data-testid=panel-program]").is_visible()
     assert "timeout" in text_of(page, "prog-message")
+
+
+def test_the_reference_search_tool_runs_in_the_page(playground, page):
+    open_app(page, playground.url)
+    # The left stop switch near the carriage, placed in the world panel.
+    tab(page, "world")
+    page.select_option("[data-testid=place-which]", "left")
+    page.fill("[data-testid=place-at]", "-20000")
+    page.click("[data-testid=place-go]")
+    wait_text(page, "world-show", "t.includes('place 0 left -20000') && !t.includes('error')")
+    tab(page, "tools")
+    page.select_option("[data-testid=rfs-mode]", "1")
+    page.fill("[data-testid=rfs-search-speed]", "1000")
+    page.click("[data-testid=rfs-start]")
+    page.locator("[data-testid=rfs-position]").wait_for(timeout=30000)
+    assert text_of(page, "rfs-state") == "not searching"
+    events = page.locator("[data-testid=rfs-event]").all_inner_texts()
+    assert any("left switch pressed" in e for e in events), events
+    # The final position is the module's AP 1.
+    final = text_of(page, "rfs-position")
+    tab(page, "motion")
+    wait_text(page, "ro-position", f"t === '{final}'")

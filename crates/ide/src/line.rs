@@ -26,7 +26,7 @@ pub fn parse(line: &str, profile: Option<&Profile>) -> Result<Instruction, Parse
         Table::Axis => None,
     };
     let Some((_, p)) = find(profile, table, word, bank) else {
-        let names: Vec<String> = parameters(profile, table).iter().map(|(_, p)| snake(&p.name)).collect();
+        let names: Vec<String> = parameters(profile, table).iter().map(|(_, p)| snake(p.label())).collect();
         let what = if table == Table::Axis { "axis" } else { "global" };
         let in_bank = bank.map_or(String::new(), |b| format!(" in bank {b}"));
         return Err(ParseError {

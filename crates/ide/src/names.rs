@@ -48,7 +48,7 @@ pub fn find<'p>(profile: &'p Profile, table: Table, word: &str, bank: Option<u8>
     let number = tmclsim_protocol::mnemonic::parse_number(word);
     parameters(profile, table)
         .into_iter()
-        .find(|(b, p)| bank.is_none_or(|x| x == *b) && number.map_or_else(|| snake(&p.name) == snake(word), |n| n == i64::from(p.number)))
+        .find(|(b, p)| bank.is_none_or(|x| x == *b) && number.map_or_else(|| snake(p.label()) == snake(word), |n| n == i64::from(p.number)))
 }
 
 #[cfg(test)]
@@ -70,5 +70,6 @@ mod tests {
         assert_eq!(find(&p, Table::Axis, "4", None).map(|(_, q)| q.number), Some(4));
         assert!(find(&p, Table::Axis, "tmcl_tick_timer", None).is_none());
         assert_eq!(find(&p, Table::Global, "tmcl_tick_timer", None).map(|(b, q)| (b, q.number)), Some((0, 132)));
+        assert_eq!(find(&p, Table::Global, "user_variable_17", Some(2)).map(|(b, q)| (b, q.number)), Some((2, 17)));
     }
 }

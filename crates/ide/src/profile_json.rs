@@ -4,8 +4,8 @@
 //! velocities and accelerations, the motion controller's clock).
 
 use serde_json::{Value, json};
-use tmclsim_profile::ReferenceSearchFamily;
 use tmclsim_profile::{Parameter, PortDirection, Profile, Quantity};
+use tmclsim_profile::{ReferenceSearchFamily, StallDetection};
 
 fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
     let a = &p.access;
@@ -16,10 +16,10 @@ fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
         tmclsim_profile::DefaultSource::Assumed => "assumed",
     };
     let mut v = json!({
-        "number": p.number, "name": p.name, "unit": p.unit, "access": access,
+        "number": p.number, "name": p.label(), "unit": p.unit, "access": access,
         "min": p.min, "max": p.max, "default": p.default, "default_source": source,
         "note": p.note, "storable": a.eeprom, "ranges": p.ranges,
-        "snake": crate::names::snake(&p.name),
+        "snake": crate::names::snake(p.label()),
         "quantity": p.quantity.map(|q| match q {
             Quantity::Velocity => "velocity",
             Quantity::Acceleration => "acceleration",
@@ -63,6 +63,45 @@ fn reference_modes(family: ReferenceSearchFamily) -> Vec<(i64, &'static str)> {
     }
 }
 
+/// The axis parameters of the tuning tools, by their role, for the
+/// features the profile has (TMCM-1141 manual, table 16; the same numbers
+/// on every module with these features). A role the module has no row for
+/// is left out; a feature it lacks is null.
+fn tuning(profile: &Profile) -> Value {
+    let f = &profile.features;
+    let has = |n: u8| profile.axis_parameters().any(|p| p.number == n);
+    let roles = |pairs: &[(&str, u8)]| -> Value {
+        let map: serde_json::Map<String, Value> = pairs.iter().filter(|(_, n)| has(*n)).map(|(k, n)| (k.to_string(), json!(n))).collect();
+        Value::Object(map)
+    };
+    let stallguard2 = (f.stall_detection == StallDetection::Stallguard2)
+        .then(|| roles(&[("threshold", 174), ("filter", 173), ("stop_speed", 181), ("load", 206), ("stall_flag", 207)]));
+    let coolstep = f.coolstep.then(|| {
+        roles(&[
+            ("max_current", 6),
+            ("minimum", 168),
+            ("down_step", 169),
+            ("hysteresis", 170),
+            ("up_step", 171),
+            ("hysteresis_start", 172),
+            ("actual_current", 180),
+            ("threshold_speed", 182),
+            ("load", 206),
+        ])
+    });
+    let reference = roles(&[
+        ("mode", 193),
+        ("search_speed", 194),
+        ("switch_speed", 195),
+        ("distance", 196),
+        ("last_position", 197),
+        ("left", 11),
+        ("right", 10),
+        ("home", 9),
+    ]);
+    json!({ "stallguard2": stallguard2, "coolstep": coolstep, "reference_search": reference })
+}
+
 pub fn of(profile: &Profile) -> Value {
     let m = &profile.module;
     let commands: Vec<&str> = m.opcodes.iter().filter_map(|&o| tmclsim_protocol::opcode::mnemonic(o)).collect();
@@ -82,6 +121,7 @@ pub fn of(profile: &Profile) -> Value {
         "motion_clock_hz": profile.features.motion_clock_hz,
         "axis_parameters": axis, "global_parameters": global,
         "inputs": port(PortDirection::Input), "outputs": port(PortDirection::Output),
+        "tuning": tuning(profile),
         "reference_modes": reference_modes(profile.features.reference_search).into_iter().map(|(v, n)| json!({"value": v, "name": n})).collect::<Vec<_>>(),
     })
 }
@@ -113,5 +153,30 @@ mod tests {
             let named = if name.contains("negative") { -1 } else { 1 };
             assert_eq!(speed.signum(), named, "mode {mode} ({name}) moves at {speed}");
         }
+    }
+
+    #[test]
+    fn the_tuning_tools_parameters_follow_the_features() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        let t = &of(&p)["tuning"];
+        assert_eq!(t["stallguard2"]["threshold"], 174);
+        assert_eq!(t["stallguard2"]["load"], 206);
+        assert_eq!(t["coolstep"]["hysteresis_start"], 172);
+        assert_eq!(t["coolstep"]["actual_current"], 180);
+        assert_eq!(t["reference_search"]["switch_speed"], 195);
+        // A module without stallGuard2 or coolStep has neither tool.
+        let q = Profile::built_in("tmcm-351").unwrap();
+        assert!(q.features.stall_detection != StallDetection::Stallguard2 && !q.features.coolstep);
+        let t = &of(&q)["tuning"];
+        assert!(t["stallguard2"].is_null() && t["coolstep"].is_null());
+    }
+
+    #[test]
+    fn each_user_variable_is_named_by_its_number() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        let rows = of(&p)["global_parameters"].as_array().unwrap().clone();
+        let row = rows.iter().find(|r| r["bank"] == 2 && r["number"] == 17).unwrap();
+        assert_eq!(row["name"], "User variable 17");
+        assert_eq!(row["snake"], "user_variable_17");
     }
 }

@@ -50,7 +50,7 @@ fn parameter(profile: &Profile, ins: Instruction) -> Option<(String, Option<Stri
         Table::Axis => profile.axis_parameter(ins.kind)?,
         Table::Global => profile.global_parameter(ins.motor, ins.kind)?,
     };
-    Some((format!("{} ({})", p.name, p.number), p.unit.clone()))
+    Some((format!("{} ({})", p.label(), p.number), p.unit.clone()))
 }
 
 /// Why a command failed, where the profile tells.
@@ -65,8 +65,10 @@ fn hint(ins: Instruction, status: u8, profile: Option<&Profile>) -> Option<Strin
         (Some(Table::Global), 3) if profile.global_parameter(ins.motor, ins.kind).is_none() => {
             Some(format!("the {name} has no global parameter {} in bank {}", ins.kind, ins.motor))
         }
-        (Some(Table::Axis), 4) => profile.axis_parameter(ins.kind).map(|p| format!("{} takes {}…{}", p.name, p.min, p.max)),
-        (Some(Table::Global), 4) => profile.global_parameter(ins.motor, ins.kind).map(|p| format!("{} takes {}…{}", p.name, p.min, p.max)),
+        (Some(Table::Axis), 4) => profile.axis_parameter(ins.kind).map(|p| format!("{} takes {}…{}", p.label(), p.min, p.max)),
+        (Some(Table::Global), 4) => {
+            profile.global_parameter(ins.motor, ins.kind).map(|p| format!("{} takes {}…{}", p.label(), p.min, p.max))
+        }
         _ => None,
     }
 }

@@ -85,6 +85,9 @@ impl DefaultSource {
 pub struct Parameter {
     pub number: u8,
     pub name: String,
+    /// Its own name when it is one of a range row's parameters ("User
+    /// variable 17"); `name` is then the range's.
+    pub own_name: Option<String>,
     pub access: Access,
     pub min: i64,
     pub max: i64,
@@ -111,6 +114,12 @@ pub enum Quantity {
 }
 
 impl Parameter {
+    /// The parameter's own name: a range row's parameters are each named
+    /// by their number where the profile says how.
+    pub fn label(&self) -> &str {
+        self.own_name.as_deref().unwrap_or(&self.name)
+    }
+
     /// Checks a wire value against the range (and the valid ranges within
     /// it). Ranges above 2^31−1 (the timer periods of bank 3) read the 32
     /// bits as unsigned.
@@ -240,6 +249,10 @@ struct ParameterRow {
     #[serde(default)]
     last: Option<u8>,
     name: String,
+    /// The name of each parameter of a range row, `{}` standing for its
+    /// number ("User variable {}").
+    #[serde(default)]
+    each: Option<String>,
     access: String,
     min: i64,
     max: i64,
@@ -359,6 +372,12 @@ impl Profile {
                 ));
             }
             let _ = &row.source;
+            if row.each.as_ref().is_some_and(|e| row.last.is_none() || !e.contains("{}")) {
+                return Err(format!(
+                    "parameter {} ({}): `each` names the parameters of a range (with `last`), `{{}}` for the number",
+                    row.number, row.name
+                ));
+            }
             for n in row.number..=row.last.unwrap_or(row.number) {
                 if table[n as usize].is_some() {
                     return Err(format!("parameter {n} ({}) is defined twice", row.name));
@@ -366,6 +385,7 @@ impl Profile {
                 table[n as usize] = Some(Parameter {
                     number: n,
                     name: row.name.clone(),
+                    own_name: row.each.as_ref().map(|e| e.replace("{}", &n.to_string())),
                     access,
                     min: row.min,
                     max: row.max,
@@ -578,6 +598,22 @@ mod tests {
 
     fn text(name: &str) -> &'static str {
         BUILT_IN.iter().find(|(n, _)| *n == name).unwrap().1
+    }
+
+    #[test]
+    fn a_range_rows_parameters_are_each_named_by_their_number() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        let v = p.global_parameter(2, 17).unwrap();
+        assert_eq!((v.label(), v.name.as_str()), ("User variable 17", "User variables #0…#55"));
+        assert_eq!(p.global_parameter(2, 200).unwrap().label(), "User variable 200");
+        assert_eq!(p.axis_parameter(1).unwrap().label(), "Actual position");
+        // `each` needs a range and a place for the number.
+        let t = text("tmcm-1141");
+        let no_number = t.replacen("each = \"User variable {}\"", "each = \"User variable\"", 1);
+        let no_range = t.replacen("last = 55\n", "", 1);
+        for broken in [no_number, no_range] {
+            assert!(Profile::from_toml(&broken).unwrap_err().contains("`each`"));
+        }
     }
 
     #[test]

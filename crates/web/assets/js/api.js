@@ -116,6 +116,24 @@ export function axisOptions(select, profile) {
   select.replaceChildren(...Array.from({ length: axes }, (_, i) => el("option", { value: String(i), text: String(i) })));
 }
 
+// The module has one selected motor: every panel's motor selector shows
+// it, and choosing another in one panel chooses it in all.
+const motorSelectors = new Map();
+
+/** Links `select` to the selected motor; `onChange` runs when it changes. */
+export function motorSelector(select, onChange) {
+  motorSelectors.set(select, onChange);
+  select.addEventListener("change", () => chooseMotor(select.value));
+}
+
+/** Chooses motor `value` in every panel. */
+export function chooseMotor(value) {
+  for (const [select, onChange] of motorSelectors) {
+    select.value = value;
+    onChange();
+  }
+}
+
 /** Saves `blob` as the file `name` (a download). */
 export function download(blob, name) {
   const a = el("a", { href: URL.createObjectURL(blob), download: name });

@@ -10,6 +10,7 @@ import { ChartsPanel } from "./charts.js";
 import { IoPanel } from "./io.js";
 import { ProgramPanel } from "./program.js";
 import { WorldPanel } from "./world.js";
+import { ToolsPanel } from "./tools.js";
 import { unitControls } from "./units.js";
 
 const panels = {
@@ -19,10 +20,12 @@ const panels = {
   charts: new ChartsPanel(),
   io: new IoPanel(),
   program: new ProgramPanel(),
+  tools: new ToolsPanel(),
   world: new WorldPanel(),
 };
 // Read by the tests.
 window.tmclsimCharts = panels.charts;
+window.tmclsimTools = panels.tools;
 let active = "direct";
 let live = null;
 // Per subscription id: which panel's signals are where in a sample.

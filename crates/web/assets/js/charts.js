@@ -5,7 +5,7 @@
 // only change the view: samples keep coming in. Each scale group of a
 // panel (µsteps, a speed, a 0…1023 load, a 0…31 current, switches 0/1)
 // has its own axis. Every panel exports PNG and CSV.
-import { el, axisOptions, download } from "./api.js";
+import { el, axisOptions, download, motorSelector } from "./api.js";
 import { factor, unitName, onUnits, divisorReads, DIVISORS } from "./units.js";
 
 const COLORS = ["#0b6bcb", "#e67e22", "#1e8e3e", "#8e44ad", "#c0392b", "#16697a", "#7f8c8d"];
@@ -35,9 +35,9 @@ export class ChartsPanel {
     });
     document.getElementById("chart-rate").addEventListener("change", () => this.ctx?.resubscribe());
     this.axis = document.getElementById("chart-axis");
-    this.axis.addEventListener("change", () => {
+    motorSelector(this.axis, () => {
       this.build();
-      this.ctx.resubscribe();
+      this.ctx?.resubscribe();
     });
     document.getElementById("chart-add").addEventListener("change", (e) => {
       const n = e.target.value;

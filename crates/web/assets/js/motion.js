@@ -1,8 +1,8 @@
-// Motion: rotate, stop, move absolute/relative with a speed, reference
-// search with the mode chosen by name; the axis's position, speed and
-// switches from the live stream. Speeds are shown and entered in the
+// Motion: rotate, stop, move absolute/relative with a speed; the axis's
+// position, speed and switches from the live stream (the reference search
+// is among the tools, tools.js). Speeds are shown and entered in the
 // page's unit, converted with the motor's divisors as last read.
-import { post, el, m, axisOptions } from "./api.js";
+import { post, el, m, axisOptions, motorSelector } from "./api.js";
 import { factor, show as inUnit, toInternal, divisorReads, divisorsOf } from "./units.js";
 
 // AP 1 actual, AP 0 target position, AP 3 actual speed, AP 8 position
@@ -13,7 +13,7 @@ export class MotionPanel {
   constructor() {
     this.axis = document.getElementById("motion-axis");
     this.log = document.getElementById("motion-log");
-    this.axis.addEventListener("change", () => this.ctx.resubscribe());
+    motorSelector(this.axis, () => this.ctx?.resubscribe());
     // A speed typed in the page's unit, as the internal value sent.
     const internal = (x) => {
       const v = toInternal(Number(x), "velocity", this.ctx.profile?.motion_clock_hz, this.divisors);
@@ -40,27 +40,12 @@ export class MotionPanel {
     };
     on("mvp-abs", () => move("ABS"));
     on("mvp-rel", () => move("REL"));
-    on("rfs-start", async () => {
-      const mode = document.getElementById("rfs-mode").value;
-      if (mode && !(await this.send(`SAP 193, ${a()}, ${mode}`))) return;
-      await this.send(`RFS START, ${a()}`);
-    });
-    on("rfs-stop", () => this.send(`RFS STOP, ${a()}`));
-    on("rfs-status", async () => {
-      const r = await this.send(`RFS STATUS, ${a()}`);
-      if (r) document.getElementById("rfs-result").textContent = r.value === 0 ? "not searching (done or never started)" : "searching";
-    });
   }
 
   setModule(ctx) {
     this.ctx = ctx;
     const p = ctx.profile;
     axisOptions(this.axis, ctx.profile);
-    const modes = p ? p.reference_modes : [];
-    document.getElementById("rfs-mode").replaceChildren(
-      el("option", { value: "", text: "as set (AP 193)" }),
-      ...modes.map((x) => el("option", { value: String(x.value), text: x.name })),
-    );
     const has = new Set(p ? p.axis_parameters.map((r) => r.number) : READOUT);
     this.readout = READOUT.filter((n) => has.has(n));
   }

@@ -3,7 +3,7 @@
 // and restored (STAP/RSAP, STGP/RSGP). Values that change flash. Speeds and
 // accelerations are shown and typed in the page's unit, converted with the
 // motor's divisors read with the rows.
-import { post, el, m, axisOptions } from "./api.js";
+import { post, el, m, axisOptions, motorSelector } from "./api.js";
 import { factor, show, toInternal, unitName, onUnits, divisorReads, divisorsOf } from "./units.js";
 
 const POLL_MS = 300;
@@ -22,7 +22,7 @@ export class ParamsPanel {
     this.axis = document.getElementById("param-axis");
     this.status = document.getElementById("param-status");
     this.filter.addEventListener("input", () => this.draw());
-    this.axis.addEventListener("change", () => this.draw());
+    motorSelector(this.axis, () => this.draw());
     for (const r of document.querySelectorAll("input[name=ptable]")) r.addEventListener("change", () => this.draw());
     onUnits(() => this.draw());
     this.visible = false;

@@ -107,7 +107,8 @@ export class ProgramPanel {
       const line = Math.max(0, d.line - 1);
       this.editor.addLineClass(line, "background", "cm-error-line");
       const text = `${" ".repeat(Math.max(0, d.column - 1))}^ ${d.line}:${d.column}: ${d.message}`;
-      this.widgets.push(this.editor.addLineWidget(line, el("div", { class: "diag-widget", "data-testid": "diagnostic", text })));
+      // A long diagnostic wraps within the editor's width.
+      this.widgets.push(this.editor.addLineWidget(line, el("div", { class: "diag-widget", "data-testid": "diagnostic", text }), { noHScroll: true }));
       const li = el("li", { "data-testid": "diagnostic-item", text: `${d.line}:${d.column}: ${d.message}` });
       li.addEventListener("click", () => {
         this.editor.setCursor({ line, ch: Math.max(0, d.column - 1) });

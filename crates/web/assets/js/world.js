@@ -1,7 +1,7 @@
 // The world around a virtual module: switches, placement, load, supply,
 // temperature, inputs, driver and link faults, reset; each one line of the
 // control protocol (docs/world.md).
-import { get, post, el, m, axisOptions } from "./api.js";
+import { get, post, el, m, axisOptions, motorSelector } from "./api.js";
 
 const POLL_MS = 250;
 
@@ -9,6 +9,7 @@ export class WorldPanel {
   constructor() {
     this.show = document.getElementById("world-show");
     this.axis = document.getElementById("world-axis");
+    motorSelector(this.axis, () => this.poll());
     const a = () => this.axis.value || "0";
     for (const which of ["left", "right", "home"]) {
       for (const how of ["press", "release", "auto"]) {
@@ -68,6 +69,15 @@ export class WorldPanel {
       document.querySelector(`[data-testid=sw-${which}-state]`).textContent = ax[which] ? "pressed" : "open";
     }
     const num = (x, digits) => (typeof x === "number" ? x.toFixed(digits) : "–");
+    // The inputs show the world as it is (set here, by a script or over the
+    // control socket), except the one being typed into.
+    const reflect = (id, x) => {
+      const input = document.getElementById(id);
+      if (document.activeElement !== input && typeof x === "number") input.value = String(Number(x.toFixed(2)));
+    };
+    reflect("world-load", ax.load);
+    reflect("world-supply", w.supply);
+    reflect("world-temp", w.temperature);
     document.getElementById("world-state").textContent =
       `t = ${num(w.time, 2)} s · carriage ${num(ax.carriage, 0)} · load ${num(Math.abs(ax.load), 0)} % · ` +
       `supply ${num(w.supply, 1)} V · ${num(w.temperature, 1)} °C${ax.stopped_by_switch ? " · stopped by a switch" : ""}`;
