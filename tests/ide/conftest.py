@@ -109,6 +109,17 @@ def tab(page, name):
     page.click(f"[data-testid=tab-{name}]")
 
 
+def text(page, testid):
+    """The text of the element with that test id."""
+    return page.inner_text(f"[data-testid={testid}]")
+
+
+def wait_text(page, testid, expression):
+    """Waits until the element's text `t` makes the JavaScript `expression`
+    true."""
+    page.wait_for_function(f"(() => {{ const t = document.querySelector('[data-testid={testid}]').textContent; return {expression}; }})()")
+
+
 def shot(page, name):
     """A screenshot for docs/ide.md, taken by the tests so that it can be
     refreshed (TMCLSIM_REFRESH_SCREENSHOTS=1) and compared."""

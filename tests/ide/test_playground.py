@@ -8,7 +8,7 @@ import threading
 import urllib.parse
 
 import pytest
-from conftest import ROOT, open_app, shot, tab
+from conftest import ROOT, open_app, shot, tab, text, wait_text
 
 PLAYGROUND = ROOT / "target" / "playground"
 # Served under a subpath, as from a project's pages.
@@ -70,23 +70,13 @@ def playground():
     files.stop()
 
 
-def text_of(page, testid):
-    return page.inner_text(f"[data-testid={testid}]")
-
-
-def wait_text(page, testid, expression):
-    """Waits until the element's text satisfies `expression` (JavaScript, `t`
-    is the text)."""
-    page.wait_for_function(f"(() => {{ const t = document.querySelector('[data-testid={testid}]').textContent; return {expression}; }})()")
-
-
 def test_the_playground_runs_the_ide_in_the_page_from_static_files_only(playground, page):
     requests, sockets = [], []
     page.on("request", lambda r: requests.append(r.url))
     page.on("websocket", lambda w: sockets.append(w.url))
     open_app(page, playground.url)
     assert page.evaluate("() => new window.tmclsim.Module('1141').profile") == "TMCM-1141"
-    assert "in this page" in text_of(page, "target")
+    assert "in this page" in text(page, "target")
     assert page.locator("[data-testid=module-item]").count() == 1
 
     # A module of another profile joins the list and is picked.
@@ -94,7 +84,7 @@ def test_the_playground_runs_the_ide_in_the_page_from_static_files_only(playgrou
     page.click("[data-testid=add-go]")
     wait_text(page, "module-title", "t.startsWith('TMCM-3110')")
     assert page.locator("[data-testid=module-item]").count() == 2
-    assert text_of(page, "module-count") == "2 of 2 modules"
+    assert text(page, "module-count") == "2 of 2 modules"
     page.locator("[data-testid=module-item]").first.click()
     wait_text(page, "module-title", "t.startsWith('TMCM-1141')")
 
@@ -127,7 +117,7 @@ def test_the_playground_runs_the_ide_in_the_page_from_static_files_only(playgrou
     wait_text(page, "sw-right-state", "t === 'pressed'")
     tab(page, "motion")
     wait_text(page, "ro-speed", "t === '0'")
-    assert text_of(page, "ro-switches").startswith("0 / 1")
+    assert text(page, "ro-switches").startswith("0 / 1")
 
     # The assembler's diagnostics at line:column; then a download and a run
     # that stops at a breakpoint.
@@ -147,7 +137,7 @@ def test_the_playground_runs_the_ide_in_the_page_from_static_files_only(playgrou
     page.click("[data-testid=prog-run]")
     wait_text(page, "ps-break", "t === 'at address 2'")
     assert page.get_attribute("[data-testid=editor]", "data-current-line") == "4"
-    assert text_of(page, "ps-acc") == "1"
+    assert text(page, "ps-acc") == "1"
     page.click("[data-testid=prog-continue]")
     wait_text(page, "ps-acc", "t === '2'")
     shot(page, "playground-program")
@@ -195,7 +185,7 @@ def test_an_example_opens_from_its_address(playground, page):
     open_app(page, playground.url + "?example=homing")
     page.wait_for_function("() => window.tmclEditor.getValue().includes('Homing by reference search')")
     assert page.locator("[data-testid=panel-program]").is_visible()
-    assert "timeout" in text_of(page, "prog-message")
+    assert "timeout" in text(page, "prog-message")
 
 
 def test_the_reference_search_tool_runs_in_the_page(playground, page):
@@ -211,10 +201,10 @@ def test_the_reference_search_tool_runs_in_the_page(playground, page):
     page.fill("[data-testid=rfs-search-speed]", "1000")
     page.click("[data-testid=rfs-start]")
     page.locator("[data-testid=rfs-position]").wait_for(timeout=30000)
-    assert text_of(page, "rfs-state") == "not searching"
+    assert text(page, "rfs-state") == "not searching"
     events = page.locator("[data-testid=rfs-event]").all_inner_texts()
     assert any("left switch pressed" in e for e in events), events
     # The final position is the module's AP 1.
-    final = text_of(page, "rfs-position")
+    final = text(page, "rfs-position")
     tab(page, "motion")
     wait_text(page, "ro-position", f"t === '{final}'")

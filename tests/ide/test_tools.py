@@ -11,7 +11,7 @@ import time
 import urllib.request
 
 import pytest
-from conftest import open_app, shot, tab
+from conftest import open_app, shot, tab, text, wait_text
 from pytrinamic.connections import ConnectionManager
 from tmclsim_binary import tmclsim_binary
 
@@ -37,15 +37,6 @@ def tmcl(served, command, type_, motor, value=0):
     with ConnectionManager(f"--interface socket_serial_tmcl --port {served.tcp}").connect() as interface:
         v = interface.send(command, type_, motor, value).value
     return v - (1 << 32) if v >= 1 << 31 else v
-
-
-def text(page, testid):
-    return page.inner_text(f"[data-testid={testid}]")
-
-
-def wait_text(page, testid, expr):
-    """Until the element's text `t` makes the JS expression true."""
-    page.wait_for_function(f"(() => {{ const t = document.querySelector('[data-testid={testid}]').textContent; return {expr}; }})()", timeout=30000)
 
 
 # --- correct display ---------------------------------------------------------

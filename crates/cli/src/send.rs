@@ -9,7 +9,7 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     let line = args.command.join(" ");
     let parsed = mnemonic::parse_line(&line);
     if let Err(e) = &parsed
-        && !has_name_operand(&line)
+        && !tmclsim_host::line::names_a_parameter(&line)
     {
         return Err(format!("{line}: {e}"));
     }
@@ -59,15 +59,4 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     let status = Status::from_code(r.status).map_or(format!("{} (unknown)", r.status), |s| s.to_string());
     println!("host {} module {} status {status} opcode {} ({}) value {}", r.host, r.module, r.opcode, opcode::name(r.opcode), r.value);
     Ok(if r.status < 100 { ExitCode::from(1) } else { ExitCode::SUCCESS })
-}
-
-/// Whether the line is a parameter command (SAP, GGP, …) whose type
-/// operand is a word, not a number: a parameter's name.
-fn has_name_operand(line: &str) -> bool {
-    match mnemonic::tokens(line).as_slice() {
-        [(_, head), (_, word), ..] => {
-            opcode::from_mnemonic(head).and_then(tmclsim_host::names::table_of).is_some() && mnemonic::parse_number(word).is_none()
-        }
-        _ => false,
-    }
 }

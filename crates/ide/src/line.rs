@@ -7,18 +7,36 @@ use tmclsim_profile::Profile;
 use tmclsim_protocol::mnemonic::{self, ParseError};
 use tmclsim_protocol::{Instruction, opcode, suggest};
 
+/// A parameter command's type operand that is a word, not a number: its
+/// table, column, the word, and the number after it (the bank of a global
+/// parameter).
+struct NameOperand<'a> {
+    table: Table,
+    column: usize,
+    word: &'a str,
+    next: Option<i64>,
+}
+
+fn name_operand(line: &str) -> Option<NameOperand<'_>> {
+    match mnemonic::tokens(line).as_slice() {
+        [(_, head), (column, word), rest @ ..] if mnemonic::parse_number(word).is_none() => {
+            let table = opcode::from_mnemonic(head).and_then(table_of)?;
+            Some(NameOperand { table, column: *column, word, next: rest.first().and_then(|(_, b)| mnemonic::parse_number(b)) })
+        }
+        _ => None,
+    }
+}
+
+/// Whether the line names a parameter (SAP, GGP, … with a word for its
+/// type): it needs a profile to be parsed.
+pub fn names_a_parameter(line: &str) -> bool {
+    name_operand(line).is_some()
+}
+
 /// Parses a line; parameter names are looked up in `profile` when there
 /// is one.
 pub fn parse(line: &str, profile: Option<&Profile>) -> Result<Instruction, ParseError> {
-    let tokens = mnemonic::tokens(line);
-    let named = match (tokens.as_slice(), profile) {
-        ([(_, head), (column, word), rest @ ..], Some(profile)) if mnemonic::parse_number(word).is_none() => {
-            let table = opcode::from_mnemonic(head).and_then(table_of);
-            table.map(|t| (t, *column, *word, rest.first().and_then(|(_, b)| mnemonic::parse_number(b)), profile))
-        }
-        _ => None,
-    };
-    let Some((table, column, word, bank, profile)) = named else {
+    let (Some(NameOperand { table, column, word, next: bank }), Some(profile)) = (name_operand(line), profile) else {
         return mnemonic::parse_line(line);
     };
     let bank = match table {
