@@ -49,11 +49,14 @@ async fn modules(State(app): State<App>) -> Json<Value> {
 /// `POST /api/scan`: the modules that answer on a link target's link,
 /// whether or not the app lists them.
 async fn scan(State(app): State<App>) -> Result<Json<Value>, ApiError> {
-    if (0..app.target.modules().len()).any(|id| app.is_downloading(id)) {
-        return Err(ApiError(StatusCode::CONFLICT, "a program is being downloaded: scan when it is done".into()));
-    }
+    // A scan asks every address: none may be in download mode.
+    let used = app.all_idle().map_err(|_| ApiError(StatusCode::CONFLICT, "a program is being downloaded: scan when it is done".into()))?;
     let listed: Vec<u8> = app.target.modules().iter().map(|m| m.address).collect();
-    let found = blocking(move || app.target.scan()).await??;
+    let found = blocking(move || {
+        let _used = used;
+        app.target.scan()
+    })
+    .await??;
     let list: Vec<Value> = found
         .iter()
         .map(|f| json!({"address": f.address, "firmware": f.firmware, "profile": f.profile, "listed": listed.contains(&f.address)}))
@@ -77,9 +80,15 @@ struct CommandBody {
 }
 
 async fn command(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<CommandBody>) -> Result<Json<Value>, ApiError> {
-    app.idle(id)?;
+    let used = app.idle(id)?;
     let ins = answers::parse_line(app.target.as_ref(), id, &body.line).map_err(bad)?;
-    Ok(Json(blocking(move || exchange(&app, id, ins)).await??))
+    Ok(Json(
+        blocking(move || {
+            let _used = used;
+            exchange(&app, id, ins)
+        })
+        .await??,
+    ))
 }
 
 #[derive(Deserialize)]
@@ -88,14 +97,26 @@ struct ReadBody {
 }
 
 async fn read(State(app): State<App>, Path(id): Path<usize>, Json(body): Json<ReadBody>) -> Result<Json<Value>, ApiError> {
-    app.observable(id)?;
-    Ok(Json(blocking(move || answers::read_json(app.target.as_ref(), id, &body.reads)).await??))
+    let used = app.observable(id)?;
+    Ok(Json(
+        blocking(move || {
+            let _used = used;
+            answers::read_json(app.target.as_ref(), id, &body.reads)
+        })
+        .await??,
+    ))
 }
 
 async fn write(State(app): State<App>, Path(id): Path<usize>, Json(w): Json<Write>) -> Result<Json<Value>, ApiError> {
-    app.idle(id)?;
+    let used = app.idle(id)?;
     let ins = w.instruction().map_err(bad)?;
-    Ok(Json(blocking(move || exchange(&app, id, ins)).await??))
+    Ok(Json(
+        blocking(move || {
+            let _used = used;
+            exchange(&app, id, ins)
+        })
+        .await??,
+    ))
 }
 
 #[derive(Deserialize)]

@@ -5,8 +5,7 @@ use axum::Json;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use serde_json::json;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use tmclsim_ide::target::{Target, TargetError};
 use tmclsim_profile::Profile;
 
@@ -22,58 +21,110 @@ pub struct App {
     pub token: Option<String>,
     /// Assemblies running at once (bounded: each may take a core).
     pub assemblers: Arc<tokio::sync::Semaphore>,
-    /// Per module: a download is under way. In download mode a module
-    /// stores every command it receives as a program word, so the app
-    /// sends nothing else to it meanwhile (its live stream pauses, other
-    /// requests are answered 409).
-    downloading: Arc<Vec<AtomicBool>>,
+    /// Per module: who is sending to it. In download mode a module stores
+    /// every command it receives as a program word, so the app sends
+    /// nothing else to it meanwhile (its live stream pauses, other
+    /// requests are answered 409), and a download begins only when the
+    /// requests already under way have their replies.
+    gates: Arc<Vec<Gate>>,
+}
+
+#[derive(Default)]
+struct Gate {
+    state: Mutex<Users>,
+    free: Condvar,
+}
+
+#[derive(Default)]
+struct Users {
+    requests: usize,
+    downloading: bool,
+}
+
+impl Gate {
+    fn users(&self) -> MutexGuard<'_, Users> {
+        self.state.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// A request's use of a module, from its check to its last reply: a
+/// download waits for it. Move it into the work that sends.
+pub struct InUse(Arc<Vec<Gate>>, usize);
+
+impl Drop for InUse {
+    fn drop(&mut self) {
+        let gate = &self.0[self.1];
+        gate.users().requests -= 1;
+        gate.free.notify_all();
+    }
 }
 
 /// Marks a module as downloading until dropped.
-pub struct Downloading(Arc<Vec<AtomicBool>>, usize);
+pub struct Downloading(Arc<Vec<Gate>>, usize);
+
+impl Downloading {
+    /// Blocks until the requests that were under way when the download
+    /// was claimed have their replies (call it on a blocking thread).
+    pub fn wait_for_requests(&self) {
+        let gate = &self.0[self.1];
+        let mut users = gate.users();
+        while users.requests > 0 {
+            users = gate.free.wait(users).unwrap_or_else(|p| p.into_inner());
+        }
+    }
+}
 
 impl Drop for Downloading {
     fn drop(&mut self) {
-        self.0[self.1].store(false, Ordering::SeqCst);
+        self.0[self.1].users().downloading = false;
     }
+}
+
+fn conflict() -> ApiError {
+    ApiError(StatusCode::CONFLICT, "a program is being downloaded to this module: wait until the download ends".into())
 }
 
 impl App {
     pub fn new(target: Arc<dyn Target>, token: Option<String>) -> App {
-        let downloading = Arc::new(target.modules().iter().map(|_| AtomicBool::new(false)).collect());
+        let gates = Arc::new(target.modules().iter().map(|_| Gate::default()).collect());
         let assemblers = Arc::new(tokio::sync::Semaphore::new(ASSEMBLERS));
-        App { target, token, downloading, assemblers }
+        App { target, token, gates, assemblers }
     }
 
-    pub fn is_downloading(&self, id: usize) -> bool {
-        self.downloading.get(id).is_some_and(|d| d.load(Ordering::SeqCst))
-    }
-
-    /// The module exists and takes requests now (no download under way).
-    pub fn idle(&self, id: usize) -> Result<(), ApiError> {
+    /// The module exists and takes requests now (no download under way);
+    /// a download claimed later waits until the answer is dropped.
+    pub fn idle(&self, id: usize) -> Result<InUse, ApiError> {
         self.address(id)?;
-        if self.is_downloading(id) {
-            return Err(ApiError(
-                StatusCode::CONFLICT,
-                "a program is being downloaded to this module: wait until the download ends".into(),
-            ));
+        let mut users = self.gates[id].users();
+        if users.downloading {
+            return Err(conflict());
         }
-        Ok(())
+        users.requests += 1;
+        Ok(InUse(self.gates.clone(), id))
+    }
+
+    /// Every module takes requests now (a scan asks every address).
+    pub fn all_idle(&self) -> Result<Vec<InUse>, ApiError> {
+        (0..self.gates.len()).map(|id| self.idle(id)).collect()
     }
 
     /// The module exists and may be observed now: always on a target that
-    /// observes its model, otherwise while no download is under way.
-    pub fn observable(&self, id: usize) -> Result<(), ApiError> {
-        if self.target.observes_the_model() { self.address(id).map(|_| ()) } else { self.idle(id) }
+    /// observes its model (no use to hold), otherwise while no download is
+    /// under way.
+    pub fn observable(&self, id: usize) -> Result<Option<InUse>, ApiError> {
+        if self.target.observes_the_model() { self.address(id).map(|_| None) } else { self.idle(id).map(Some) }
     }
 
     /// Claims the module for a download; refused while another runs.
+    /// Nothing may be sent before [`Downloading::wait_for_requests`].
     pub fn start_download(&self, id: usize) -> Result<Downloading, ApiError> {
         self.address(id)?;
-        if self.downloading[id].compare_exchange(false, true, Ordering::SeqCst, Ordering::SeqCst).is_err() {
+        let mut users = self.gates[id].users();
+        if users.downloading {
             return Err(ApiError(StatusCode::CONFLICT, "a program is being downloaded to this module already".into()));
         }
-        Ok(Downloading(self.downloading.clone(), id))
+        users.downloading = true;
+        Ok(Downloading(self.gates.clone(), id))
     }
 
     pub fn profile(&self, id: usize) -> Result<Option<Arc<Profile>>, ApiError> {

@@ -62,13 +62,17 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
                 }
             }
             _ = tick.tick() => {
-                if sub.is_empty() || app.observable(id).is_err() {
-                    // A module on a link in download mode would store the
-                    // reads as program words: the stream pauses.
+                // A module on a link in download mode would store the
+                // reads as program words: the stream pauses.
+                let Ok(used) = app.observable(id) else { continue };
+                if sub.is_empty() {
                     continue;
                 }
                 let (a, s) = (app.clone(), sub.clone());
-                let take = move || sample(a.target.as_ref(), id, &s);
+                let take = move || {
+                    let _used = used;
+                    sample(a.target.as_ref(), id, &s)
+                };
                 // Virtual modules answer in microseconds: no thread hand-off.
                 let answer = if app.target.blocks() { tokio::task::spawn_blocking(take).await } else { Ok(take()) };
                 let Ok(v) = answer else { return };

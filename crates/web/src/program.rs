@@ -3,7 +3,7 @@
 //! streamed as progress lines, run/stop/pause/step/continue/reset
 //! (128–131), the breakpoints, and the program's state.
 
-use crate::app::{ApiError, App, bad, blocking};
+use crate::app::{ASSEMBLERS, ApiError, App, bad, blocking};
 use axum::Json;
 use axum::body::Body;
 use axum::extract::{Path, State};
@@ -14,10 +14,6 @@ use serde_json::Value;
 use tmclsim_asm::Program;
 use tmclsim_ide::program::{self as ide, ActionError};
 use tmclsim_profile::Profile;
-
-/// Assemblies at once (`/api/assemble` and downloads); another request
-/// meanwhile is answered 503 (docs/robustness.md).
-pub const ASSEMBLERS: usize = 2;
 
 /// Assembles on the blocking pool, at most [`ASSEMBLERS`] at once.
 async fn assemble_bounded(app: &App, source: String, profile: Option<std::sync::Arc<Profile>>) -> Result<Result<Program, Value>, ApiError> {
@@ -63,12 +59,13 @@ pub async fn download(State(app): State<App>, Path(id): Path<usize>, Json(b): Js
     let claim = app.start_download(id)?;
     let (tx, rx) = tokio::sync::mpsc::channel::<String>(64);
     tokio::task::spawn_blocking(move || {
-        let _claim = claim;
+        claim.wait_for_requests();
         let mut send = |v: Value| {
             let _ = tx.blocking_send(format!("{v}\n"));
         };
         let end = ide::download_end(app.target.as_ref(), id, &program, &mut send);
         send(end);
+        drop(claim);
     });
     let stream = tokio_stream::StreamExt::map(tokio_stream::wrappers::ReceiverStream::new(rx), Ok::<_, std::convert::Infallible>);
     Ok(([(header::CONTENT_TYPE, "application/x-ndjson")], Body::from_stream(stream)).into_response())
@@ -77,13 +74,25 @@ pub async fn download(State(app): State<App>, Path(id): Path<usize>, Json(b): Js
 /// `GET program/source`: the program read back from the module (134),
 /// disassembled.
 pub async fn source(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
-    app.idle(id)?;
-    Ok(Json(blocking(move || ide::source_json(app.target.as_ref(), id)).await??))
+    let used = app.idle(id)?;
+    Ok(Json(
+        blocking(move || {
+            let _used = used;
+            ide::source_json(app.target.as_ref(), id)
+        })
+        .await??,
+    ))
 }
 
 pub async fn state(State(app): State<App>, Path(id): Path<usize>) -> Result<Json<Value>, ApiError> {
-    app.observable(id)?;
-    Ok(Json(blocking(move || ide::state_of(app.target.as_ref(), id)).await??))
+    let used = app.observable(id)?;
+    Ok(Json(
+        blocking(move || {
+            let _used = used;
+            ide::state_of(app.target.as_ref(), id)
+        })
+        .await??,
+    ))
 }
 
 #[derive(Deserialize)]
@@ -92,10 +101,11 @@ pub struct BreakpointsBody {
 }
 
 pub async fn breakpoints(State(app): State<App>, Path(id): Path<usize>, Json(b): Json<BreakpointsBody>) -> Result<Json<Value>, ApiError> {
-    app.idle(id)?;
+    let used = app.idle(id)?;
     ide::check_breakpoints(app.target.as_ref(), id, &b.addresses).map_err(bad)?;
     Ok(Json(
         blocking(move || {
+            let _used = used;
             app.target.set_breakpoints(id, &b.addresses)?;
             ide::state_of(app.target.as_ref(), id)
         })
@@ -104,8 +114,12 @@ pub async fn breakpoints(State(app): State<App>, Path(id): Path<usize>, Json(b):
 }
 
 pub async fn action(State(app): State<App>, Path((id, action)): Path<(usize, String)>) -> Result<Json<Value>, ApiError> {
-    app.idle(id)?;
-    let out = blocking(move || ide::action(app.target.as_ref(), id, &action)).await?;
+    let used = app.idle(id)?;
+    let out = blocking(move || {
+        let _used = used;
+        ide::action(app.target.as_ref(), id, &action)
+    })
+    .await?;
     out.map(Json).map_err(|e| match e {
         ActionError::Unknown(s) => bad(s),
         ActionError::Target(e) => e.into(),

@@ -244,6 +244,56 @@ fn observers_and_a_second_host_do_not_corrupt_a_hosts_download() {
 }
 
 #[test]
+fn the_ides_reads_on_a_link_wait_for_its_download() {
+    // The app on a link (`tmclsim ide --tcp`): its program state and reads
+    // go over the same link as its download; a read that was checked
+    // before the download was claimed must have its reply before the
+    // download's first frame, or the module stores it as a word.
+    let server = Server::start(&["--tcp", "127.0.0.1:0"]);
+    let ide = Server::ide(&["--tcp", &server.tcp()]);
+    let url = ide.printed("open");
+    let stop = Arc::new(AtomicBool::new(false));
+    let reads = Arc::new(AtomicU64::new(0));
+    let pollers: Vec<_> = (0..3)
+        .map(|n| {
+            let (url, stop, reads) = (url.clone(), stop.clone(), reads.clone());
+            std::thread::spawn(move || {
+                while !stop.load(Ordering::Relaxed) {
+                    let (status, body) = if n == 0 {
+                        get(&url, "/api/modules/0/program/state")
+                    } else {
+                        common::post(&url, "/api/modules/0/read", r#"{"reads":[{"kind":"ap","number":1}]}"#)
+                    };
+                    assert!(status.contains("200") || status.contains("409"), "{status} {body}");
+                    reads.fetch_add(1, Ordering::Relaxed);
+                }
+            })
+        })
+        .collect();
+    let source: String = (0..64).map(|n| format!("SAP 4, 0, {}\\n", 1000 + n)).collect();
+    let body = format!(r#"{{"source": "{source}"}}"#);
+    for round in 0..10 {
+        let before = reads.load(Ordering::Relaxed);
+        let (status, answer) = common::post(&url, "/api/modules/0/program/download", &body);
+        assert!(status.contains("200") && answer.contains("\"verified\":true"), "round {round}: {status} {answer}");
+        let t = Instant::now();
+        while reads.load(Ordering::Relaxed) < before + 3 {
+            assert!(t.elapsed() < Duration::from_secs(10), "the pollers do not run");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+    stop.store(true, Ordering::Relaxed);
+    for p in pollers {
+        p.join().unwrap();
+    }
+    let mut host = server.connect();
+    for a in 0..64 {
+        let r = exchange(&mut host, Instruction::new(134, 0, 0, a));
+        assert_eq!(Instruction::from_bytes(r[1..8].try_into().unwrap()), Instruction::new(5, 4, 0, 1000 + a), "word {a}");
+    }
+}
+
+#[test]
 fn a_download_whose_host_left_passes_to_the_next_host() {
     let server = Server::start(&["--tcp", "127.0.0.1:0"]);
     let mut first = server.connect();

@@ -4,8 +4,6 @@
 use crate::common;
 
 use common::{Server, get, post, text, tmclsim};
-use std::io::{BufRead, BufReader};
-use std::process::{Command, Stdio};
 
 #[test]
 fn serve_web_prints_the_url_and_lists_the_module() {
@@ -37,12 +35,10 @@ fn a_public_web_address_needs_the_flag() {
 #[test]
 fn ide_reaches_a_served_module_over_tcp() {
     let server = Server::start(&["--tcp", "127.0.0.1:0"]);
-    let (mut ide, url, lines) = ide(&["--tcp", &server.tcp()]);
-    assert!(lines.iter().any(|l| l.contains("1141V146 at address 1")), "{lines:?}");
-    let (_, body) = get(&url, "/api/modules");
+    let ide = Server::ide(&["--tcp", &server.tcp()]);
+    assert!(ide.banner.iter().any(|l| l.contains("1141V146 at address 1")), "{:?}", ide.banner);
+    let (_, body) = get(&ide.printed("open"), "/api/modules");
     assert!(body.contains("\"virtual\":false") && body.contains("TMCM-1141"), "{body}");
-    ide.kill().unwrap();
-    ide.wait().unwrap();
 }
 
 #[test]
@@ -81,35 +77,12 @@ fn log_frames_shows_the_apps_commands_on_the_link_web() {
     assert!(web[2].ends_with("to 1: GAP 4, 0"), "{}", web[2]);
 }
 
-/// Starts `tmclsim ide` with `args`: the process, the app's URL and the
-/// lines it printed before.
-fn ide(args: &[&str]) -> (std::process::Child, String, Vec<String>) {
-    let mut ide = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
-        .arg("ide")
-        .args(args)
-        .args(["--web", "127.0.0.1:0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(ide.stdout.take().unwrap());
-    let mut lines = Vec::new();
-    let url = loop {
-        let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "ide ended: {lines:?}");
-        if let Some(u) = line.trim().strip_prefix("open: ") {
-            break u.to_string();
-        }
-        lines.push(line);
-    };
-    (ide, url, lines)
-}
-
 #[test]
 fn ide_leaves_out_an_address_that_does_not_answer_and_a_scan_finds_every_module() {
     let server = Server::start(&["--bus", "tmcm-1141@1,tmcm-351@7", "--tcp", "127.0.0.1:0"]);
-    let (mut a, url, lines) = ide(&["--tcp", &server.tcp(), "--bus-addresses", "1,2,5"]);
-    assert!(lines.iter().any(|l| l.contains("1141V146 at address 1")), "{lines:?}");
+    let a = Server::ide(&["--tcp", &server.tcp(), "--bus-addresses", "1,2,5"]);
+    let url = a.printed("open");
+    assert!(a.banner.iter().any(|l| l.contains("1141V146 at address 1")), "{:?}", a.banner);
     let (_, body) = get(&url, "/api/modules");
     assert!(body.contains("\"address\":1") && !body.contains("\"address\":5"), "{body}");
     // The scan: every address in under 2 s, both modules with their
@@ -117,25 +90,19 @@ fn ide_leaves_out_an_address_that_does_not_answer_and_a_scan_finds_every_module(
     let t = std::time::Instant::now();
     let (_, body) = post(&url, "/api/scan", "{}");
     let took = t.elapsed();
-    if took.as_secs_f64() >= 2.0 {
-        a.kill().unwrap();
-        panic!("the scan took {took:?}");
-    }
+    assert!(took.as_secs_f64() < 2.0, "the scan took {took:?}");
     let one = r#"{"address":1,"firmware":"1141V146","listed":true,"profile":"TMCM-1141"}"#;
     let seven = r#"{"address":7,"firmware":"0351V445","listed":false,"profile":"TMCM-351"}"#;
     assert_eq!(body, format!(r#"{{"modules":[{one},{seven}]}}"#));
     // The link still answers in step afterwards.
     let (_, body) = post(&url, "/api/modules/0/command", r#"{"line": "GAP 1, 0"}"#);
     assert!(body.contains("\"status\":100"), "{body}");
-    a.kill().unwrap();
-    a.wait().unwrap();
+    drop(a);
     // ide --scan lists what answers.
-    let (mut b, url, lines) = ide(&["--tcp", &server.tcp(), "--scan"]);
-    assert!(lines.iter().any(|l| l.contains("1141V146 at address 1") && l.contains("0351V445 at address 7")), "{lines:?}");
-    let (_, body) = get(&url, "/api/modules");
+    let b = Server::ide(&["--tcp", &server.tcp(), "--scan"]);
+    assert!(b.banner.iter().any(|l| l.contains("1141V146 at address 1") && l.contains("0351V445 at address 7")), "{:?}", b.banner);
+    let (_, body) = get(&b.printed("open"), "/api/modules");
     assert!(body.contains("TMCM-351"), "{body}");
-    b.kill().unwrap();
-    b.wait().unwrap();
 }
 
 #[test]

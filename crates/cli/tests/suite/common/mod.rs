@@ -17,10 +17,10 @@ pub fn serve_command(args: &[&str]) -> Command {
     c
 }
 
-/// Reads what a starting server prints up to its `connect with:` line
-/// (`None` when it ends first), then keeps draining its standard output
-/// so that it never blocks.
-fn read_banner(child: &mut Child) -> Option<Vec<String>> {
+/// Reads what a starting server prints up to its line beginning with
+/// `last` (`None` when it ends first), then keeps draining its standard
+/// output so that it never blocks.
+fn read_banner(child: &mut Child, last: &str) -> Option<Vec<String>> {
     let mut out = BufReader::new(child.stdout.take().expect("stdout piped"));
     let mut banner = Vec::new();
     loop {
@@ -28,7 +28,7 @@ fn read_banner(child: &mut Child) -> Option<Vec<String>> {
         if out.read_line(&mut line).unwrap() == 0 {
             return None;
         }
-        let done = line.starts_with("connect with:");
+        let done = line.starts_with(last);
         banner.push(line.trim().to_string());
         if done {
             break;
@@ -51,7 +51,7 @@ fn printed(banner: &[String], key: &str) -> String {
 /// until it serves; returns the process and its TCP endpoint.
 pub fn serve(args: &[&str], stderr: Stdio) -> (Child, String) {
     let mut child = serve_command(&[&["--tcp", "127.0.0.1:0"][..], args].concat()).stderr(stderr).spawn().unwrap();
-    let banner = read_banner(&mut child).expect("the server ended before serving");
+    let banner = read_banner(&mut child, "connect with:").expect("the server ended before serving");
     (child, printed(&banner, "tcp"))
 }
 
@@ -74,9 +74,22 @@ impl Server {
         Server::of(command.spawn().unwrap())
     }
 
+    /// `tmclsim ide ARGS --web 127.0.0.1:0`, once it serves the app (its
+    /// URL is `printed("open")`).
+    pub fn ide(args: &[&str]) -> Server {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_tmclsim"));
+        c.arg("ide").args(args).args(["--web", "127.0.0.1:0"]).stdout(Stdio::piped()).stderr(Stdio::piped());
+        Server::serving(c.spawn().unwrap(), "open:")
+    }
+
     /// A started server process (its standard output piped; its standard
     /// error, if piped, becomes the log).
-    pub fn of(mut child: Child) -> Server {
+    pub fn of(child: Child) -> Server {
+        Server::serving(child, "connect with:")
+    }
+
+    /// A started process, once it printed its line beginning with `last`.
+    fn serving(mut child: Child, last: &str) -> Server {
         let log = Arc::new(Mutex::new(Vec::new()));
         if let Some(err) = child.stderr.take() {
             let l = log.clone();
@@ -86,7 +99,7 @@ impl Server {
                 }
             });
         }
-        let Some(banner) = read_banner(&mut child) else {
+        let Some(banner) = read_banner(&mut child, last) else {
             let _ = child.wait();
             std::thread::sleep(Duration::from_millis(100));
             panic!("the server ended before serving: {:?}", log.lock().unwrap());
