@@ -7,6 +7,6 @@ pub mod client;
 pub mod trace;
 
 // Without I/O, so that the playground has them too.
-pub use tmclsim_ide::{line, names, reply};
+pub use tmclsim_ide::{download, line, names, observe, reply};
 
 pub use client::{Client, hex};
