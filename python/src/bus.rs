@@ -9,8 +9,8 @@ use pyo3::prelude::*;
 use std::borrow::Cow;
 use std::sync::Arc;
 use tmclsim_firmware::Bus as FwBus;
+use tmclsim_host::SharedBus;
 use tmclsim_protocol::{FRAME_LEN, Request};
-use tmclsim_server::SharedBus;
 
 /// Several modules on one link: every frame reaches every module, the
 /// addressed one answers.

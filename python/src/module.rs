@@ -1,6 +1,6 @@
 //! `Module`: one virtual TMCL module.
 //!
-//! The module lives on a bus (`tmclsim_server::SharedBus`, a bus of one
+//! The module lives on a bus (`tmclsim_host::SharedBus`, a bus of one
 //! unless it was put on a `Bus`), as every front end's module does: the
 //! bus's clock is stepped in process (virtual time stands still between
 //! `advance` calls) and follows the wall clock while a `Server` serves it
@@ -23,11 +23,11 @@ use tmclsim_firmware::module::gp::SERIAL_ADDRESS;
 use tmclsim_firmware::profile::Parameter;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
+use tmclsim_host::SharedBus;
+use tmclsim_host::eeprom_file::{EepromFile, LoadError, resolve};
 use tmclsim_host::names::{Names, snake};
 use tmclsim_host::observe;
 use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Request, Status, opcode};
-use tmclsim_server::SharedBus;
-use tmclsim_server::eeprom_file::{EepromFile, LoadError, resolve};
 
 /// A virtual TMCL module (a TMCM-1141 by default).
 ///
