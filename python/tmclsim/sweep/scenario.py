@@ -197,7 +197,7 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
         m.load_program(tmclsim.Program.from_binary(programs[profile]))
         for line in lines:
             r = m.send(line)
-            if r is None or r.status < 100:
+            if r is None or not r.ok:
                 raise ScenarioError(f"'{line}' answered {'nothing' if r is None else f'status {r.status} ({r.description})'}")
         for r in reads:
             # A value the module does not have is the scenario's error,
