@@ -6,7 +6,7 @@
 use crate::errors::{catch, internal_error, value_error};
 use pyo3::prelude::*;
 use std::time::{Duration, Instant};
-use tmclsim_server::SharedBus;
+use tmclsim_host::SharedBus;
 
 /// The wall time a slice aims at: Ctrl-C answers within about this long.
 const SLICE_WALL: Duration = Duration::from_millis(20);

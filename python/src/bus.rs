@@ -4,13 +4,13 @@
 use crate::advance::seconds_to_ns;
 use crate::errors::{guard, value_error};
 use crate::module::{Module, served_error};
-use crate::types::{Reply, ReplyKind, command_from};
+use crate::types::{Reply, command_from};
 use pyo3::prelude::*;
 use std::borrow::Cow;
 use std::sync::Arc;
 use tmclsim_firmware::Bus as FwBus;
+use tmclsim_host::SharedBus;
 use tmclsim_protocol::{FRAME_LEN, Request};
-use tmclsim_server::SharedBus;
 
 /// Several modules on one link: every frame reaches every module, the
 /// addressed one answers.
@@ -41,11 +41,10 @@ impl Bus {
             if m.shared.len() != 1 {
                 return Err(value_error("the module is on a bus already"));
             }
-            let address = m.address_now()?;
-            if addresses.contains(&address) {
-                return Err(value_error(format!("two modules have address {address}: give each its own (Module(address=…))")));
-            }
-            addresses.push(address);
+            addresses.push(m.address_now()?);
+        }
+        if let Some(address) = tmclsim_firmware::bus::duplicate_address(addresses) {
+            return Err(value_error(format!("two modules have address {address}: give each its own (Module(address=…))")));
         }
         // Each module leaves its bus of one for the new bus, with its
         // EEPROM file; the firmware bus brings them to one time.
@@ -108,7 +107,7 @@ impl Bus {
         let ins = command_from(command, r#type, motor, value)?;
         let frame = Request::new(address, ins).encode();
         let reply = self.send_frame(command.py(), Cow::Borrowed(&frame))?;
-        Ok(reply.map(|raw| Reply::new(raw, ReplyKind::of(ins, address, &raw))))
+        Ok(reply.map(|raw| Reply::new(raw, tmclsim_host::reply::shape(ins, address, &raw))))
     }
 
     /// advance(seconds: float) -> None

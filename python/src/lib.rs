@@ -8,7 +8,6 @@
 //! - `asm.rs`: `Program`, `assemble`, `disassemble`;
 //! - `types.rs`: `Reply`, `Instruction`, `Registers`;
 //! - `world.rs`: the control protocol of docs/world.md on any module;
-//! - `names.rs`: parameters by name;
 //! - `advance.rs`: moving virtual time on (checked durations, Ctrl-C);
 //! - `errors.rs`: raising the package's Python exceptions, panics caught;
 //! - `cli_main`: the `tmclsim` command itself, for the console script.
@@ -21,7 +20,6 @@ mod asm;
 mod bus;
 mod errors;
 mod module;
-mod names;
 mod server;
 mod types;
 mod world;

@@ -1,6 +1,6 @@
 //! `Module`: one virtual TMCL module.
 //!
-//! The module lives on a bus (`tmclsim_server::SharedBus`, a bus of one
+//! The module lives on a bus (`tmclsim_host::SharedBus`, a bus of one
 //! unless it was put on a `Bus`), as every front end's module does: the
 //! bus's clock is stepped in process (virtual time stands still between
 //! `advance` calls) and follows the wall clock while a `Server` serves it
@@ -9,7 +9,6 @@
 use crate::advance::advance_in_slices;
 use crate::asm::{Program, program_from};
 use crate::errors::{catch, guard, internal_error, os_error, tmcl_error, value_error};
-use crate::names::{Names, snake_case};
 use crate::types::{Registers, Reply, ReplyKind, command_from};
 use crate::world;
 use pyo3::exceptions::PyRuntimeError;
@@ -24,9 +23,11 @@ use tmclsim_firmware::module::gp::SERIAL_ADDRESS;
 use tmclsim_firmware::profile::Parameter;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::{Eeprom, Module as FwModule, Profile, World};
+use tmclsim_host::SharedBus;
+use tmclsim_host::eeprom_file::{EepromFile, LoadError, resolve};
+use tmclsim_host::names::{Names, snake};
+use tmclsim_host::observe;
 use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Request, Status, opcode};
-use tmclsim_server::SharedBus;
-use tmclsim_server::eeprom_file::{EepromFile, LoadError, resolve};
 
 /// A virtual TMCL module (a TMCM-1141 by default).
 ///
@@ -90,7 +91,7 @@ impl Module {
     pub fn send_instruction(&mut self, ins: Ins) -> PyResult<Option<Reply>> {
         let address = self.address_now()?;
         let reply = self.handle_frame(&Request::new(address, ins).encode())?;
-        Ok(reply.map(|raw| Reply::new(raw, ReplyKind::of(ins, address, &raw))))
+        Ok(reply.map(|raw| Reply::new(raw, tmclsim_host::reply::shape(ins, address, &raw))))
     }
 
     /// A frame for this module; a write the EEPROM file did not take is
@@ -131,27 +132,9 @@ impl Module {
         Ok((bank.unwrap_or(0), byte(param, "parameter number")?))
     }
 
-    /// Why a parameter access failed, in words.
-    fn explain(&self, status: Status, command: String, spec: Option<&Parameter>, write: bool, motor_or_bank: Option<(&str, u8)>) -> String {
-        let mut text = command;
-        if let Some(p) = spec {
-            text.push_str(&format!(" ({})", p.name));
-        }
-        text.push_str(&format!(": {} (status {})", status.describe(), status.code()));
-        let detail = match (status, spec) {
-            (Status::WrongType, None) => Some("the module has no such parameter".to_string()),
-            (Status::WrongType, Some(p)) if write && !p.access.write => Some(format!("it is read-only (access {})", p.access)),
-            (Status::WrongType, Some(p)) if !write && !p.access.read => Some(format!("it cannot be read (access {})", p.access)),
-            (Status::InvalidValue, Some(p)) if write && motor_or_bank.is_none() => Some(format!("the value must be in {}", p.range_text())),
-            (Status::InvalidValue, _) => {
-                motor_or_bank.map(|(what, n)| format!("{what} {n} does not exist on the {}", self.profile.module.name))
-            }
-            _ => None,
-        };
-        if let Some(d) = detail {
-            text.push_str(&format!("; {d}"));
-        }
-        text
+    /// A parameter command that failed, as `TmclError` with the reason.
+    fn failed(&self, py: Python<'_>, ins: Ins, status: Status) -> PyErr {
+        tmcl_error(py, status, tmclsim_host::reply::explain(ins, status, Some(&self.profile)))
     }
 
     fn resolve_address(&self, at: &Bound<'_, PyAny>) -> PyResult<u16> {
@@ -211,7 +194,7 @@ fn parameter_dict<'py>(py: Python<'py>, p: &Parameter, bank: Option<u8>) -> PyRe
         d.set_item("bank", b)?;
     }
     d.set_item("name", &p.name)?;
-    d.set_item("snake_name", snake_case(&p.name))?;
+    d.set_item("snake_name", snake(&p.name))?;
     d.set_item("access", p.access.to_string())?;
     d.set_item("min", p.min)?;
     d.set_item("max", p.max)?;
@@ -414,16 +397,7 @@ impl Module {
         let number = self.axis_number(param)?;
         match self.with(|m| m.get_axis_parameter(number, motor))? {
             Ok(v) => Ok(v),
-            Err(status) => {
-                let text = self.explain(
-                    status,
-                    format!("GAP {number}, {motor}"),
-                    self.profile.axis_parameter(number),
-                    false,
-                    (motor >= self.profile.module.axes).then_some(("motor", motor)),
-                );
-                Err(tmcl_error(param.py(), status, text))
-            }
+            Err(status) => Err(self.failed(param.py(), Ins::new(opcode::GAP, number, motor, 0), status)),
         }
     }
 
@@ -438,16 +412,7 @@ impl Module {
         let word = crate::types::wire_value(value)?;
         match self.with(|m| m.set_axis_parameter(number, motor, word))? {
             Ok(()) => Ok(()),
-            Err(status) => {
-                let text = self.explain(
-                    status,
-                    format!("SAP {number}, {motor}, {value}"),
-                    self.profile.axis_parameter(number),
-                    true,
-                    (motor >= self.profile.module.axes).then_some(("motor", motor)),
-                );
-                Err(tmcl_error(param.py(), status, text))
-            }
+            Err(status) => Err(self.failed(param.py(), Ins::new(opcode::SAP, number, motor, word), status)),
         }
     }
 
@@ -461,16 +426,7 @@ impl Module {
         let (bank, number) = self.global_number(param, bank)?;
         match self.with(|m| m.get_global_parameter(number, bank))? {
             Ok(v) => Ok(v),
-            Err(status) => {
-                let text = self.explain(
-                    status,
-                    format!("GGP {number}, {bank}"),
-                    self.profile.global_parameter(bank, number),
-                    false,
-                    (!self.profile.has_bank(bank)).then_some(("bank", bank)),
-                );
-                Err(tmcl_error(param.py(), status, text))
-            }
+            Err(status) => Err(self.failed(param.py(), Ins::new(opcode::GGP, number, bank, 0), status)),
         }
     }
 
@@ -484,17 +440,28 @@ impl Module {
         let word = crate::types::wire_value(value)?;
         match self.with(|m| m.set_global_parameter(number, bank, word))? {
             Ok(()) => Ok(()),
-            Err(status) => {
-                let text = self.explain(
-                    status,
-                    format!("SGP {number}, {bank}, {value}"),
-                    self.profile.global_parameter(bank, number),
-                    true,
-                    (!self.profile.has_bank(bank)).then_some(("bank", bank)),
-                );
-                Err(tmcl_error(param.py(), status, text))
-            }
+            Err(status) => Err(self.failed(param.py(), Ins::new(opcode::SGP, number, bank, word), status)),
         }
+    }
+
+    /// _axis_number(name: str) -> int
+    /// --
+    ///
+    /// The number of the axis parameter with this name (the lookup
+    /// ``get_axis_parameter`` makes); ``ValueError`` when there is none.
+    fn _axis_number(&self, name: &Bound<'_, PyString>) -> PyResult<u8> {
+        self.axis_number(name.as_any())
+    }
+
+    /// _global_number(name: str, bank=None) -> tuple[int, int]
+    /// --
+    ///
+    /// The bank and number of the global parameter with this name (the
+    /// lookup ``get_global_parameter`` makes); ``ValueError`` when there
+    /// is none.
+    #[pyo3(signature = (name, bank=None))]
+    fn _global_number(&self, name: &Bound<'_, PyString>, bank: Option<u8>) -> PyResult<(u8, u8)> {
+        self.global_number(name.as_any(), bank)
     }
 
     /// axis_parameters() -> list[dict]
@@ -578,7 +545,7 @@ impl Module {
     #[pyo3(signature = (motor=0))]
     fn error_flags(&mut self, motor: usize) -> PyResult<i32> {
         self.check_motor(motor)?;
-        self.with(|m| m.axis(motor).params[207])
+        self.with(|m| observe::extended_error_flags(m, motor as u8))
     }
 
     /// at_end_stop(motor=0) -> bool
@@ -589,10 +556,7 @@ impl Module {
     #[pyo3(signature = (motor=0))]
     fn at_end_stop(&mut self, motor: usize) -> PyResult<bool> {
         self.check_motor(motor)?;
-        self.with(|m| {
-            let c = m.mechanical_position(motor);
-            m.world().axes[motor].travel.is_some_and(|(lo, hi)| c <= lo || c >= hi)
-        })
+        self.with(|m| observe::at_end_stop(m, motor))
     }
 
     /// The digital outputs as a bit vector (OUT0 = bit 0).

@@ -18,7 +18,8 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
-use tmclsim_server::{Endpoints, LinkFaults, ServerConfig, ServerHandle, SharedBus};
+use tmclsim_host::{LinkFaults, SharedBus};
+use tmclsim_server::{Endpoints, ServerConfig, ServerHandle};
 
 /// An endpoint argument: `True` (the default place), `False`/`None` (off),
 /// or an address / path.

@@ -5,36 +5,13 @@ use crate::errors::{tmcl_error, value_error};
 use pyo3::prelude::*;
 use pyo3::types::{PyInt, PySequence, PyString};
 use std::borrow::Cow;
-use tmclsim_firmware::module::{Compare, error_flag};
-use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Status, checksum, mnemonic, opcode};
+use tmclsim_firmware::module::Compare;
+use tmclsim_protocol::{FRAME_LEN, Instruction as Ins, Status, checksum, mnemonic};
 
-/// What kind of frame a reply is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ReplyKind {
-    /// `[host][module][status][opcode][value][checksum]`.
-    Normal,
-    /// 136 type 0: the host address and eight characters, no checksum.
-    Version,
-    /// 134: the host address and the stored instruction.
-    Memory,
-}
-
-impl ReplyKind {
-    /// How to read the reply `frame` to the request `ins` sent to `address`.
-    pub fn of(ins: Ins, address: u8, frame: &[u8; FRAME_LEN]) -> ReplyKind {
-        match ins.opcode {
-            opcode::FIRMWARE_VERSION if ins.kind == 0 => ReplyKind::Version,
-            opcode::READ_MEMORY => {
-                // An error answer to 134 is a normal reply; a memory word
-                // that looks exactly like one cannot be told apart.
-                let normal_error =
-                    frame[1] == address && frame[3] == opcode::READ_MEMORY && frame[2] < 100 && checksum(&frame[..8]) == frame[8];
-                if normal_error { ReplyKind::Normal } else { ReplyKind::Memory }
-            }
-            _ => ReplyKind::Normal,
-        }
-    }
-}
+/// What kind of frame a reply is: a normal reply, the version text of 136
+/// type 0, or the stored word of 134 (told apart from an error reply as
+/// every host of tmclsim tells it).
+pub use tmclsim_host::reply::Shape as ReplyKind;
 
 /// A module's answer to one command.
 ///
@@ -414,14 +391,7 @@ impl Registers {
     /// The set error flags by name: "ETO", "EAL", "EDV", "EPO", "ESD".
     #[getter]
     fn error_flags(&self) -> Vec<&'static str> {
-        let names = [
-            (error_flag::TIMEOUT, "ETO"),
-            (error_flag::ALARM, "EAL"),
-            (error_flag::DEVIATION, "EDV"),
-            (error_flag::POSITION, "EPO"),
-            (error_flag::SHUTDOWN, "ESD"),
-        ];
-        names.iter().filter(|(bit, _)| self.errors & bit != 0).map(|(_, n)| *n).collect()
+        tmclsim_host::observe::error_flag_names(self.errors)
     }
 
     fn __repr__(&self) -> String {

@@ -3,14 +3,15 @@
 //! exactly as the control socket of a served link does.
 
 use tmclsim_firmware::world_command::Addressed;
-use tmclsim_server::{SharedBus, control};
+use tmclsim_host::SharedBus;
+use tmclsim_host::shared::execute;
 
 /// Runs one control line on module `index` of a bus (`@ADDRESS` picks
 /// another module of the same bus). `link …` needs a served link.
 pub fn run(shared: &SharedBus, index: usize, line: &str, served: bool) -> Result<String, String> {
     match line.split_whitespace().next() {
         Some("link") if !served => Err("link faults need a link: serve the module and use the server's world() or link_faults()".into()),
-        Some("link") | Some("help") | None => control::execute(shared, line),
+        Some("link") | Some("help") | None => execute(shared, line),
         Some(_) => {
             let Addressed { address, command } = Addressed::parse(line)?;
             match address {

@@ -412,9 +412,7 @@ impl Quantity {
                 let number = match mnemonic::parse_number(&name) {
                     Some(n) => u8::try_from(n).ok().filter(|n| profile.axis_parameter(*n).is_some()),
                     // The manual's name, or the console's (`actual_position`).
-                    None => profile.axis_parameter_named(&name).map(|p| p.number).or_else(|| {
-                        tmclsim_host::names::find(profile, tmclsim_host::names::Table::Axis, &name, None).map(|(_, p)| p.number)
-                    }),
+                    None => tmclsim_host::names::find(profile, tmclsim_host::names::Table::Axis, &name, None).map(|(_, p)| p.number),
                 };
                 let names = profile.axis_parameters().map(|p| p.name.as_str());
                 let number = number.ok_or_else(|| {
@@ -426,13 +424,16 @@ impl Quantity {
                 let (name, bank) = split(rest);
                 let name = name.join(" ");
                 let number = mnemonic::parse_number(&name);
-                let found = (0..=3u8).flat_map(|b| profile.global_parameters(b).map(move |p| (b, p))).find(|(b, p)| match number {
-                    Some(n) => i64::from(p.number) == n && bank.is_none_or(|x| x == i64::from(*b)),
-                    None => {
-                        (p.name.eq_ignore_ascii_case(&name) || tmclsim_host::names::snake(&p.name) == tmclsim_host::names::snake(&name))
-                            && bank.is_none_or(|x| x == i64::from(*b))
-                    }
-                });
+                let found = match number {
+                    Some(n) => (0..=3u8)
+                        .flat_map(|b| profile.global_parameters(b).map(move |p| (b, p)))
+                        .find(|(b, p)| i64::from(p.number) == n && bank.is_none_or(|x| x == i64::from(*b))),
+                    // The manual's name, or the console's (`tmcl_tick_timer`).
+                    None => match bank.map(u8::try_from).transpose() {
+                        Ok(bank) => tmclsim_host::names::find(profile, tmclsim_host::names::Table::Global, &name, bank),
+                        Err(_) => None,
+                    },
+                };
                 let names = (0..=3u8).flat_map(|b| profile.global_parameters(b).map(|p| p.name.as_str()));
                 match found {
                     Some((bank, p)) => Ok(Quantity::Global { number: p.number, bank }),

@@ -3,6 +3,7 @@
 use crate::SendArgs;
 use crate::client::hex;
 use std::process::ExitCode;
+use tmclsim_host::reply::Shape;
 use tmclsim_protocol::{Reply, Request, Status, mnemonic, opcode};
 
 pub fn run(args: SendArgs) -> Result<ExitCode, String> {
@@ -40,17 +41,17 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
         Err(e) => return Err(e),
     };
     println!("reply:   {}", hex(&reply));
-    if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
-        println!("version: {}", String::from_utf8_lossy(&reply[1..]));
-        return Ok(ExitCode::SUCCESS);
-    }
-    // 134 answers with the stored instruction in place of the module
-    // address, unless it failed.
-    let failed = reply[1] == args.link.address && reply[2] < 100 && reply[3] == opcode::READ_MEMORY;
-    if ins.opcode == opcode::READ_MEMORY && !failed {
-        let stored = tmclsim_protocol::Instruction::from_bytes(reply[1..8].try_into().unwrap());
-        println!("memory:  {}", mnemonic::format(stored));
-        return Ok(ExitCode::SUCCESS);
+    match tmclsim_host::reply::shape(ins, args.link.address, &reply) {
+        Shape::Version => {
+            println!("version: {}", String::from_utf8_lossy(&reply[1..]));
+            return Ok(ExitCode::SUCCESS);
+        }
+        Shape::Memory => {
+            let stored = tmclsim_protocol::Instruction::from_bytes(reply[1..8].try_into().unwrap());
+            println!("memory:  {}", mnemonic::format(stored));
+            return Ok(ExitCode::SUCCESS);
+        }
+        Shape::Normal => {}
     }
     let Some(r) = Reply::decode(&reply) else {
         println!("the reply's checksum is wrong");

@@ -1,10 +1,10 @@
 //! `tmclsim upload`: download a program to any TMCL module, real or
 //! virtual, verify it by reading it back with 134, optionally start it.
 
-use crate::client::hex;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use tmclsim_asm::Program;
+use tmclsim_host::download::{DownloadError, download_and_verify};
 use tmclsim_protocol::{Instruction, Status, opcode};
 
 #[derive(clap::Args)]
@@ -69,35 +69,13 @@ fn upload(args: UploadArgs) -> Result<(), Stop> {
         }
         Ok(())
     };
-    ok(c.request(Instruction::new(opcode::STOP_APPLICATION, 0, 0, 0))?, "stop")?;
-    ok(c.request(Instruction::new(opcode::ENTER_DOWNLOAD, 0, 0, 0))?, "enter download mode")?;
     let mut progress = crate::progress::Progress::new(2 * words.len() as u64, "{bar:40} {pos}/{len} words sent and read back");
-    for (a, w) in words.iter().enumerate() {
-        progress.set(a as u64);
-        let r = c.request(*w)?;
-        if r.status != Status::Loaded.code() {
-            let _ = c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
-            return Err(Stop::Failed(format!("word {a} ({}) was not stored: status {}", tmclsim_protocol::mnemonic::format(*w), r.status)));
-        }
-    }
-    ok(c.request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0))?, "exit download mode")?;
-    // Verify by reading every word back.
-    for (a, w) in words.iter().enumerate() {
-        progress.set((words.len() + a) as u64);
-        let raw = c.exchange(Instruction::new(opcode::READ_MEMORY, 0, 0, a as i32))?;
-        if raw[1] == args.link.address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
-            return Err(Stop::Failed(format!("read-back of word {a}: status {} (code protection?)", raw[2])));
-        }
-        let stored = Instruction::from_bytes(raw[1..8].try_into().unwrap());
-        if stored != *w {
-            return Err(Stop::Failed(format!(
-                "word {a} reads back as {} ({}), not {}",
-                tmclsim_protocol::mnemonic::format(stored),
-                hex(&raw),
-                tmclsim_protocol::mnemonic::format(*w)
-            )));
-        }
-    }
+    let address = args.link.address;
+    let mut request = |ins: Instruction| c.request(ins).map(|r| r.encode());
+    download_and_verify(&mut request, address, &words, &mut |done| progress.set(done as u64)).map_err(|e| match e {
+        DownloadError::Link(e) => Stop::from(e),
+        e => Stop::Failed(e.to_string()),
+    })?;
     progress.finish();
     println!("uploaded and verified {} instructions", words.len());
     if args.autostart {

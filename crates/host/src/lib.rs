@@ -4,9 +4,15 @@
 //! `trace` and the browser IDE.
 
 pub mod client;
+pub mod eeprom_file;
+pub mod eeprom_files;
+pub mod faults;
+pub mod shared;
 pub mod trace;
 
 // Without I/O, so that the playground has them too.
-pub use tmclsim_ide::{line, names, reply};
+pub use tmclsim_ide::{download, line, names, observe, reply};
 
 pub use client::{Client, hex};
+pub use faults::LinkFaults;
+pub use shared::{SharedBus, Stats};

@@ -6,12 +6,16 @@
 //!
 //! A host's words for TMCL are here too, shared with `tmclsim-host`:
 //! parameter names ([`names`]), direct-mode lines with names ([`line`]),
-//! replies in words ([`reply`]).
+//! replies in words ([`reply`]), a program's download with its
+//! verification ([`download`]), and what an observer reads off a virtual
+//! module ([`observe`]).
 
 pub mod answers;
+pub mod download;
 pub mod line;
 pub mod live;
 pub mod names;
+pub mod observe;
 pub mod profile_json;
 pub mod program;
 pub mod reply;

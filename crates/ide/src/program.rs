@@ -4,6 +4,7 @@
 //! variables, and what only a virtual module can add).
 
 use crate::answers::entry;
+use crate::download::DownloadError;
 use crate::target::{Target, TargetError, check};
 use serde_json::{Value, json};
 use tmclsim_asm::{MemoryResolver, Program};
@@ -51,41 +52,24 @@ pub fn assemble_json(source: &str, profile: Option<&Profile>) -> Value {
     }
 }
 
-/// Downloads the words and verifies them by reading them back, reporting
-/// progress (`{"progress": n, "total": n}`) to `progress`.
+/// Downloads the words and verifies them by reading them back
+/// ([`crate::download`]), reporting progress (`{"progress": n, "total": n}`)
+/// to `progress` every eight words.
 pub fn download_words(target: &dyn Target, id: usize, words: &[Instruction], progress: &mut dyn FnMut(Value)) -> Result<(), TargetError> {
-    let t = target;
-    let total = 2 * words.len();
-    t.halt(id);
-    check(&t.request(id, Instruction::new(opcode::STOP_APPLICATION, 0, 0, 0))?)?;
-    check(&t.request(id, Instruction::new(opcode::ENTER_DOWNLOAD, 0, 0, 0))?)?;
-    for (a, w) in words.iter().enumerate() {
-        let r = t.request(id, *w)?;
-        if r[2] != Status::Loaded.code() {
-            let _ = t.request(id, Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
-            return Err(TargetError::Failed(format!("word {a} was not stored: status {} ({})", r[2], crate::target::status_text(r[2]))));
-        }
-        if a % 8 == 7 || a + 1 == words.len() {
-            progress(json!({"progress": a + 1, "total": total}));
-        }
-    }
-    check(&t.request(id, Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0))?)?;
     let address = entry(target, id)?.address;
-    for (a, w) in words.iter().enumerate() {
-        let raw = t.request(id, Instruction::new(opcode::READ_MEMORY, 0, 0, a as i32))?;
-        if raw[1] == address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
-            return Err(TargetError::Failed(format!("reading back word {a}: status {} (code protection?)", raw[2])));
+    let (len, total) = (words.len(), 2 * words.len());
+    target.halt(id);
+    let mut request = |ins: Instruction| target.request(id, ins);
+    let mut report = |done: usize| {
+        let k = if done > len { done - len } else { done };
+        if k % 8 == 0 || k == len {
+            progress(json!({"progress": done, "total": total}));
         }
-        let stored = Instruction::from_bytes(raw[1..8].try_into().expect("seven bytes"));
-        if stored != *w {
-            let f = tmclsim_protocol::mnemonic::format;
-            return Err(TargetError::Failed(format!("word {a} reads back as {}, not {}", f(stored), f(*w))));
-        }
-        if a % 8 == 7 || a + 1 == words.len() {
-            progress(json!({"progress": words.len() + a + 1, "total": total}));
-        }
-    }
-    Ok(())
+    };
+    crate::download::download_and_verify(&mut request, address, words, &mut report).map_err(|e| match e {
+        DownloadError::Link(e) => e,
+        e => TargetError::Failed(e.to_string()),
+    })
 }
 
 /// The last line of a download's answer: done and verified, or the error.
@@ -106,14 +90,14 @@ pub fn read_program(target: &dyn Target, id: usize) -> Result<Vec<Instruction>, 
     let mut all = Vec::new();
     for a in 0..i32::from(words) {
         let raw = target.request(id, Instruction::new(opcode::READ_MEMORY, 0, 0, a))?;
-        if raw[1] == address && raw[2] < 100 && raw[3] == opcode::READ_MEMORY {
+        match crate::reply::memory_word(&raw, address) {
+            Ok(word) => all.push(word),
             // Past the memory's end (status 4), or code protection.
-            if a > 0 && raw[2] == Status::InvalidValue.code() {
-                break;
+            Err(status) if a > 0 && status == Status::InvalidValue.code() => break,
+            Err(status) => {
+                return Err(TargetError::Failed(format!("reading word {a}: status {status} ({})", crate::target::status_text(status))));
             }
-            return Err(TargetError::Failed(format!("reading word {a}: status {} ({})", raw[2], crate::target::status_text(raw[2]))));
         }
-        all.push(Instruction::from_bytes(raw[1..8].try_into().expect("seven bytes")));
     }
     let end = all.iter().rposition(|w| *w != Instruction::default()).map_or(0, |p| p + 1);
     all.truncate(end);
@@ -166,12 +150,7 @@ pub fn state_of(target: &dyn Target, id: usize) -> Result<Value, TargetError> {
             0 => "EQ ZE",
             _ => "GT",
         }];
-        use tmclsim_firmware::module::error_flag as e;
-        for (bit, name) in [(e::TIMEOUT, "ETO"), (e::ALARM, "EAL"), (e::DEVIATION, "EDV"), (e::POSITION, "EPO"), (e::SHUTDOWN, "ESD")] {
-            if p.errors & bit != 0 {
-                f.push(name);
-            }
-        }
+        f.extend(crate::observe::error_flag_names(p.errors));
         f.join(" ")
     });
     Ok(json!({

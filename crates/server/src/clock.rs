@@ -2,12 +2,16 @@
 //! ([`Bus::next_deadline`](tmclsim_firmware::Bus::next_deadline)), never on
 //! a polling period.
 
-use crate::shared::SharedBus;
+use crate::SharedBus;
 use std::sync::Arc;
-use tokio::sync::watch;
+use tokio::sync::{Notify, watch};
 use tokio::time::Instant;
 
 pub(crate) async fn run(bus: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
+    // Woken whenever something changed the bus's plans.
+    let changed = Arc::new(Notify::new());
+    let notify = changed.clone();
+    bus.set_waker(move || notify.notify_one());
     loop {
         let due = bus.tick();
         let at = due.and_then(|ns| bus.instant_of(ns));
@@ -23,7 +27,7 @@ pub(crate) async fn run(bus: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
                     bus.record_wakeup(std::time::Instant::now().saturating_duration_since(at).as_nanos() as u64);
                 }
             }
-            _ = bus.changed() => {}
+            _ = changed.notified() => {}
             _ = stop.changed() => return,
         }
     }

@@ -2,18 +2,18 @@
 //! module while it runs (docs/world.md lists the commands).
 
 use crate::ServerConfig;
-use crate::faults::LinkFaults;
-use crate::shared::SharedBus;
+use crate::SharedBus;
 use crate::slots::{Activity, Slots, accept};
 use std::sync::Arc;
-use std::time::Duration;
-use tmclsim_firmware::world_command::{Addressed, on_off};
 use tmclsim_protocol::preamble::{Preamble, Verdict};
 use tokio::io::{AsyncBufRead, AsyncBufReadExt, AsyncRead, AsyncReadExt, AsyncWriteExt, BufReader};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::watch;
 
 pub use tmclsim_firmware::world_command::HELP;
+/// A control line on a bus (the bus's own: the Python package runs lines
+/// there too).
+pub use tmclsim_host::shared::execute;
 
 /// Serves the control socket: at most `config.control_max_connections`
 /// clients at once (docs/robustness.md), each line at most
@@ -198,37 +198,4 @@ async fn skip_line(r: &mut (impl AsyncBufRead + Unpin)) -> std::io::Result<()> {
             }
         }
     }
-}
-
-/// Executes one control line (`[@ADDRESS] COMMAND …`, docs/world.md);
-/// `Ok` carries what to print after `ok`. `link …` changes the link's
-/// faults; everything else is a typed world command applied through the
-/// bus to the addressed module (the first one without `@ADDRESS`).
-pub fn execute(bus: &SharedBus, line: &str) -> Result<String, String> {
-    let mut w = line.split_whitespace();
-    match w.next() {
-        None => return Ok(String::new()),
-        Some("help") => return Ok(HELP.to_string()),
-        Some("link") => {
-            let mut f: LinkFaults = bus.link_faults();
-            match w.next() {
-                Some("drop") => f.drop = num(w.next(), "count")?,
-                Some("corrupt") => f.corrupt = num(w.next(), "count")?,
-                Some("delay") => f.delay = Duration::from_millis(num(w.next(), "delay in ms")?),
-                Some("mute") => f.mute = on_off(w.next())?,
-                Some("clear") => f = LinkFaults::default(),
-                other => return Err(format!("link {}: use drop, corrupt, delay, mute or clear", other.unwrap_or(""))),
-            }
-            bus.set_link_faults(f);
-            return Ok(String::new());
-        }
-        Some(_) => {}
-    }
-    let Addressed { address, command } = Addressed::parse(line)?;
-    bus.apply_world(address, &command)
-}
-
-fn num<T: std::str::FromStr>(w: Option<&str>, what: &str) -> Result<T, String> {
-    let w = w.ok_or_else(|| format!("{what} is missing"))?;
-    w.parse().map_err(|_| format!("'{w}' is not a valid {what}"))
 }

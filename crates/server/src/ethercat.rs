@@ -3,7 +3,6 @@
 //! the same interface, as from the last slave of a line.
 
 use crate::eeprom_file::EepromFile;
-use crate::eeprom_files::EepromFiles;
 use std::collections::BTreeMap;
 use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -11,6 +10,7 @@ use std::sync::mpsc;
 use std::sync::{Arc, Mutex};
 use tmclsim_ethercat::Segment;
 use tmclsim_firmware::Eeprom;
+use tmclsim_host::eeprom_files::EepromFiles;
 
 const ETH_P_ALL: u16 = 0x0003;
 const PACKET_OUTGOING: u8 = 4;

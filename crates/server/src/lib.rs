@@ -15,23 +15,21 @@
 
 mod clock;
 pub mod control;
-pub mod eeprom_file;
-mod eeprom_files;
 pub mod ethercat;
-mod faults;
 pub mod files;
 pub mod frame_log;
 mod link;
 mod pty;
-mod shared;
 mod slcan;
 mod slots;
 pub mod sources;
 mod tcp;
 
-pub use faults::LinkFaults;
-pub use shared::{SharedBus, Stats};
+// The bus a link serves and its EEPROM files are the host crate's (the
+// Python package drives them without a server).
 pub use slots::ACCEPT_BACKOFF;
+pub use tmclsim_host::eeprom_file;
+pub use tmclsim_host::{LinkFaults, SharedBus, Stats};
 
 use eeprom_file::EepromFile;
 use std::net::SocketAddr;
@@ -169,8 +167,8 @@ impl ServerHandle {
     }
 
     /// Frames handled and real-time deadlines missed, over all links.
-    pub fn stats(&self) -> shared::Stats {
-        self.links.iter().fold(shared::Stats::default(), |acc, l| acc.merged(l.bus.stats()))
+    pub fn stats(&self) -> Stats {
+        self.links.iter().fold(Stats::default(), |acc, l| acc.merged(l.bus.stats()))
     }
 
     /// Stops serving, closes the links and removes the pty symlinks.

@@ -1,12 +1,13 @@
 //! One byte-stream link (a TCP connection or the pty): framing, the
 //! module's answer, replies and events written back in order.
 
-use crate::shared::SharedBus;
+use crate::SharedBus;
 use crate::slots::Activity;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::ascii::LineState;
+use tmclsim_host::shared::EventSink;
 use tmclsim_protocol::FRAME_LEN;
 use tmclsim_protocol::preamble::{Preamble, Verdict};
 use tmclsim_protocol::serial::FrameAssembler;
@@ -110,6 +111,9 @@ where
     let mut preamble = options.network.map(|_| Preamble::new());
     let mut bad_frames = 0u32;
     let (events_tx, mut events) = mpsc::unbounded_channel::<[u8; FRAME_LEN]>();
+    let sink: EventSink = Arc::new(move |event| {
+        let _ = events_tx.send(event);
+    });
     let start = Instant::now();
     let mut assembler = FrameAssembler::new(options.inter_byte_timeout.as_nanos() as u64);
     let log = |direction: crate::frame_log::Direction, frame: &[u8; FRAME_LEN]| {
@@ -155,7 +159,7 @@ where
                     bad_frames = if checksum_ok { 0 } else { bad_frames + 1 };
                     activity.touch();
                     log(crate::frame_log::Direction::In, &frame);
-                    let (replies, pause) = bus.handle(link, &events_tx, &frame);
+                    let (replies, pause) = bus.handle(link, &sink, &frame);
                     for reply in replies {
                         let (reply, fault_delay) = bus.outgoing(reply);
                         let delay = pause + fault_delay;

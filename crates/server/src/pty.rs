@@ -11,7 +11,7 @@
 //! when the claim ends, but only while it still points to this pty.
 
 use crate::ServerConfig;
-use crate::shared::SharedBus;
+use crate::SharedBus;
 use std::io;
 use std::io::{Read, Write};
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd, RawFd};

@@ -2,10 +2,11 @@
 //! modules on its CAN bus: python-can's `slcan` interface and PyTrinamic's
 //! `slcan_tmcl` connection open it like a CANable or a Lawicel CANUSB.
 
+use crate::SharedBus;
 use crate::pty::Pty;
-use crate::shared::SharedBus;
 use std::sync::Arc;
 use tmclsim_firmware::can::CanFrame;
+use tmclsim_host::shared::EventSink;
 use tmclsim_protocol::slcan::{self, SlcanCommand};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::sync::{mpsc, watch};
@@ -24,6 +25,9 @@ pub(crate) async fn run(pty: Pty, bus: Arc<SharedBus>, mut stop: watch::Receiver
     let (mut reader, mut writer) = (master.clone(), master);
     let link = crate::link::next_link_id();
     let (events_tx, mut events) = mpsc::unbounded_channel::<[u8; 9]>();
+    let sink: EventSink = Arc::new(move |event| {
+        let _ = events_tx.send(event);
+    });
     let mut open = false;
     let mut line = Vec::with_capacity(MAX_LINE);
     let mut buf = [0u8; 256];
@@ -43,7 +47,7 @@ pub(crate) async fn run(pty: Pty, bus: Arc<SharedBus>, mut stop: watch::Receiver
                         b'\r' => {
                             let text = String::from_utf8_lossy(&line).into_owned();
                             line.clear();
-                            command(&text, &mut open, &bus, link, &events_tx, &mut out);
+                            command(&text, &mut open, &bus, link, &sink, &mut out);
                         }
                         b'\n' => {}
                         _ if line.len() < MAX_LINE => line.push(b),
@@ -67,7 +71,7 @@ pub(crate) async fn run(pty: Pty, bus: Arc<SharedBus>, mut stop: watch::Receiver
 
 /// One line from the host; the adapter's answer and any received frames
 /// are appended to `out`.
-fn command(text: &str, open: &mut bool, bus: &SharedBus, link: u64, events: &mpsc::UnboundedSender<[u8; 9]>, out: &mut String) {
+fn command(text: &str, open: &mut bool, bus: &SharedBus, link: u64, events: &EventSink, out: &mut String) {
     const OK: &str = "\r";
     const ERROR: &str = "\x07";
     match slcan::parse(text) {

@@ -1,7 +1,7 @@
 //! TCP: every connection is a link of its own to the same module.
 
 use crate::ServerConfig;
-use crate::shared::SharedBus;
+use crate::SharedBus;
 use crate::slots::{Activity, Slots, accept};
 use std::sync::Arc;
 use tokio::net::TcpListener;

@@ -8,6 +8,7 @@ use tmclsim_firmware::bus::Bus;
 use tmclsim_firmware::program::RunMode;
 use tmclsim_firmware::world_command::{Addressed, HELP};
 use tmclsim_firmware::{Eeprom, Module, Profile, World};
+use tmclsim_ide::reply::Shape;
 use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Request, Status, mnemonic, opcode};
 
 /// How many 138 events are kept until they are taken; older ones are
@@ -341,17 +342,17 @@ impl Sim {
 /// The reply `raw` to `ins` from the module at `address`.
 fn answer_of(ins: Instruction, raw: &[u8; FRAME_LEN], address: u8) -> Answer {
     let ok = Status::Ok.code();
-    if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
+    match tmclsim_ide::reply::shape(ins, address, raw) {
         // The host address and eight characters, no checksum.
-        return Answer { status: ok, value: 0, text: Some(String::from_utf8_lossy(&raw[1..]).into_owned()) };
+        Shape::Version => return Answer { status: ok, value: 0, text: Some(String::from_utf8_lossy(&raw[1..]).into_owned()) },
+        // The stored word in place of the module address.
+        Shape::Memory => {
+            let stored = Instruction::from_bytes(raw[1..8].try_into().expect("seven bytes"));
+            return Answer { status: ok, value: stored.value, text: Some(mnemonic::format(stored)) };
+        }
+        Shape::Normal => {}
     }
     let reply = Reply::decode(raw);
-    let normal_error = reply.is_some_and(|r| r.module == address && r.status < 100 && r.opcode == ins.opcode);
-    if ins.opcode == opcode::READ_MEMORY && !normal_error {
-        // The stored word in place of the module address.
-        let stored = Instruction::from_bytes(raw[1..8].try_into().expect("seven bytes"));
-        return Answer { status: ok, value: stored.value, text: Some(mnemonic::format(stored)) };
-    }
     match reply {
         Some(r) => {
             let text = (r.status < 100).then(|| Status::from_code(r.status).map_or("unknown status", Status::describe).to_string());

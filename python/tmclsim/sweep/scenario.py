@@ -122,15 +122,16 @@ def files(mx: Matrix, index: int) -> Dict[str, str]:
 
 
 def _number(m, kind: str, what: Any, index: int) -> int:
-    """A parameter's number from its number or its name."""
+    """A parameter's number from its number or its name, as the module
+    looks names up."""
     if isinstance(what, int):
         return what
-    rows = m.axis_parameters() if kind == "ap" else m.global_parameters(index)
-    w = str(what).lower().replace(" ", "_")
-    for r in rows:
-        if r["snake_name"] == w or r["name"].lower() == str(what).lower():
-            return r["number"]
-    raise ScenarioError(f"the {m.profile} has no {'axis' if kind == 'ap' else 'global'} parameter '{what}'")
+    try:
+        if kind == "ap":
+            return m._axis_number(str(what))
+        return m._global_number(str(what), index)[1]
+    except ValueError as e:
+        raise ScenarioError(str(e)) from None
 
 
 def setup_lines(m, mx: Matrix, values: Dict[str, Any]) -> List[str]:
@@ -146,10 +147,13 @@ def setup_lines(m, mx: Matrix, values: Dict[str, Any]) -> List[str]:
     return lines
 
 
-def _is_207(r: Read) -> bool:
+def _is_207(m, r: Read) -> bool:
     if isinstance(r.what, int):
         return r.what == 207
-    return str(r.what).lower().replace(" ", "_") == "extended_error_flags"
+    try:
+        return m._axis_number(str(r.what)) == 207
+    except ValueError:
+        return False
 
 
 def read(m, r: Read) -> int:
@@ -159,7 +163,7 @@ def read(m, r: Read) -> int:
     if r.kind == "var":
         return m.get_global_parameter(r.what, 2)
     if r.kind == "ap":
-        if _is_207(r):
+        if _is_207(m, r):
             return m.error_flags(r.index)
         return m.get_axis_parameter(r.what, r.index)
     return m.get_global_parameter(r.what, r.index)
@@ -193,7 +197,7 @@ def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, An
         m.load_program(tmclsim.Program.from_binary(programs[profile]))
         for line in lines:
             r = m.send(line)
-            if r is None or r.status < 100:
+            if r is None or not r.ok:
                 raise ScenarioError(f"'{line}' answered {'nothing' if r is None else f'status {r.status} ({r.description})'}")
         for r in reads:
             # A value the module does not have is the scenario's error,

@@ -206,7 +206,7 @@ impl Session {
         for table in [names::Table::Axis, names::Table::Global] {
             for (bank, p) in names::parameters(profile, table) {
                 let number = mnemonic::parse_number(topic);
-                if number.map_or_else(|| names::snake(&p.name) == names::snake(topic), |n| n == i64::from(p.number)) {
+                if number.map_or_else(|| names::key(&p.name) == names::key(topic), |n| n == i64::from(p.number)) {
                     let which = if table == names::Table::Axis { "AP".to_string() } else { format!("GP bank {bank}:") };
                     found.push(format!(
                         "{which} {} {} ({}): access {}, {}…{}, default {}{}",

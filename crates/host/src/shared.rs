@@ -1,7 +1,12 @@
-//! A [`Bus`] shared by the connections of a link, its clock task, its
-//! control socket and any in-process user (the Python package): the bus
-//! behind a lock, plus what only a server has — EEPROM files, the link
-//! that receives events, link faults and counters.
+//! A [`Bus`] shared by everyone who drives it: the Python package's
+//! modules in process, and while they are served, the connections of a
+//! link, its clock task and its control socket. The bus behind a lock,
+//! with the EEPROM files of its modules (a write a file does not take is
+//! answered with status 5, docs/behaviour.md rule 82), the events no link
+//! has received yet, and what a served link adds: the link that receives
+//! events, link faults and counters. No I/O but the EEPROM files and no
+//! async runtime: a server wakes its clock task through
+//! [`SharedBus::set_waker`].
 
 use crate::eeprom_file::EepromFile;
 use crate::eeprom_files::EepromFiles;
@@ -9,13 +14,15 @@ use crate::faults::LinkFaults;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::can::CanFrame;
-use tmclsim_firmware::world_command::WorldCommand;
+use tmclsim_firmware::world_command::{Addressed, HELP, WorldCommand, on_off};
 use tmclsim_firmware::{Bus, Module};
 use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Status};
-use tokio::sync::{Notify, mpsc};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
-type EventSink = mpsc::UnboundedSender<[u8; FRAME_LEN]>;
+pub type EventSink = Arc<dyn Fn([u8; FRAME_LEN]) + Send + Sync>;
+
+/// What wakes a server's clock task when the bus's plans changed.
+type Waker = Arc<dyn Fn() + Send + Sync>;
 
 /// Events kept for an in-process reader while no link has spoken.
 const UNCLAIMED_EVENTS: usize = 1024;
@@ -59,7 +66,7 @@ impl Stats {
 pub struct SharedBus {
     stats: Mutex<Stats>,
     state: Mutex<State>,
-    changed: Notify,
+    waker: Mutex<Option<Waker>>,
     faults: Mutex<LinkFaults>,
     /// Some module of the link is in ASCII mode.
     ascii: std::sync::atomic::AtomicBool,
@@ -74,7 +81,7 @@ impl SharedBus {
         let shared = SharedBus {
             stats: Mutex::new(Stats::default()),
             state: Mutex::new(State { bus, eeproms, sink: None, unclaimed: Vec::new(), scheduled: None }),
-            changed: Notify::new(),
+            waker: Mutex::new(None),
             faults: Mutex::new(LinkFaults::default()),
             ascii: std::sync::atomic::AtomicBool::new(false),
         };
@@ -109,8 +116,22 @@ impl SharedBus {
         *self.stats.lock().unwrap_or_else(|p| p.into_inner())
     }
 
+    /// `wake` is called whenever something changed the bus's plans (a
+    /// request, an advance, the clock switched): a server's clock task
+    /// waits for it. It replaces the one set before.
+    pub fn set_waker(&self, wake: impl Fn() + Send + Sync + 'static) {
+        *self.waker.lock().unwrap_or_else(|p| p.into_inner()) = Some(Arc::new(wake));
+    }
+
+    fn wake(&self) {
+        let waker = self.waker.lock().unwrap_or_else(|p| p.into_inner()).clone();
+        if let Some(wake) = waker {
+            wake();
+        }
+    }
+
     /// The clock woke `late_ns` after a due time.
-    pub(crate) fn record_wakeup(&self, late_ns: u64) {
+    pub fn record_wakeup(&self, late_ns: u64) {
         let mut s = self.stats.lock().unwrap_or_else(|p| p.into_inner());
         s.wakeups += 1;
         if late_ns > 1_000_000 {
@@ -139,7 +160,7 @@ impl SharedBus {
 
     /// Passes an outgoing frame through the link faults: `None` drops it;
     /// the duration is an extra delay.
-    pub(crate) fn outgoing(&self, frame: [u8; FRAME_LEN]) -> (Option<[u8; FRAME_LEN]>, Duration) {
+    pub fn outgoing(&self, frame: [u8; FRAME_LEN]) -> (Option<[u8; FRAME_LEN]>, Duration) {
         let mut f = self.faults.lock().unwrap_or_else(|p| p.into_inner());
         let delay = f.delay;
         (f.apply(frame), delay)
@@ -160,7 +181,7 @@ impl SharedBus {
     /// where the modules are.
     pub fn set_stepped(&self, stepped: bool) {
         self.with_bus(|bus| bus.set_stepped(stepped));
-        self.changed.notify_one();
+        self.wake();
     }
 
     pub fn is_stepped(&self) -> bool {
@@ -171,7 +192,7 @@ impl SharedBus {
     /// they become due).
     pub fn advance(&self, dt_ns: u64) {
         self.with_bus(|bus| bus.advance(dt_ns));
-        self.changed.notify_one();
+        self.wake();
     }
 
     /// Runs `f` on the bus, brought up to the clock's now; then carries out
@@ -191,7 +212,7 @@ impl SharedBus {
         let failed = Self::after_change(&mut s);
         self.update_ascii(&s);
         drop(s);
-        self.changed.notify_one();
+        self.wake();
         (r, written.iter().any(|i| failed.contains(i)))
     }
 
@@ -233,7 +254,7 @@ impl SharedBus {
 
     /// Handles one frame from link `link`, whose events go to `sink`.
     /// Returns the replies and how long to wait before sending them.
-    pub(crate) fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
+    pub fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
         self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
         // The addressed modules first catch up on their own, so that what
@@ -251,7 +272,7 @@ impl SharedBus {
     }
 
     /// Handles a CAN frame: every module sees it, those it is for answer.
-    pub(crate) fn handle_can(&self, link: u64, sink: &EventSink, frame: &CanFrame) -> Vec<CanFrame> {
+    pub fn handle_can(&self, link: u64, sink: &EventSink, frame: &CanFrame) -> Vec<CanFrame> {
         self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
         let mut s = self.lock();
         let before = Self::generations(&mut s, Bus::catch_up);
@@ -288,7 +309,7 @@ impl SharedBus {
     }
 
     /// Link `link` is gone (docs/behaviour.md rule 91).
-    pub(crate) fn link_closed(&self, link: u64) {
+    pub fn link_closed(&self, link: u64) {
         self.lock().bus.link_closed(link);
     }
 
@@ -329,7 +350,7 @@ impl SharedBus {
 
     /// One byte of text for the modules in ASCII mode from a link whose
     /// lines are `lines`; echoes and replies are appended to `out`.
-    pub(crate) fn ascii_byte(&self, lines: &mut tmclsim_firmware::ascii::LineState, byte: u8, out: &mut Vec<u8>) {
+    pub fn ascii_byte(&self, lines: &mut tmclsim_firmware::ascii::LineState, byte: u8, out: &mut Vec<u8>) {
         let mut s = self.lock();
         s.bus.ascii_byte(lines, byte, out);
         Self::after_change(&mut s);
@@ -352,13 +373,13 @@ impl SharedBus {
         let wake = due.is_some_and(|d| s.scheduled.is_none_or(|sch| d < sch));
         drop(s);
         if wake {
-            self.changed.notify_one();
+            self.wake();
         }
         failed
     }
 
     /// A 138 event (9-byte form) as the CAN frame of the module it is from.
-    pub(crate) fn event_as_can(&self, event: &[u8; FRAME_LEN]) -> Option<CanFrame> {
+    pub fn event_as_can(&self, event: &[u8; FRAME_LEN]) -> Option<CanFrame> {
         let s = self.lock();
         s.bus.index_of(event[1]).map(|i| s.bus.event_as_can(i, event))
     }
@@ -366,18 +387,13 @@ impl SharedBus {
     /// The clock task: brings the bus to now, carries out what became due
     /// and returns the next deadline, remembered so that requests know
     /// whether to wake the task earlier.
-    pub(crate) fn tick(&self) -> Option<u64> {
+    pub fn tick(&self) -> Option<u64> {
         let mut s = self.lock();
         s.bus.catch_up();
         Self::after_change(&mut s);
         let due = s.bus.next_deadline();
         s.scheduled = due;
         due
-    }
-
-    /// Resolves when something changed the bus's plans.
-    pub(crate) async fn changed(&self) {
-        self.changed.notified().await
     }
 
     /// Carries out what changed: events go to the link that spoke last,
@@ -388,15 +404,48 @@ impl SharedBus {
         let effects = s.bus.take_effects();
         for (index, event) in effects.events {
             match &s.sink {
-                Some((_, sink)) => {
-                    let _ = sink.send(event);
-                }
+                Some((_, sink)) => sink(event),
                 None if s.unclaimed.len() < UNCLAIMED_EVENTS => s.unclaimed.push((index, event)),
                 None => {}
             }
         }
         effects.eeprom_written.into_iter().filter(|&index| !s.eeproms.save_from(&mut s.bus, index)).collect()
     }
+}
+
+/// Executes one control line (`[@ADDRESS] COMMAND …`, docs/world.md) on a
+/// bus; `Ok` carries what to print after `ok`. `link …` changes the link's
+/// faults; everything else is a typed world command applied through the
+/// bus to the addressed module (the first one without `@ADDRESS`). The
+/// control socket of a served link and the Python package both run their
+/// lines here.
+pub fn execute(bus: &SharedBus, line: &str) -> Result<String, String> {
+    let mut w = line.split_whitespace();
+    match w.next() {
+        None => return Ok(String::new()),
+        Some("help") => return Ok(HELP.to_string()),
+        Some("link") => {
+            let mut f: LinkFaults = bus.link_faults();
+            match w.next() {
+                Some("drop") => f.drop = num(w.next(), "count")?,
+                Some("corrupt") => f.corrupt = num(w.next(), "count")?,
+                Some("delay") => f.delay = Duration::from_millis(num(w.next(), "delay in ms")?),
+                Some("mute") => f.mute = on_off(w.next())?,
+                Some("clear") => f = LinkFaults::default(),
+                other => return Err(format!("link {}: use drop, corrupt, delay, mute or clear", other.unwrap_or(""))),
+            }
+            bus.set_link_faults(f);
+            return Ok(String::new());
+        }
+        Some(_) => {}
+    }
+    let Addressed { address, command } = Addressed::parse(line)?;
+    bus.apply_world(address, &command)
+}
+
+fn num<T: std::str::FromStr>(w: Option<&str>, what: &str) -> Result<T, String> {
+    let w = w.ok_or_else(|| format!("{what} is missing"))?;
+    w.parse().map_err(|_| format!("'{w}' is not a valid {what}"))
 }
 
 #[cfg(test)]
@@ -439,7 +488,7 @@ mod tests {
         assert_eq!(ask(&bus, opcode::EXIT_DOWNLOAD, 0, 0), (5, opcode::EXIT_DOWNLOAD));
         assert!(bus.with(|m| m.eeprom().program.is_empty()));
         // A link's frame and a CAN frame.
-        let (sink, _events) = mpsc::unbounded_channel();
+        let sink: EventSink = Arc::new(|_| ());
         let (replies, _) = bus.handle(1, &sink, &frame(opcode::STAP, 4, 0));
         let r = Reply::decode(&replies[0]).expect("a valid checksum");
         assert_eq!((r.status, r.opcode), (5, opcode::STAP));
@@ -457,5 +506,46 @@ mod tests {
         let image = crate::eeprom_file::load(&path).unwrap().unwrap();
         assert_eq!((image.axis(0, 4), image.axis(0, 5)), (Some(1000), Some(300)));
         assert!(image.program.is_empty());
+    }
+
+    #[test]
+    fn in_process_without_a_server_events_wait_on_the_bus_and_changes_wake_the_clock() {
+        let bus = SharedBus::new(Bus::single(Module::built_in("tmcm-1141").unwrap()), Vec::new());
+        let woken = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let w = woken.clone();
+        bus.set_waker(move || {
+            w.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        });
+        // 138 type 0 asks for the event at the target; MVP moves there.
+        assert_eq!(ask(&bus, opcode::TARGET_REACHED_EVENT, 0, 1), (100, opcode::TARGET_REACHED_EVENT));
+        assert_eq!(ask(&bus, opcode::MVP, 0, 1000), (100, opcode::MVP));
+        assert!(woken.load(std::sync::atomic::Ordering::Relaxed) >= 2, "each request wakes the clock task");
+        bus.advance(2_000_000_000);
+        let events = bus.take_unclaimed_events(0);
+        assert_eq!(events.len(), 1, "no link spoke: the event waits for an in-process reader");
+        assert!(crate::trace::is_event(&events[0]));
+        assert!(bus.take_unclaimed_events(0).is_empty());
+        // A link that speaks receives the events from then on.
+        let got = Arc::new(Mutex::new(Vec::new()));
+        let g = got.clone();
+        let sink: EventSink = Arc::new(move |e| g.lock().unwrap().push(e));
+        bus.handle(7, &sink, &frame(opcode::TARGET_REACHED_EVENT, 0, 1));
+        bus.handle(7, &sink, &frame(opcode::MVP, 0, 0));
+        bus.advance(2_000_000_000);
+        assert_eq!(got.lock().unwrap().len(), 1);
+        assert!(bus.take_unclaimed_events(0).is_empty());
+    }
+
+    #[test]
+    fn control_lines_change_the_world_and_the_link_faults() {
+        let bus = SharedBus::new(Bus::single(Module::built_in("tmcm-1141").unwrap()), Vec::new());
+        assert_eq!(execute(&bus, ""), Ok(String::new()));
+        assert!(execute(&bus, "help").unwrap().contains("link"));
+        assert_eq!(execute(&bus, "link drop 2"), Ok(String::new()));
+        assert_eq!(bus.link_faults().drop, 2);
+        assert!(execute(&bus, "link frob").unwrap_err().contains("use drop, corrupt"));
+        assert_eq!(execute(&bus, "input 1 1"), Ok(String::new()));
+        assert_eq!(ask(&bus, opcode::GIO, 1, 0).0, 100);
+        assert!(execute(&bus, "@9 input 1 1").is_err(), "no module at address 9");
     }
 }

@@ -1,8 +1,8 @@
 //! The EEPROM files of a bus's modules and the image each file holds:
 //! module `i`'s EEPROM writes are saved to file `i`, and a save that fails
 //! puts the module back to what its file holds (docs/behaviour.md rule
-//! 82). The served links ([`crate::SharedBus`]) and EtherCAT
-//! ([`crate::ethercat`]) both save through it.
+//! 82). The shared bus ([`crate::shared::SharedBus`]) and a server's
+//! EtherCAT segment both save through it.
 
 use crate::eeprom_file::EepromFile;
 use std::sync::Arc;
