@@ -166,8 +166,9 @@ impl Module {
         } else {
             self.axes[m].driver.cool_scale = None;
         }
-        let scale = self.current_scale(m);
-        let margin = self.margin(m, scale, off);
+        // Without a load and with the driver on, the whole torque is
+        // margin whatever the current ([`Module::margin`]).
+        let margin = if self.world.axes[m].loads.is_empty() && !off { 1.0 } else { self.margin(m, self.current_scale(m), off) };
         if self.profile.features.stall_detection == StallDetection::Stallguard2 {
             if moving {
                 self.axes[m].driver.load_value = self.stallguard(m, margin);

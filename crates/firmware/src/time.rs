@@ -269,9 +269,13 @@ impl Module {
             let ramp = self.ramp(motor);
             let x_before = self.axes[motor].motion.x;
             let mut motion = std::mem::take(&mut self.axes[motor].motion);
-            let step = {
+            let step = if self.world.axes[motor].has_switch_positions() {
                 let mut stops = |x: f64| self.stops_at(motor, x);
                 motion.advance(left, &ramp, &mut stops, edges, searching)
+            } else {
+                // The switches read the same everywhere: so do the stops.
+                let fixed = self.stops_at(motor, x_before);
+                motion.advance(left, &ramp, &mut |_| fixed, edges, searching)
             };
             self.axes[motor].motion = motion;
             self.drive(motor, x_before, step.elapsed);
