@@ -35,8 +35,12 @@ impl Module {
         // was has just computed it.
         let mut known = None;
         loop {
-            let timer = self.run_timers();
-            let world = known.take();
+            // After such a batch the timers are as they were too: the time
+            // is the same and no instruction of the batch touches them.
+            let (timer, world) = match known.take() {
+                Some((timer, world)) => (timer, Some(world)),
+                None => (self.run_timers(), None),
+            };
             if self.program.is_running() {
                 if self.program.wait.is_some() {
                     self.check_wait();
@@ -50,7 +54,7 @@ impl Module {
                     // the world's next event.
                     let world = self.world_deadline(timer);
                     if self.run_batch(world.map_or(end, |d| d.min(end))) {
-                        known = Some(world);
+                        known = Some((timer, world));
                     }
                     continue;
                 }
@@ -98,17 +102,18 @@ impl Module {
             self.io.last_inputs = inputs;
         }
         for m in 0..self.axes.len() {
+            let Some(&(pl, pr)) = self.io.last_switches.get(m) else { continue };
             let (l, r, _) = self.switches(m);
-            let (pl, pr) = self.io.last_switches.get(m).copied().unwrap_or((l, r));
+            if (l, r) == (pl, pr) {
+                continue;
+            }
             if l != pl {
                 self.trigger(Source::StopLeft(m as u8), l);
             }
             if r != pr {
                 self.trigger(Source::StopRight(m as u8), r);
             }
-            if let Some(s) = self.io.last_switches.get_mut(m) {
-                *s = (l, r);
-            }
+            self.io.last_switches[m] = (l, r);
         }
     }
 
@@ -215,11 +220,15 @@ impl Module {
     /// Where the switches of an axis change state, in motor coordinates
     /// (at most eight edges): the edges and how many there are.
     fn switch_edges(&self, motor: usize) -> ([f64; 8], usize) {
+        let mut edges = [0.0f64; 8];
+        let world = &self.world.axes[motor];
+        if !world.has_switch_positions() {
+            return (edges, 0);
+        }
         let offset = self.axes[motor].mech_offset;
         let sign = self.shaft_sign();
-        let mut edges = [0.0f64; 8];
         let mut count = 0;
-        for m in self.world.axes[motor].thresholds().take(edges.len()) {
+        for m in world.thresholds().take(edges.len()) {
             edges[count] = (m - offset) * sign;
             count += 1;
         }
