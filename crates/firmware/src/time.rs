@@ -34,11 +34,15 @@ impl Module {
         // The world's next event, when a batch that left the world as it
         // was has just computed it.
         let mut known = None;
+        // The world was found quiet ([`Quiet`]) and only world steps and
+        // batches that left the world as it was came since: it still is.
+        let mut quiet = false;
         loop {
             // After such a batch the timers are as they were too: the time
             // is the same and no instruction of the batch touches them.
             let (timer, world) = match known.take() {
                 Some((timer, world)) => (timer, Some(world)),
+                None if quiet => (None, None),
                 None => (self.run_timers(), None),
             };
             if self.program.is_running() {
@@ -52,9 +56,11 @@ impl Module {
                 if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
                     // Pure instructions run ahead of the world only up to
                     // the world's next event.
-                    let world = self.world_deadline(timer);
+                    let world = self.next_world_event(timer, &mut quiet);
                     if self.run_batch(world.map_or(end, |d| d.min(end))) {
                         known = Some((timer, world));
+                    } else {
+                        quiet = false;
                     }
                     continue;
                 }
@@ -63,10 +69,25 @@ impl Module {
                 break;
             }
             // The next moment something happens on its own.
-            let world = world.unwrap_or_else(|| self.world_deadline(timer));
+            let world = match world {
+                Some(w) => w,
+                None => self.next_world_event(timer, &mut quiet),
+            };
             let t = earliest(world, self.program_deadline()).filter(|&d| d > self.now_ns).map_or(end, |d| d.min(end));
             self.step_world(t);
         }
+    }
+
+    /// [`Module::world_deadline`] while [`Module::advance`] goes on: only
+    /// the heartbeat's while the world is known to be quiet; else worked
+    /// out, and whether the world is quiet found out with it.
+    fn next_world_event(&self, timer: Option<u64>, quiet: &mut bool) -> Option<u64> {
+        if *quiet {
+            return self.heartbeat_deadline();
+        }
+        let (world, q) = self.world_deadline_and_quiet(timer);
+        *quiet = q == Quiet::Yes && timer.is_none();
+        world
     }
 
     /// Moves the motors to `t` and looks at what changed.
@@ -173,12 +194,20 @@ impl Module {
     /// The next event of the world and the interrupt system (everything but
     /// the program's own next instruction or WAIT).
     fn world_deadline(&self, timer: Option<u64>) -> Option<u64> {
+        self.world_deadline_and_quiet(timer).0
+    }
+
+    /// [`Module::world_deadline`], and whether the world is quiet.
+    fn world_deadline_and_quiet(&self, timer: Option<u64>) -> (Option<u64>, Quiet) {
         let mut next = earliest(self.heartbeat_deadline(), timer);
-        if self.driver_watches() {
+        let watches = self.driver_watches();
+        if watches {
             next = earliest(next, Some(self.now_ns + DRIVER_SAMPLE_NS));
         }
         let armed = self.motion_interrupts_armed();
+        let mut quiet = !watches && !armed && !self.has_closed_loop();
         for (motor, axis) in self.axes.iter().enumerate() {
+            quiet &= !axis.notify_on_arrival && axis.rfs.is_none();
             if axis.motion.v == 0.0 && !axis.notify_on_arrival && !armed {
                 continue;
             }
@@ -189,7 +218,7 @@ impl Module {
                 next = earliest(next, self.edge_deadline(motor));
             }
         }
-        next
+        (next, if quiet { Quiet::Yes } else { Quiet::No })
     }
 
     /// When the motor comes to rest, if it moves and will.
@@ -459,26 +488,39 @@ impl Module {
     /// load, stall detection, coolStep, an encoder deviation limit, or a
     /// driver that is off.
     pub(crate) fn driver_watches(&self) -> bool {
-        (0..self.axes.len()).any(|m| {
-            let axis = &self.axes[m];
+        let f = &self.profile.features;
+        let closed_loop = self.has_closed_loop();
+        self.axes.iter().zip(&self.world.axes).enumerate().any(|(m, (axis, world))| {
             let p = &axis.params;
-            let f = &self.profile.features;
+            if closed_loop && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6) {
+                return true;
+            }
             let will_move = axis.motion.v != 0.0
                 || match axis.motion.mode {
                     crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
                     _ => axis.motion.x != axis.motion.target,
                 };
-            let closed_loop = self.has_closed_loop() && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6);
-            closed_loop
-                || will_move
-                    && (!self.world.axes[m].loads.is_empty()
-                        || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
-                        || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
-                        || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
-                        || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
-                        || self.driver_off(m))
+            will_move
+                && (!world.loads.is_empty()
+                    || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
+                    || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
+                    || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
+                    || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
+                    || self.driver_off(m))
         })
     }
+}
+
+/// The world is quiet when its next event can only be the heartbeat's or a
+/// timer's: the driver watches no motor, no interrupt or 138 event waits
+/// for motion, no reference search runs, no closed loop regulates. World
+/// steps keep it quiet (a motor only comes to rest, or stops when the
+/// heartbeat trips), and so do instructions that leave the world as it was
+/// ([`is_pure`], [`observes_only`]); any other instruction may end it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Quiet {
+    Yes,
+    No,
 }
 
 /// Instructions that read the world at their own moment (docs/behaviour.md
