@@ -112,30 +112,39 @@ impl Module {
     /// their bank 3 trigger setting selects.
     fn look_at_inputs(&mut self) {
         let inputs = self.world.digital_inputs;
-        let changed = inputs ^ self.io.last_inputs;
-        if changed != 0 {
-            for n in 0..8u8 {
-                if changed & (1 << n) != 0 {
-                    let rising = inputs & (1 << n) != 0;
-                    self.trigger(Source::InputChange(n), rising);
-                }
-            }
-            self.io.last_inputs = inputs;
+        if inputs != self.io.last_inputs {
+            self.inputs_changed(inputs);
         }
-        for m in 0..self.axes.len() {
-            let Some(&(pl, pr)) = self.io.last_switches.get(m) else { continue };
+        for m in 0..self.axes.len().min(self.io.last_switches.len()) {
             let (l, r, _) = self.switches(m);
-            if (l, r) == (pl, pr) {
-                continue;
+            if (l, r) != self.io.last_switches[m] {
+                self.switches_changed(m, (l, r));
             }
-            if l != pl {
-                self.trigger(Source::StopLeft(m as u8), l);
-            }
-            if r != pr {
-                self.trigger(Source::StopRight(m as u8), r);
-            }
-            self.io.last_switches[m] = (l, r);
         }
+    }
+
+    #[inline(never)]
+    fn inputs_changed(&mut self, inputs: u32) {
+        let changed = inputs ^ self.io.last_inputs;
+        for n in 0..8u8 {
+            if changed & (1 << n) != 0 {
+                let rising = inputs & (1 << n) != 0;
+                self.trigger(Source::InputChange(n), rising);
+            }
+        }
+        self.io.last_inputs = inputs;
+    }
+
+    #[inline(never)]
+    fn switches_changed(&mut self, m: usize, (l, r): (bool, bool)) {
+        let (pl, pr) = self.io.last_switches[m];
+        if l != pl {
+            self.trigger(Source::StopLeft(m as u8), l);
+        }
+        if r != pr {
+            self.trigger(Source::StopRight(m as u8), r);
+        }
+        self.io.last_switches[m] = (l, r);
     }
 
     /// An edge on an input: raise its interrupt if bank 3 selects the edge
