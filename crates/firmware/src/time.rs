@@ -37,6 +37,12 @@ impl Module {
         // The world was found quiet ([`Quiet`]) and only world steps and
         // batches that left the world as it was came since: it still is.
         let mut quiet = false;
+        // The inputs and switches read as at the last look: they do not
+        // depend on where the carriages are (the world itself does not
+        // change while time advances), and only world steps and batches
+        // that left the world as it was came since.
+        let fixed_switches = self.world.axes.iter().all(|w| !w.has_switch_positions());
+        let mut as_seen = fixed_switches;
         loop {
             // After such a batch the timers are as they were too: the time
             // is the same and no instruction of the batch touches them.
@@ -61,6 +67,7 @@ impl Module {
                         known = Some((timer, world));
                     } else {
                         quiet = false;
+                        as_seen = false;
                     }
                     continue;
                 }
@@ -74,7 +81,8 @@ impl Module {
                 None => self.next_world_event(timer, &mut quiet),
             };
             let t = earliest(world, self.program_deadline()).filter(|&d| d > self.now_ns).map_or(end, |d| d.min(end));
-            self.step_world(t);
+            self.step_world(t, !as_seen);
+            as_seen = fixed_switches;
         }
     }
 
@@ -90,8 +98,9 @@ impl Module {
         world
     }
 
-    /// Moves the motors to `t` and looks at what changed.
-    fn step_world(&mut self, t: u64) {
+    /// Moves the motors to `t` and looks at what changed (the inputs and
+    /// switches with `look`).
+    fn step_world(&mut self, t: u64, look: bool) {
         let dt = t - self.now_ns;
         for motor in 0..self.axes.len() {
             self.advance_axis(motor, dt);
@@ -105,7 +114,9 @@ impl Module {
                 self.motor_stop(motor);
             }
         }
-        self.look_at_inputs();
+        if look {
+            self.look_at_inputs();
+        }
     }
 
     /// Raises input-change and stop-switch interrupts for the transitions
