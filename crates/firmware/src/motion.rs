@@ -215,11 +215,11 @@ impl Motion {
     /// of `x`) where a switch changes state; a phase ends there so that the
     /// caller can re-evaluate the switches. With `until_crossing` the step
     /// ends at the first threshold reached.
-    pub fn advance(
+    pub fn advance<F: FnMut(f64) -> Stops + ?Sized>(
         &mut self,
         mut dt: f64,
         ramp: &Ramp,
-        stops: &mut dyn FnMut(f64) -> Stops,
+        stops: &mut F,
         thresholds: &[f64],
         until_crossing: bool,
     ) -> Step {
@@ -293,7 +293,7 @@ impl Motion {
 
     /// Seconds until the motor comes to rest (on its target, or stopped
     /// for good), if it will; walks the planned phases without moving.
-    pub fn time_to_rest(&self, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops) -> Option<f64> {
+    pub fn time_to_rest<F: FnMut(f64) -> Stops + ?Sized>(&self, ramp: &Ramp, stops: &mut F) -> Option<f64> {
         let mut probe = self.clone();
         let mut total = 0.0;
         for _ in 0..MAX_PHASES {

@@ -326,16 +326,17 @@ impl Module {
         for _ in 0..64 {
             let ramp = self.ramp(motor);
             let x_before = self.axes[motor].motion.x;
-            let mut motion = std::mem::take(&mut self.axes[motor].motion);
             let step = if self.world.axes[motor].has_switch_positions() {
+                let mut motion = std::mem::take(&mut self.axes[motor].motion);
                 let mut stops = |x: f64| self.stops_at(motor, x);
-                motion.advance(left, &ramp, &mut stops, edges, searching)
+                let step = motion.advance(left, &ramp, &mut stops, edges, searching);
+                self.axes[motor].motion = motion;
+                step
             } else {
                 // The switches read the same everywhere: so do the stops.
                 let fixed = self.stops_at(motor, x_before);
-                motion.advance(left, &ramp, &mut |_| fixed, edges, searching)
+                self.axes[motor].motion.advance(left, &ramp, &mut |_| fixed, edges, searching)
             };
-            self.axes[motor].motion = motion;
             self.drive(motor, x_before, step.elapsed);
             if let Some(t) = step.stopped_at {
                 stopped_at = Some(elapsed + t);
