@@ -131,49 +131,24 @@ impl Module {
     pub(crate) fn drive(&mut self, m: usize, x_before: f64, dt: f64) {
         let moved = self.axes[m].motion.x - x_before;
         let moving = self.axes[m].motion.v != 0.0 || moved != 0.0;
-        let p = self.axes[m].params;
+        let p = &self.axes[m].params;
+        let (stall_speed, threshold, limit) =
+            (p[ap::STOP_ON_STALL as usize], p[ap::STALL_THRESHOLD as usize], p[ap::MAX_ENCODER_DEVIATION as usize]);
         let off = self.driver_off(m);
         // coolStep regulates above its threshold speed, when enabled.
         let semin = if self.profile.features.coolstep { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
         let cool = semin > 0 && moving && self.actual_speed(m).abs() >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
         if cool {
-            let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
-            let min =
-                if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
-            let mut cs = self.axes[m].driver.cool_scale.unwrap_or(max);
-            let per_measurement = if p[ap::STALLGUARD_FILTER as usize] == 1 { 4.0 } else { 1.0 };
-            let measurements = (moved.abs() / self.microsteps(m) / per_measurement).min(256.0);
-            let lower = semin * 32;
-            let upper = (semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32;
-            let up = [1.0, 2.0, 4.0, 8.0][p[ap::SMART_ENERGY_CURRENT_UP_STEP as usize].clamp(0, 3) as usize];
-            let down_every = [32.0, 8.0, 2.0, 1.0][p[ap::SMART_ENERGY_CURRENT_DOWN_STEP as usize].clamp(0, 3) as usize];
-            let mut count = self.axes[m].driver.down_count;
-            for _ in 0..measurements.ceil() as usize {
-                let sg = self.stallguard(m, self.margin(m, cs, off));
-                if sg < lower {
-                    cs = (cs + up).min(max);
-                    count = 0.0;
-                } else if sg > upper {
-                    count += 1.0;
-                    if count >= down_every {
-                        cs = (cs - 1.0).max(min);
-                        count = 0.0;
-                    }
-                }
-            }
-            self.axes[m].driver.cool_scale = Some(cs);
-            self.axes[m].driver.down_count = count;
+            self.cool_step(m, moved, off, semin);
         } else {
             self.axes[m].driver.cool_scale = None;
         }
-        let scale = self.current_scale(m);
-        let margin = self.margin(m, scale, off);
+        let margin = if self.world.axes[m].loads.is_empty() && !off { 1.0 } else { self.margin(m, self.current_scale(m), off) };
         if self.profile.features.stall_detection == StallDetection::Stallguard2 {
             if moving {
                 self.axes[m].driver.load_value = self.stallguard(m, margin);
             }
             // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
-            let stall_speed = p[ap::STOP_ON_STALL as usize];
             if moving && stall_speed > 0 && self.actual_speed(m).abs() >= stall_speed && self.axes[m].driver.load_value == 0 {
                 self.stop_now(m);
                 self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
@@ -185,7 +160,6 @@ impl Module {
             if moving {
                 self.axes[m].driver.load_value = round_in(7.0 * (1.0 - margin), 7.0);
             }
-            let threshold = p[ap::STALL_THRESHOLD as usize];
             if moving && threshold > 0 && self.axes[m].driver.load_value > threshold {
                 self.stop_now(m);
             }
@@ -207,7 +181,6 @@ impl Module {
         }
         // Encoder deviation (AP 212): the motor stops when the position
         // counter and the encoder drift apart further than allowed.
-        let limit = p[ap::MAX_ENCODER_DEVIATION as usize];
         if limit > 0 && moving && self.profile.features.encoder_deviation_stop {
             let deviation = (self.actual_position(m) as i64 - self.encoder_position(m) as i64).abs();
             if deviation > limit as i64 {
@@ -217,6 +190,38 @@ impl Module {
             }
         }
         let _ = dt;
+    }
+
+    /// coolStep's regulation over the measurements of a move of `moved`
+    /// µsteps: the current scale goes up under load and down without.
+    fn cool_step(&mut self, m: usize, moved: f64, off: bool, semin: i32) {
+        let p = &self.axes[m].params;
+        let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
+        let min =
+            if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
+        let mut cs = self.axes[m].driver.cool_scale.unwrap_or(max);
+        let per_measurement = if p[ap::STALLGUARD_FILTER as usize] == 1 { 4.0 } else { 1.0 };
+        let measurements = (moved.abs() / self.microsteps(m) / per_measurement).min(256.0);
+        let lower = semin * 32;
+        let upper = (semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32;
+        let up = [1.0, 2.0, 4.0, 8.0][p[ap::SMART_ENERGY_CURRENT_UP_STEP as usize].clamp(0, 3) as usize];
+        let down_every = [32.0, 8.0, 2.0, 1.0][p[ap::SMART_ENERGY_CURRENT_DOWN_STEP as usize].clamp(0, 3) as usize];
+        let mut count = self.axes[m].driver.down_count;
+        for _ in 0..measurements.ceil() as usize {
+            let sg = self.stallguard(m, self.margin(m, cs, off));
+            if sg < lower {
+                cs = (cs + up).min(max);
+                count = 0.0;
+            } else if sg > upper {
+                count += 1.0;
+                if count >= down_every {
+                    cs = (cs - 1.0).max(min);
+                    count = 0.0;
+                }
+            }
+        }
+        self.axes[m].driver.cool_scale = Some(cs);
+        self.axes[m].driver.down_count = count;
     }
 
     /// A hard stop: velocity mode, zero speed, at once.

@@ -6,7 +6,7 @@
 
 use crate::module::Module;
 use crate::outcome::Origin;
-use crate::program::{Context, RunMode, STACK_DEPTH, Source, TraceRecord, Wait};
+use crate::program::{RunMode, Source, TraceRecord, Wait};
 use tmclsim_protocol::{Command, Instruction, Status, WaitCondition, opcode};
 
 /// Ten milliseconds: one WAIT tick.
@@ -115,31 +115,25 @@ impl Module {
             return Err(Status::InvalidCommand);
         }
         let cmd = Command::decode(ins).map_err(|e| e.status())?;
-        let memory = self.program.memory.len() as i32;
-        let target = |a: i32| if (0..memory).contains(&a) { Ok(a as u16) } else { Err(Status::InvalidValue) };
+        let program = &mut self.program;
         match cmd {
-            Command::Ja { address } => self.program.pc = target(address)?,
+            Command::Ja { address } => program.pc = program.target(address)?,
             Command::Jc { condition, address } => {
-                let a = target(address)?;
+                let a = program.target(address)?;
                 if self.registers.holds(condition) {
-                    self.program.pc = a;
+                    program.pc = a;
                 }
             }
-            Command::Csub { address } => self.call(target(address)?),
+            Command::Csub { address } => program.call(program.target(address)?),
             Command::Call { condition, address } => {
-                let a = target(address)?;
+                let a = program.target(address)?;
                 if self.registers.holds(condition) {
-                    self.call(a);
+                    program.call(a);
                 }
             }
-            Command::Rsub => {
-                // RSUB on an empty stack is ignored.
-                if let Some(ret) = self.program.stack.pop() {
-                    self.program.pc = ret;
-                }
-            }
+            Command::Rsub => program.return_from_subroutine(),
             Command::Djnz { var, address } => {
-                let a = target(address)?;
+                let a = program.target(address)?;
                 let i = var as usize;
                 if i >= self.profile.module.user_variables as usize {
                     return Err(Status::InvalidValue);
@@ -151,19 +145,13 @@ impl Module {
                 }
             }
             Command::Rst { address } => {
-                let a = target(address)?;
-                self.program.stack.clear();
-                self.program.handler = None;
-                self.program.wait = None;
+                program.restart_at(program.target(address)?);
                 self.registers = Default::default();
-                self.program.pc = a;
             }
-            Command::Stop => self.program.mode = RunMode::Stop,
+            Command::Stop => program.mode = RunMode::Stop,
             Command::Reti => {
-                if let Some(ctx) = self.program.handler.take() {
-                    self.registers = ctx.registers;
-                    self.program.pc = ctx.pc;
-                    self.program.wait = ctx.wait;
+                if let Some(registers) = program.return_from_interrupt() {
+                    self.registers = registers;
                 }
             }
             Command::Wait { condition, motor, ticks } => {
@@ -180,14 +168,6 @@ impl Module {
             }
         }
         Ok(())
-    }
-
-    fn call(&mut self, address: u16) {
-        // A call with a full stack is ignored (manual 3.7.44).
-        if self.program.stack.len() < STACK_DEPTH {
-            self.program.stack.push(self.program.pc);
-            self.program.pc = address;
-        }
     }
 
     /// Enters the handler of the most urgent pending interrupt, if the
@@ -210,9 +190,7 @@ impl Module {
         };
         self.program.clear_pending(n);
         let vector = self.interrupts.vectors[n as usize].expect("checked");
-        self.program.handler = Some(Context { registers: self.registers, pc: self.program.pc, wait: self.program.wait.take() });
-        self.program.pc = vector;
-        self.program.next_ns = self.program.next_ns.max(self.now_ns);
+        self.program.enter_handler(vector, self.registers, self.now_ns);
     }
 
     /// Raises the interrupt of a source, if the program has it enabled.

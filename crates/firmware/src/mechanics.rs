@@ -48,8 +48,12 @@ impl Module {
 
     pub(crate) fn switches_at(&self, motor: usize, x: f64) -> (bool, bool, bool) {
         let w = &self.world.axes[motor];
-        let m = self.mech(motor, x);
         let invert = self.globals[0][gp::END_SWITCH_POLARITY as usize] == 1;
+        if !w.has_switch_positions() {
+            // Only levels driven by hand: the same everywhere.
+            return (w.forced_left.unwrap_or(false) ^ invert, w.forced_right.unwrap_or(false) ^ invert, w.forced_home.unwrap_or(false));
+        }
+        let m = self.mech(motor, x);
         (w.left_pressed(m) ^ invert, w.right_pressed(m) ^ invert, w.home_pressed(m))
     }
 
@@ -67,11 +71,21 @@ impl Module {
         }
     }
 
-    /// Ramp settings of an axis in µsteps and seconds.
+    /// Ramp settings of an axis in µsteps and seconds. The plain ramp (no
+    /// interpolated move, torque mode or reference search) is worked out
+    /// once per change of the axis parameters it comes from.
     pub(crate) fn ramp(&self, motor: usize) -> motion::Ramp {
-        if let Some(r) = self.axes[motor].ramp_override {
+        let axis = &self.axes[motor];
+        if let Some(r) = axis.ramp_override {
             return r;
         }
+        if axis.closed_loop.torque_mode || axis.rfs.is_some() {
+            return self.work_out_ramp(motor);
+        }
+        axis.plain_ramp(|| self.work_out_ramp(motor))
+    }
+
+    fn work_out_ramp(&self, motor: usize) -> motion::Ramp {
         let p = &self.axes[motor].params;
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;

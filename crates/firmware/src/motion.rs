@@ -50,6 +50,20 @@ pub fn positioning_accel(a: u32, ramp_div: u32, pulse_div: u32) -> f64 {
     (a as f64).clamp(lower.min(upper), upper)
 }
 
+/// `x.floor() as i64` without a call into the maths library: the
+/// conversion truncates towards zero (and saturates, NaN gives 0), one step
+/// down makes it the floor of a negative fraction.
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t.saturating_sub(1) } else { t }
+}
+
+/// `x.ceil() as i64`, as [`floor_i64`].
+fn ceil_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) < x { t.saturating_add(1) } else { t }
+}
+
 /// Sign of a velocity or distance: −1, 0 or +1 (`f64::signum` gives +1
 /// for 0).
 trait Sgn {
@@ -201,11 +215,11 @@ impl Motion {
     /// of `x`) where a switch changes state; a phase ends there so that the
     /// caller can re-evaluate the switches. With `until_crossing` the step
     /// ends at the first threshold reached.
-    pub fn advance(
+    pub fn advance<F: FnMut(f64) -> Stops + ?Sized>(
         &mut self,
         mut dt: f64,
         ramp: &Ramp,
-        stops: &mut dyn FnMut(f64) -> Stops,
+        stops: &mut F,
         thresholds: &[f64],
         until_crossing: bool,
     ) -> Step {
@@ -279,7 +293,7 @@ impl Motion {
 
     /// Seconds until the motor comes to rest (on its target, or stopped
     /// for good), if it will; walks the planned phases without moving.
-    pub fn time_to_rest(&self, ramp: &Ramp, stops: &mut dyn FnMut(f64) -> Stops) -> Option<f64> {
+    pub fn time_to_rest<F: FnMut(f64) -> Stops + ?Sized>(&self, ramp: &Ramp, stops: &mut F) -> Option<f64> {
         let mut probe = self.clone();
         let mut total = 0.0;
         for _ in 0..MAX_PHASES {
@@ -303,9 +317,9 @@ impl Motion {
     /// the motor comes from while it moves).
     pub fn position(&self) -> i64 {
         if self.v > 0.0 {
-            (self.x + 1e-9).floor() as i64
+            floor_i64(self.x + 1e-9)
         } else if self.v < 0.0 {
-            (self.x - 1e-9).ceil() as i64
+            ceil_i64(self.x - 1e-9)
         } else {
             self.x.round() as i64
         }
@@ -536,6 +550,17 @@ impl Motion {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_and_ceil_are_the_library_s() {
+        let mut cases = vec![0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.5, -2.5, 1e-9, -1e-9, 4503599627370495.5, -4503599627370495.5];
+        cases.extend([9.3e18, -9.3e18, 2f64.powi(63), -(2f64.powi(63)), 1e300, -1e300, f64::NAN, f64::INFINITY, f64::NEG_INFINITY]);
+        cases.extend((0..100_000).map(|i| i as f64 * 0.37 - 18_000.0 + 1e-9));
+        for x in cases {
+            assert_eq!(floor_i64(x), x.floor() as i64, "floor {x}");
+            assert_eq!(ceil_i64(x), x.ceil() as i64, "ceil {x}");
+        }
+    }
 
     #[test]
     fn pow2_is_exact() {

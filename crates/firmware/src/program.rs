@@ -2,11 +2,14 @@
 //! interrupts and the trace.
 //!
 //! The interpreter itself lives in `interpreter.rs`; this file holds the
-//! data it works on, so that a reader sees the machine before the loop.
+//! data it works on, so that a reader sees the machine before the loop,
+//! and the control flow of the branch commands (jumps, the subroutine
+//! stack, entering and leaving an interrupt handler), which touches
+//! nothing but the program's own state.
 
 use crate::link_id::LinkId;
 use crate::state::registers::Registers;
-use tmclsim_protocol::{Instruction, WaitCondition};
+use tmclsim_protocol::{Instruction, Status, WaitCondition};
 
 /// Subroutine stack depth (manual 3.7.20, 3.7.44).
 pub const STACK_DEPTH: usize = 8;
@@ -173,6 +176,55 @@ impl Program {
     pub fn length(&self) -> usize {
         self.memory.iter().rposition(|i| *i != Instruction::default()).map_or(0, |p| p + 1)
     }
+
+    // ----- the control flow: the branch commands' part of the machine ---
+
+    /// A branch target: an address inside program memory.
+    pub fn target(&self, address: i32) -> Result<u16, Status> {
+        if (0..self.memory.len() as i32).contains(&address) { Ok(address as u16) } else { Err(Status::InvalidValue) }
+    }
+
+    /// CSUB, CALL: the return address goes on the stack; a call with a
+    /// full stack is ignored (manual 3.7.44).
+    pub fn call(&mut self, address: u16) {
+        if self.stack.len() < STACK_DEPTH {
+            self.stack.push(self.pc);
+            self.pc = address;
+        }
+    }
+
+    /// RSUB; on an empty stack it is ignored.
+    pub fn return_from_subroutine(&mut self) {
+        if let Some(ret) = self.stack.pop() {
+            self.pc = ret;
+        }
+    }
+
+    /// RST: the stack, the interrupt handler and the WAIT are dropped and
+    /// the program goes on at `address` (the caller clears the registers).
+    pub fn restart_at(&mut self, address: u16) {
+        self.stack.clear();
+        self.handler = None;
+        self.wait = None;
+        self.pc = address;
+    }
+
+    /// Enters the handler at `vector` from where the program is: its
+    /// registers, counter and WAIT are kept for RETI.
+    pub fn enter_handler(&mut self, vector: u16, registers: Registers, now_ns: u64) {
+        self.handler = Some(Context { registers, pc: self.pc, wait: self.wait.take() });
+        self.pc = vector;
+        self.next_ns = self.next_ns.max(now_ns);
+    }
+
+    /// RETI: back to where the handler was entered, with the registers to
+    /// restore; `None` outside a handler (ignored).
+    pub fn return_from_interrupt(&mut self) -> Option<Registers> {
+        let ctx = self.handler.take()?;
+        self.pc = ctx.pc;
+        self.wait = ctx.wait;
+        Some(ctx.registers)
+    }
 }
 
 #[cfg(test)]
@@ -197,5 +249,33 @@ mod tests {
         assert_eq!(p.first_pending(|n| n > 3), Some(40));
         p.clear_pending(40);
         assert_eq!(p.first_pending(|n| n > 3), Some(200));
+    }
+
+    #[test]
+    fn control_flow_owns_the_stack_and_the_handler() {
+        let mut p = Program::new(16);
+        assert_eq!(p.target(15), Ok(15));
+        assert_eq!(p.target(16), Err(Status::InvalidValue), "outside program memory");
+        assert_eq!(p.target(-1), Err(Status::InvalidValue));
+        p.pc = 3;
+        for _ in 0..STACK_DEPTH + 2 {
+            p.call(10);
+        }
+        assert_eq!(p.stack.len(), STACK_DEPTH, "a call with a full stack is ignored");
+        for _ in 0..STACK_DEPTH + 2 {
+            p.return_from_subroutine();
+        }
+        assert_eq!(p.pc, 3, "back where the first call came from; RSUB on an empty stack is ignored");
+        assert_eq!(p.return_from_interrupt(), None, "RETI outside a handler");
+        let registers = Registers { accumulator: 7, ..Registers::default() };
+        p.wait = Some(Wait { condition: WaitCondition::Ticks, motor: 0, until_ns: Some(5) });
+        p.enter_handler(12, registers, 100);
+        assert_eq!((p.pc, p.wait, p.next_ns), (12, None, 100), "the handler does not wait");
+        assert_eq!(p.return_from_interrupt(), Some(registers));
+        assert_eq!(p.pc, 3);
+        assert!(p.wait.is_some(), "the WAIT goes on after RETI");
+        p.call(9);
+        p.restart_at(4);
+        assert!((p.stack.is_empty(), p.handler, p.wait) == (true, None, None) && p.pc == 4);
     }
 }

@@ -34,9 +34,23 @@ impl Module {
         // The world's next event, when a batch that left the world as it
         // was has just computed it.
         let mut known = None;
+        // The world was found quiet ([`Quiet`]) and only world steps and
+        // batches that left the world as it was came since: it still is.
+        let mut quiet = false;
+        // The inputs and switches read as at the last look: they do not
+        // depend on where the carriages are (the world itself does not
+        // change while time advances), and only world steps and batches
+        // that left the world as it was came since.
+        let fixed_switches = self.world.axes.iter().all(|w| !w.has_switch_positions());
+        let mut as_seen = fixed_switches;
         loop {
-            let timer = self.run_timers();
-            let world = known.take();
+            // After such a batch the timers are as they were too: the time
+            // is the same and no instruction of the batch touches them.
+            let (timer, world) = match known.take() {
+                Some((timer, world)) => (timer, Some(world)),
+                None if quiet => (None, None),
+                None => (self.run_timers(), None),
+            };
             if self.program.is_running() {
                 if self.program.wait.is_some() {
                     self.check_wait();
@@ -48,9 +62,12 @@ impl Module {
                 if self.program.wait.is_none() && self.program.next_ns <= self.now_ns && self.now_ns < end {
                     // Pure instructions run ahead of the world only up to
                     // the world's next event.
-                    let world = self.world_deadline(timer);
+                    let world = self.next_world_event(timer, &mut quiet);
                     if self.run_batch(world.map_or(end, |d| d.min(end))) {
-                        known = Some(world);
+                        known = Some((timer, world));
+                    } else {
+                        quiet = false;
+                        as_seen = false;
                     }
                     continue;
                 }
@@ -59,14 +76,31 @@ impl Module {
                 break;
             }
             // The next moment something happens on its own.
-            let world = world.unwrap_or_else(|| self.world_deadline(timer));
+            let world = match world {
+                Some(w) => w,
+                None => self.next_world_event(timer, &mut quiet),
+            };
             let t = earliest(world, self.program_deadline()).filter(|&d| d > self.now_ns).map_or(end, |d| d.min(end));
-            self.step_world(t);
+            self.step_world(t, !as_seen);
+            as_seen = fixed_switches;
         }
     }
 
-    /// Moves the motors to `t` and looks at what changed.
-    fn step_world(&mut self, t: u64) {
+    /// [`Module::world_deadline`] while [`Module::advance`] goes on: only
+    /// the heartbeat's while the world is known to be quiet; else worked
+    /// out, and whether the world is quiet found out with it.
+    fn next_world_event(&self, timer: Option<u64>, quiet: &mut bool) -> Option<u64> {
+        if *quiet {
+            return self.heartbeat_deadline();
+        }
+        let (world, q) = self.world_deadline_and_quiet(timer);
+        *quiet = q == Quiet::Yes && timer.is_none();
+        world
+    }
+
+    /// Moves the motors to `t` and looks at what changed (the inputs and
+    /// switches with `look`).
+    fn step_world(&mut self, t: u64, look: bool) {
         let dt = t - self.now_ns;
         for motor in 0..self.axes.len() {
             self.advance_axis(motor, dt);
@@ -80,36 +114,48 @@ impl Module {
                 self.motor_stop(motor);
             }
         }
-        self.look_at_inputs();
+        if look {
+            self.look_at_inputs();
+        }
     }
 
     /// Raises input-change and stop-switch interrupts for the transitions
     /// their bank 3 trigger setting selects.
     fn look_at_inputs(&mut self) {
         let inputs = self.world.digital_inputs;
-        let changed = inputs ^ self.io.last_inputs;
-        if changed != 0 {
-            for n in 0..8u8 {
-                if changed & (1 << n) != 0 {
-                    let rising = inputs & (1 << n) != 0;
-                    self.trigger(Source::InputChange(n), rising);
-                }
-            }
-            self.io.last_inputs = inputs;
+        if inputs != self.io.last_inputs {
+            self.inputs_changed(inputs);
         }
-        for m in 0..self.axes.len() {
+        for m in 0..self.axes.len().min(self.io.last_switches.len()) {
             let (l, r, _) = self.switches(m);
-            let (pl, pr) = self.io.last_switches.get(m).copied().unwrap_or((l, r));
-            if l != pl {
-                self.trigger(Source::StopLeft(m as u8), l);
-            }
-            if r != pr {
-                self.trigger(Source::StopRight(m as u8), r);
-            }
-            if let Some(s) = self.io.last_switches.get_mut(m) {
-                *s = (l, r);
+            if (l, r) != self.io.last_switches[m] {
+                self.switches_changed(m, (l, r));
             }
         }
+    }
+
+    #[inline(never)]
+    fn inputs_changed(&mut self, inputs: u32) {
+        let changed = inputs ^ self.io.last_inputs;
+        for n in 0..8u8 {
+            if changed & (1 << n) != 0 {
+                let rising = inputs & (1 << n) != 0;
+                self.trigger(Source::InputChange(n), rising);
+            }
+        }
+        self.io.last_inputs = inputs;
+    }
+
+    #[inline(never)]
+    fn switches_changed(&mut self, m: usize, (l, r): (bool, bool)) {
+        let (pl, pr) = self.io.last_switches[m];
+        if l != pl {
+            self.trigger(Source::StopLeft(m as u8), l);
+        }
+        if r != pr {
+            self.trigger(Source::StopRight(m as u8), r);
+        }
+        self.io.last_switches[m] = (l, r);
     }
 
     /// An edge on an input: raise its interrupt if bank 3 selects the edge
@@ -168,12 +214,20 @@ impl Module {
     /// The next event of the world and the interrupt system (everything but
     /// the program's own next instruction or WAIT).
     fn world_deadline(&self, timer: Option<u64>) -> Option<u64> {
+        self.world_deadline_and_quiet(timer).0
+    }
+
+    /// [`Module::world_deadline`], and whether the world is quiet.
+    fn world_deadline_and_quiet(&self, timer: Option<u64>) -> (Option<u64>, Quiet) {
         let mut next = earliest(self.heartbeat_deadline(), timer);
-        if self.driver_watches() {
+        let watches = self.driver_watches();
+        if watches {
             next = earliest(next, Some(self.now_ns + DRIVER_SAMPLE_NS));
         }
         let armed = self.motion_interrupts_armed();
+        let mut quiet = !watches && !armed && !self.has_closed_loop();
         for (motor, axis) in self.axes.iter().enumerate() {
+            quiet &= !axis.notify_on_arrival && axis.rfs.is_none();
             if axis.motion.v == 0.0 && !axis.notify_on_arrival && !armed {
                 continue;
             }
@@ -184,7 +238,7 @@ impl Module {
                 next = earliest(next, self.edge_deadline(motor));
             }
         }
-        next
+        (next, if quiet { Quiet::Yes } else { Quiet::No })
     }
 
     /// When the motor comes to rest, if it moves and will.
@@ -215,11 +269,15 @@ impl Module {
     /// Where the switches of an axis change state, in motor coordinates
     /// (at most eight edges): the edges and how many there are.
     fn switch_edges(&self, motor: usize) -> ([f64; 8], usize) {
+        let mut edges = [0.0f64; 8];
+        let world = &self.world.axes[motor];
+        if !world.has_switch_positions() {
+            return (edges, 0);
+        }
         let offset = self.axes[motor].mech_offset;
         let sign = self.shaft_sign();
-        let mut edges = [0.0f64; 8];
         let mut count = 0;
-        for m in self.world.axes[motor].thresholds().take(edges.len()) {
+        for m in world.thresholds().take(edges.len()) {
             edges[count] = (m - offset) * sign;
             count += 1;
         }
@@ -268,12 +326,17 @@ impl Module {
         for _ in 0..64 {
             let ramp = self.ramp(motor);
             let x_before = self.axes[motor].motion.x;
-            let mut motion = std::mem::take(&mut self.axes[motor].motion);
-            let step = {
+            let step = if self.world.axes[motor].has_switch_positions() {
+                let mut motion = std::mem::take(&mut self.axes[motor].motion);
                 let mut stops = |x: f64| self.stops_at(motor, x);
-                motion.advance(left, &ramp, &mut stops, edges, searching)
+                let step = motion.advance(left, &ramp, &mut stops, edges, searching);
+                self.axes[motor].motion = motion;
+                step
+            } else {
+                // The switches read the same everywhere: so do the stops.
+                let fixed = self.stops_at(motor, x_before);
+                self.axes[motor].motion.advance(left, &ramp, &mut |_| fixed, edges, searching)
             };
-            self.axes[motor].motion = motion;
             self.drive(motor, x_before, step.elapsed);
             if let Some(t) = step.stopped_at {
                 stopped_at = Some(elapsed + t);
@@ -446,26 +509,39 @@ impl Module {
     /// load, stall detection, coolStep, an encoder deviation limit, or a
     /// driver that is off.
     pub(crate) fn driver_watches(&self) -> bool {
-        (0..self.axes.len()).any(|m| {
-            let axis = &self.axes[m];
+        let f = &self.profile.features;
+        let closed_loop = self.has_closed_loop();
+        self.axes.iter().zip(&self.world.axes).enumerate().any(|(m, (axis, world))| {
             let p = &axis.params;
-            let f = &self.profile.features;
+            if closed_loop && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6) {
+                return true;
+            }
             let will_move = axis.motion.v != 0.0
                 || match axis.motion.mode {
                     crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
                     _ => axis.motion.x != axis.motion.target,
                 };
-            let closed_loop = self.has_closed_loop() && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6);
-            closed_loop
-                || will_move
-                    && (!self.world.axes[m].loads.is_empty()
-                        || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
-                        || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
-                        || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
-                        || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
-                        || self.driver_off(m))
+            will_move
+                && (!world.loads.is_empty()
+                    || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
+                    || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
+                    || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
+                    || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
+                    || self.driver_off(m))
         })
     }
+}
+
+/// The world is quiet when its next event can only be the heartbeat's or a
+/// timer's: the driver watches no motor, no interrupt or 138 event waits
+/// for motion, no reference search runs, no closed loop regulates. World
+/// steps keep it quiet (a motor only comes to rest, or stops when the
+/// heartbeat trips), and so do instructions that leave the world as it was
+/// ([`is_pure`], [`observes_only`]); any other instruction may end it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Quiet {
+    Yes,
+    No,
 }
 
 /// Instructions that read the world at their own moment (docs/behaviour.md

@@ -105,6 +105,13 @@ impl AxisWorld {
         }
     }
 
+    /// Some switch is pressed at some positions (and not at others): the
+    /// switches depend on where the carriage is. Without, they read only
+    /// the levels driven by hand.
+    pub fn has_switch_positions(&self) -> bool {
+        self.left_switch.is_some() || self.right_switch.is_some() || self.home_switch.is_some()
+    }
+
     /// Mechanical positions where a switch changes state.
     pub fn thresholds(&self) -> impl Iterator<Item = f64> + '_ {
         let home = self.home_switch.map(|(a, b)| [a, b]);

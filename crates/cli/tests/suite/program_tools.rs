@@ -284,8 +284,8 @@ fn a_long_run_is_quiet_when_stderr_is_no_terminal() {
     let source = d.join("poll.tmc");
     std::fs::write(&source, "Loop:\n  MVP ABS, 0, 512000\nWait:\n  GAP 8, 0\n  JC ZE, Wait\n  MVP ABS, 0, 0\n  JA Loop\n").unwrap();
     let started = std::time::Instant::now();
-    // Six minutes of a busy loop: over a second even in a release build.
-    let o = tmclsim(&["run", source.to_str().unwrap(), "--for", "6m"]);
+    // Twenty minutes of a busy loop: over a second even in a release build.
+    let o = tmclsim(&["run", source.to_str().unwrap(), "--for", "20m"]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(started.elapsed().as_secs_f64() > 1.0, "long enough for a bar on a terminal");
     let stderr = String::from_utf8_lossy(&o.stderr);

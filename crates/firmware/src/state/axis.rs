@@ -5,6 +5,7 @@
 use crate::motion::{Motion, Ramp, RampMode};
 use crate::parameter_numbers::ap;
 use crate::reference_search::ReferenceSearch;
+use std::cell::Cell;
 
 /// One motor axis.
 #[derive(Clone, Debug)]
@@ -31,6 +32,9 @@ pub struct Axis {
     /// AP 209 minus what the encoder measures (set by SAP 209).
     pub encoder_offset: i64,
     pub closed_loop: ClosedLoop,
+    /// The plain ramp last worked out and the parameter words it came
+    /// from (`Module::ramp`).
+    pub(crate) ramp_cache: Cell<Option<(RampKey, Ramp)>>,
 }
 
 impl Axis {
@@ -52,6 +56,7 @@ impl Axis {
             ramp_override: None,
             encoder_offset: 0,
             closed_loop: Default::default(),
+            ramp_cache: Cell::new(None),
         }
     }
 
@@ -61,12 +66,46 @@ impl Axis {
         self.motion.mode = mode;
     }
 
+    /// The plain ramp (no override, torque mode or reference search):
+    /// the one last worked out while the parameters it comes from are
+    /// the same, else `work_out`'s.
+    pub(crate) fn plain_ramp(&self, work_out: impl FnOnce() -> Ramp) -> Ramp {
+        let key = RampKey::of(&self.params);
+        if let Some((k, r)) = self.ramp_cache.get()
+            && k == key
+        {
+            return r;
+        }
+        let r = work_out();
+        self.ramp_cache.set(Some((key, r)));
+        r
+    }
+
     /// Ends what takes the ramp generator over from the plain ramp: a
     /// reference search, an interpolated move's ramp, torque mode.
     pub fn end_overrides(&mut self) {
         self.rfs = None;
         self.ramp_override = None;
         self.closed_loop.torque_mode = false;
+    }
+}
+
+/// The axis parameters a plain ramp comes from (AP 4, 2, 130, 5, 154,
+/// 153), as their words: the ramp worked out for them stays valid while
+/// they are the same.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct RampKey([i32; 6]);
+
+impl RampKey {
+    fn of(p: &[i32; 256]) -> RampKey {
+        RampKey([
+            p[ap::MAX_SPEED as usize],
+            p[ap::TARGET_SPEED as usize],
+            p[ap::MIN_SPEED as usize],
+            p[ap::MAX_ACCELERATION as usize],
+            p[ap::PULSE_DIVISOR as usize],
+            p[ap::RAMP_DIVISOR as usize],
+        ])
     }
 }
 
