@@ -89,7 +89,10 @@ def browser():
 
 
 @pytest.fixture
-def page(browser):
+def page(browser, start):
+    """A page of its own; it closes before the test's processes stop
+    (it depends on `start`), so no request of the page outlives its
+    server. An error the page did not handle fails the test."""
     context = browser.new_context(viewport={"width": 1280, "height": 800}, accept_downloads=True)
     pg = context.new_page()
     errors = []

@@ -99,6 +99,23 @@ def test_a_move_from_pytrinamic_shows_on_the_chart_and_the_position(served, page
     shot(page, "motion")
 
 
+def test_a_server_that_stopped_is_an_error_the_page_shows(served, page):
+    # The page keeps running when its server goes away: each request that
+    # gets no answer is shown as an error (the page fixture fails the test
+    # on any error the page does not handle).
+    open_app(page, served.url)
+    served.stop()
+    page.fill("[data-testid=direct-input]", "GAP 4, 0")
+    page.press("[data-testid=direct-input]", "Enter")
+    page.locator("[data-testid=direct-reply]").wait_for()
+    assert page.inner_text("[data-testid=direct-reply]").startswith("no answer from the server")
+    tab(page, "program")
+    page.evaluate("s => window.tmclEditor.setValue(s)", LOOP_WITH_WAIT)
+    page.click("[data-testid=prog-download]")
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.startsWith('no answer from the server')")
+    page.wait_for_timeout(500)
+
+
 def test_direct_mode_answers_in_words(served, page):
     open_app(page, served.url)
     page.fill("[data-testid=direct-input]", "SAP maximum_positioning_speed, 0, 1500")

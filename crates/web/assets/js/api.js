@@ -29,7 +29,12 @@ async function httpCall(method, path, body) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
   }
-  const r = await fetch(path, init);
+  let r;
+  try {
+    r = await fetch(path, init);
+  } catch (e) {
+    return { error: unreachable(e) };
+  }
   let data;
   try {
     data = await r.json();
@@ -40,14 +45,36 @@ async function httpCall(method, path, body) {
   return data;
 }
 
+/** What a request that got no answer at all says (the server stopped, or
+ * the network failed): an answer like any other error. */
+function unreachable(e) {
+  return `no answer from the server (${e.message})`;
+}
+
 async function httpPostLines(path, body, onLine) {
-  const r = await fetch(path, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+  const failed = (e) => {
+    const last = { error: unreachable(e) };
+    onLine(last);
+    return last;
+  };
+  let r;
+  try {
+    r = await fetch(path, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+  } catch (e) {
+    return failed(e);
+  }
   const reader = r.body.getReader();
   const decoder = new TextDecoder();
   let buffer = "";
   let last = null;
   for (;;) {
-    const { value, done } = await reader.read();
+    let chunk;
+    try {
+      chunk = await reader.read();
+    } catch (e) {
+      return failed(e);
+    }
+    const { value, done } = chunk;
     if (done) break;
     buffer += decoder.decode(value, { stream: true });
     let nl;
