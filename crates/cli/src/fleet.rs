@@ -162,6 +162,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
         };
         specs.push(LinkSpec { modules, config });
     }
+    let signals = crate::signal::Signals::install()?;
     let server = tmclsim_server::start_fleet(specs).map_err(|e| format!("cannot serve the fleet: {e}"))?;
     println!("tmclsim: fleet of {total} modules on {} links is serving", server.links().len());
     let web = crate::ide::start_web(args, server.links())?;
@@ -172,7 +173,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    crate::signal::wait_for_signal();
+    signals.wait();
     drop(web);
     let s = server.stats();
     println!("stats: frames {}, missed real-time deadlines {}, max lateness {} µs", s.frames, s.missed_deadlines, s.max_lateness_ns / 1000);

@@ -42,12 +42,13 @@ pub fn run(args: IdeArgs) -> Result<ExitCode, String> {
     use tmclsim_web::Target;
     let names: Vec<String> = target.modules().iter().map(|m| format!("{} at address {}", m.firmware, m.address)).collect();
     let link = target.describe();
+    let signals = crate::signal::Signals::install()?;
     let web = start(target, args.web, args.web_public)?;
     println!("tmclsim ide: {} on {link}", names.join(", "));
     println!("open: {}", web.url());
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    crate::signal::wait_for_signal();
+    signals.wait();
     println!("tmclsim ide: stopping");
     drop(web);
     Ok(ExitCode::SUCCESS)

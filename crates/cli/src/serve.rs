@@ -138,12 +138,13 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
         })
         .collect::<Result<Vec<_>, String>>()?;
     let segment = tmclsim_ethercat::Segment::new(modules)?;
+    let signals = crate::signal::Signals::install()?;
     let handle = tmclsim_server::ethercat::serve(iface, segment, eeproms).map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
     println!("tmclsim: {} virtual {} EtherCAT slave(s) on {iface}", args.slaves, profile.module.name);
     println!("connect with: an EtherCAT master on {iface}'s peer, e.g. pysoem: master.open(\"<peer interface>\")");
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    crate::signal::wait_for_signal();
+    signals.wait();
     println!("tmclsim: stopping");
     handle.stop();
     Ok(ExitCode::SUCCESS)
@@ -194,6 +195,7 @@ fn serve(
     let token = config.control_token.clone();
     let names: Vec<String> = modules.iter().map(|m| format!("{} (address {})", m.profile().module.name, m.address())).collect();
     let addresses: Vec<(u8, String)> = modules.iter().map(|m| (m.address(), m.profile().module.name.clone())).collect();
+    let signals = crate::signal::Signals::install()?;
     let server = tmclsim_server::start_bus(modules, config).map_err(|e| format!("cannot serve: {e}"))?;
     let ep = server.endpoints().clone();
     println!("tmclsim: virtual {} is serving", names.join(", "));
@@ -237,7 +239,7 @@ fn serve(
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
-    crate::signal::wait_for_signal();
+    signals.wait();
     drop(web);
     if let Some(path) = &args.endpoints {
         let _ = std::fs::remove_file(path);

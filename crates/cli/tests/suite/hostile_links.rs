@@ -273,4 +273,15 @@ fn out_of_file_descriptors_the_accept_loop_backs_off() {
     drop(clients);
     std::thread::sleep(Duration::from_millis(500));
     server.check();
+    // Out of descriptors again, it still stops on SIGTERM, at once and
+    // cleanly: its signal handlers were installed before it served.
+    let clients: Vec<TcpStream> = (0..60).map(|_| TcpStream::connect(server.tcp()).unwrap()).collect();
+    std::thread::sleep(Duration::from_millis(300));
+    let mut server = server;
+    // SAFETY: signalling the child this test started.
+    unsafe {
+        libc::kill(server.child.id() as i32, libc::SIGTERM);
+    }
+    assert_eq!(server.exit_code_within(Duration::from_secs(5)), Some(0), "{:?}", server.log.lock().unwrap());
+    drop(clients);
 }
