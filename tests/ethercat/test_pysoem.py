@@ -34,10 +34,17 @@ STATE_TIMEOUT_US = 2_000_000
 # master's fraction of a millisecond, since the slave is a process on a test
 # machine that may be busy.
 RECEIVE_TIMEOUT_US = 100_000
+# The process data watchdog the tests set: 5 s. A busy test machine can
+# hold the master (or the slave process) for longer than the slave's
+# 100 ms default, which would stop the motor and drop the slave to SafeOp
+# in the middle of a move; the watchdog's own test sets 100 ms again.
+WATCHDOG_MS = 5000
 
 
 def to_op(m):
     m.config_map()
+    for s in m.slaves:
+        s.set_watchdog("processdata", WATCHDOG_MS)
     assert m.state_check(pysoem.SAFEOP_STATE, STATE_TIMEOUT_US) == pysoem.SAFEOP_STATE
     for s in m.slaves:
         s.output = struct.pack("<Ii", 0, 0)
@@ -205,6 +212,8 @@ def test_process_data_watchdog(ethercat):
     to_op(m)
     s.output = struct.pack("<Ii", 2, 800)
     cycle_until(m, lambda: inputs(s)[5] == 800)
+    s.set_watchdog("processdata", 100)
+    assert s.get_watchdog("processdata") == pytest.approx(100)
     time.sleep(0.3)  # no process data for longer than the 100 ms watchdog
     m.read_state()
     assert s.state == pysoem.SAFEOP_STATE | 0x10
