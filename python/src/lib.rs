@@ -74,10 +74,7 @@ fn profiles() -> Vec<&'static str> {
 /// ``status_text(4) == "invalid value"``).
 #[pyfunction]
 fn status_text(status: u8) -> String {
-    match tmclsim_protocol::Status::from_code(status) {
-        Some(s) => s.describe().to_string(),
-        None => format!("status {status}"),
-    }
+    tmclsim_protocol::Status::text(status).into_owned()
 }
 
 /// _panic_inside_guard() -> None

@@ -44,10 +44,7 @@ impl Reply {
     }
 
     fn status_text(&self) -> String {
-        match Status::from_code(self.raw[2]) {
-            Some(s) => s.describe().to_string(),
-            None => format!("unknown status {}", self.raw[2]),
-        }
+        Status::text(self.raw[2]).into_owned()
     }
 }
 

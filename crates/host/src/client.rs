@@ -8,17 +8,38 @@ use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Request};
 
 trait Stream: Read + Write {
     fn set_deadline(&mut self, left: Duration) -> std::io::Result<()>;
+    /// Drops whatever was received and not read yet.
+    fn discard_input(&mut self) -> std::io::Result<()>;
 }
 
 impl Stream for std::net::TcpStream {
     fn set_deadline(&mut self, left: Duration) -> std::io::Result<()> {
         self.set_read_timeout(Some(left.max(Duration::from_millis(1))))
     }
+
+    fn discard_input(&mut self) -> std::io::Result<()> {
+        self.set_nonblocking(true)?;
+        let mut buf = [0u8; 256];
+        let drained = loop {
+            match self.read(&mut buf) {
+                Ok(0) => break Ok(()),
+                Ok(_) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => break Ok(()),
+                Err(e) => break Err(e),
+            }
+        };
+        self.set_nonblocking(false)?;
+        drained
+    }
 }
 
 impl Stream for Box<dyn serialport::SerialPort> {
     fn set_deadline(&mut self, left: Duration) -> std::io::Result<()> {
         self.set_timeout(left.max(Duration::from_millis(1))).map_err(std::io::Error::other)
+    }
+
+    fn discard_input(&mut self) -> std::io::Result<()> {
+        self.clear(serialport::ClearBuffer::Input).map_err(std::io::Error::other)
     }
 }
 
@@ -40,10 +61,26 @@ impl Client {
     }
 
     /// Sends one instruction and returns the raw reply frame.
+    ///
+    /// A reply that comes after its request's timeout stays in the link;
+    /// taken for the next request's reply, it would put every later reply
+    /// one request behind. So what was received before the request is
+    /// dropped, and a frame whose instruction is not the request's (a late
+    /// reply that arrives meanwhile) is skipped. The text reply of 136
+    /// type 0 carries no instruction byte: it is taken as it comes.
     pub fn exchange(&mut self, ins: Instruction) -> Result<[u8; FRAME_LEN], String> {
         let frame = Request::new(self.address, ins).encode();
+        self.stream.discard_input().map_err(|e| format!("read: {e}"))?;
         self.stream.write_all(&frame).map_err(|e| format!("write: {e}"))?;
-        self.read_frame()
+        let text = ins.opcode == tmclsim_protocol::opcode::FIRMWARE_VERSION && ins.kind == 0;
+        let start = Instant::now();
+        loop {
+            let left = self.timeout.saturating_sub(start.elapsed());
+            let reply = self.read_frame_within(left)?;
+            if text || reply[3] == ins.opcode {
+                return Ok(reply);
+            }
+        }
     }
 
     /// Sends one instruction and returns the decoded reply.
@@ -65,11 +102,15 @@ impl Client {
     }
 
     fn read_frame(&mut self) -> Result<[u8; FRAME_LEN], String> {
+        self.read_frame_within(self.timeout)
+    }
+
+    fn read_frame_within(&mut self, timeout: Duration) -> Result<[u8; FRAME_LEN], String> {
         let start = Instant::now();
         let mut buf = [0u8; FRAME_LEN];
         let mut got = 0;
         while got < FRAME_LEN {
-            let left = self.timeout.checked_sub(start.elapsed()).ok_or_else(|| no_reply(got))?;
+            let left = timeout.checked_sub(start.elapsed()).ok_or_else(|| no_reply(got))?;
             self.stream.set_deadline(left).map_err(|e| e.to_string())?;
             match self.stream.read(&mut buf[got..]) {
                 Ok(0) => return Err("the link closed before the reply was complete".into()),
@@ -148,4 +189,50 @@ fn no_reply(got: usize) -> String {
 
 pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02X}")).collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::net::TcpListener;
+
+    /// The reply frame a module at address 1 sends for `opcode` with `value`.
+    fn reply(opcode: u8, value: i32) -> [u8; FRAME_LEN] {
+        let mut r = [0u8; FRAME_LEN];
+        r[..4].copy_from_slice(&[2, 1, 100, opcode]);
+        r[4..8].copy_from_slice(&value.to_be_bytes());
+        r[8] = r[..8].iter().fold(0u8, |s, b| s.wrapping_add(*b));
+        r
+    }
+
+    #[test]
+    fn a_late_reply_is_never_taken_for_the_next_requests() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        let module = std::thread::spawn(move || {
+            let (mut s, _) = listener.accept().unwrap();
+            let mut request = [0u8; FRAME_LEN];
+            // GAP 1: answered after the host gave up waiting.
+            s.read_exact(&mut request).unwrap();
+            std::thread::sleep(Duration::from_millis(150));
+            s.write_all(&reply(6, 111)).unwrap();
+            // SAP 4: answered at once.
+            s.read_exact(&mut request).unwrap();
+            s.write_all(&reply(5, 222)).unwrap();
+            // GGP 0: a late GAP reply comes in between, then its own.
+            s.read_exact(&mut request).unwrap();
+            s.write_all(&[reply(6, 333), reply(10, 444)].concat()).unwrap();
+            // 136 type 0: the text reply has no instruction byte.
+            s.read_exact(&mut request).unwrap();
+            s.write_all(b"\x021141V146").unwrap();
+        });
+        let mut c = Client::open(Some(&addr), None, 9600, 1, Duration::from_millis(50)).unwrap();
+        assert!(c.exchange(Instruction::new(6, 1, 0, 0)).unwrap_err().starts_with("no reply"));
+        std::thread::sleep(Duration::from_millis(200));
+        assert_eq!(c.exchange(Instruction::new(5, 4, 0, 222)).unwrap(), reply(5, 222), "the late GAP reply was dropped");
+        c.timeout = Duration::from_secs(2);
+        assert_eq!(c.exchange(Instruction::new(10, 0, 0, 0)).unwrap(), reply(10, 444), "the late reply skipped");
+        assert_eq!(&c.exchange(Instruction::new(136, 0, 0, 0)).unwrap()[1..], b"1141V146");
+        module.join().unwrap();
+    }
 }

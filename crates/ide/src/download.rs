@@ -43,7 +43,7 @@ impl<E: std::fmt::Display> std::fmt::Display for DownloadError<E> {
 
 /// `4 (invalid value)`.
 fn status_words(status: u8) -> String {
-    Status::from_code(status).map_or(format!("{status} (unknown)"), |s| format!("{status} ({})", s.describe()))
+    format!("{status} ({})", Status::text(status))
 }
 
 /// Downloads `words` from address 0 through `request` (one request to the

@@ -115,6 +115,6 @@ pub fn check(reply: &[u8; FRAME_LEN]) -> Result<(), TargetError> {
 }
 
 /// The status text of a reply status code.
-pub fn status_text(code: u8) -> &'static str {
-    tmclsim_protocol::Status::from_code(code).map_or("unknown status", |s| s.describe())
+pub fn status_text(code: u8) -> std::borrow::Cow<'static, str> {
+    tmclsim_protocol::Status::text(code)
 }

@@ -49,6 +49,15 @@ impl Status {
         (self as u8) < 100
     }
 
+    /// Any status code in words: the status's own, or "unknown status N"
+    /// for a code TMCL does not define.
+    pub fn text(code: u8) -> std::borrow::Cow<'static, str> {
+        match Status::from_code(code) {
+            Some(s) => s.describe().into(),
+            None => format!("unknown status {code}").into(),
+        }
+    }
+
     pub const fn describe(self) -> &'static str {
         match self {
             Status::WrongChecksum => "wrong checksum",
@@ -67,5 +76,32 @@ impl Status {
 impl std::fmt::Display for Status {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{} ({})", self.code(), self.describe())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Status;
+
+    #[test]
+    fn every_code_has_its_words_and_an_undefined_one_says_so() {
+        // The reply status codes of the firmware manuals (TMCM-1141 V1.46,
+        // reply format), and one TMCL does not define.
+        let words: Vec<String> = [1, 2, 3, 4, 5, 6, 100, 101, 128, 7].iter().map(|&c| Status::text(c).into_owned()).collect();
+        assert_eq!(
+            words,
+            [
+                "wrong checksum",
+                "invalid command",
+                "wrong type",
+                "invalid value",
+                "configuration EEPROM locked",
+                "command not available",
+                "ok",
+                "command loaded into program memory",
+                "target position reached",
+                "unknown status 7",
+            ]
+        );
     }
 }

@@ -355,7 +355,7 @@ fn answer_of(ins: Instruction, raw: &[u8; FRAME_LEN], address: u8) -> Answer {
     let reply = Reply::decode(raw);
     match reply {
         Some(r) => {
-            let text = (r.status < 100).then(|| Status::from_code(r.status).map_or("unknown status", Status::describe).to_string());
+            let text = (r.status < 100).then(|| Status::text(r.status).into_owned());
             Answer { status: r.status, value: r.value, text }
         }
         None => Answer { status: 0, value: 0, text: Some("the reply's checksum is wrong".into()) },
