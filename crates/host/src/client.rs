@@ -65,19 +65,19 @@ impl Client {
     /// A reply that comes after its request's timeout stays in the link;
     /// taken for the next request's reply, it would put every later reply
     /// one request behind. So what was received before the request is
-    /// dropped, and a frame whose instruction is not the request's (a late
-    /// reply that arrives meanwhile) is skipped. The text reply of 136
-    /// type 0 carries no instruction byte: it is taken as it comes.
+    /// dropped, and a normal reply whose instruction is not the request's
+    /// (a late reply that arrives meanwhile) is skipped. The version text
+    /// of 136 type 0 and the stored word of 134 carry no instruction byte
+    /// of the request (`reply::shape`): they are taken as they come.
     pub fn exchange(&mut self, ins: Instruction) -> Result<[u8; FRAME_LEN], String> {
         let frame = Request::new(self.address, ins).encode();
         self.stream.discard_input().map_err(|e| format!("read: {e}"))?;
         self.stream.write_all(&frame).map_err(|e| format!("write: {e}"))?;
-        let text = ins.opcode == tmclsim_protocol::opcode::FIRMWARE_VERSION && ins.kind == 0;
         let start = Instant::now();
         loop {
             let left = self.timeout.saturating_sub(start.elapsed());
             let reply = self.read_frame_within(left)?;
-            if text || reply[3] == ins.opcode {
+            if tmclsim_ide::reply::shape(ins, self.address, &reply) != tmclsim_ide::reply::Shape::Normal || reply[3] == ins.opcode {
                 return Ok(reply);
             }
         }
@@ -222,9 +222,12 @@ mod tests {
             // GGP 0: a late GAP reply comes in between, then its own.
             s.read_exact(&mut request).unwrap();
             s.write_all(&[reply(6, 333), reply(10, 444)].concat()).unwrap();
-            // 136 type 0: the text reply has no instruction byte.
+            // 136 type 0 and 134: replies without the request's
+            // instruction byte.
             s.read_exact(&mut request).unwrap();
             s.write_all(b"\x021141V146").unwrap();
+            s.read_exact(&mut request).unwrap();
+            s.write_all(&[2, 5, 4, 0, 0, 0, 3, 232, 0]).unwrap();
         });
         let mut c = Client::open(Some(&addr), None, 9600, 1, Duration::from_millis(50)).unwrap();
         assert!(c.exchange(Instruction::new(6, 1, 0, 0)).unwrap_err().starts_with("no reply"));
@@ -233,6 +236,8 @@ mod tests {
         c.timeout = Duration::from_secs(2);
         assert_eq!(c.exchange(Instruction::new(10, 0, 0, 0)).unwrap(), reply(10, 444), "the late reply skipped");
         assert_eq!(&c.exchange(Instruction::new(136, 0, 0, 0)).unwrap()[1..], b"1141V146");
+        let word = c.exchange(Instruction::new(134, 0, 0, 0)).unwrap();
+        assert_eq!(tmclsim_ide::reply::memory_word(&word, 1), Ok(Instruction::new(5, 4, 0, 1000)), "SAP 4, 0, 1000 read back");
         module.join().unwrap();
     }
 }
