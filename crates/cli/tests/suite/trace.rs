@@ -149,7 +149,11 @@ fn a_session_over_tcp_checks_clean_and_an_altered_reply_is_one_difference() {
     let i = all.iter().position(|l| l.contains("05 06 01 00")).unwrap();
     assert!(all[i + 1].contains("\"host\""), "no reply recorded after the request to address 5: {}", all[i + 1]);
 
-    let (code, out) = check(&trace, &["--module", "tmcm-1141"]);
+    // The module served here shares a test machine that may be busy: its
+    // 138 event can leave tens of milliseconds late, which a module's own
+    // firmware would not do. The window is widened to 100 ms for that.
+    let patient = ["--time-tolerance", "100"];
+    let (code, out) = check(&trace, &[&["--module", "tmcm-1141"][..], &patient].concat());
     assert_eq!(code, Some(0), "{out}");
     assert!(out.contains("result: 0 differences, 1 not comparable"), "{out}");
     assert!(out.contains("GGP 132 (TMCL tick timer), bank 0: 1 reply; tick timer"), "{out}");
@@ -159,7 +163,7 @@ fn a_session_over_tcp_checks_clean_and_an_altered_reply_is_one_difference() {
     let altered = dir.path().join("altered.jsonl");
     let n = reply_line(&trace, frame("GAP 4, 0"));
     alter_value(&trace, n, 2000, &altered);
-    let (code, out) = check(&altered, &[]);
+    let (code, out) = check(&altered, &patient);
     assert_eq!(code, Some(1), "{out}");
     assert!(out.contains("result: 1 difference, 1 not comparable"), "{out}");
     assert!(out.contains("GAP 4 (Maximum positioning speed), motor 0: 1 difference\n"), "{out}");
