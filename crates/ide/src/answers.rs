@@ -46,7 +46,7 @@ fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8
     }
     json!({
         "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
-        "status": raw[2], "status_text": crate::target::status_text(raw[2]), "value": value,
+        "status": raw[2], "status_text": tmclsim_protocol::Status::text(raw[2]), "value": value,
         "text": crate::reply::describe(ins, raw, address, profile),
     })
 }

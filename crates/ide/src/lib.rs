@@ -21,4 +21,4 @@ pub mod program;
 pub mod reply;
 pub mod target;
 
-pub use target::{Found, ModuleEntry, Target, TargetError, status_text};
+pub use target::{Found, ModuleEntry, Target, TargetError};

@@ -95,7 +95,7 @@ pub fn read_program(target: &dyn Target, id: usize) -> Result<Vec<Instruction>, 
             // Past the memory's end (status 4), or code protection.
             Err(status) if a > 0 && status == Status::InvalidValue.code() => break,
             Err(status) => {
-                return Err(TargetError::Failed(format!("reading word {a}: status {status} ({})", crate::target::status_text(status))));
+                return Err(TargetError::Failed(format!("reading word {a}: status {status} ({})", Status::text(status))));
             }
         }
     }

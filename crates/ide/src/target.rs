@@ -110,11 +110,6 @@ pub trait Target: Send + Sync + 'static {
 pub fn check(reply: &[u8; FRAME_LEN]) -> Result<(), TargetError> {
     match reply[2] {
         s if s >= 100 => Ok(()),
-        s => Err(TargetError::Failed(format!("the module answered status {s} ({})", status_text(s)))),
+        s => Err(TargetError::Failed(format!("the module answered status {s} ({})", tmclsim_protocol::Status::text(s)))),
     }
-}
-
-/// The status text of a reply status code.
-pub fn status_text(code: u8) -> std::borrow::Cow<'static, str> {
-    tmclsim_protocol::Status::text(code)
 }

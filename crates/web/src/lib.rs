@@ -15,7 +15,7 @@ pub mod virtual_target;
 
 pub use link_target::{LinkTarget, Probe};
 pub use serve::Limits;
-pub use tmclsim_ide::target::{self, Found, ModuleEntry, Target, TargetError, status_text};
+pub use tmclsim_ide::target::{self, Found, ModuleEntry, Target, TargetError};
 pub use virtual_target::VirtualTarget;
 
 use std::net::SocketAddr;
