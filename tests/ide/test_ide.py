@@ -206,6 +206,7 @@ def test_a_program_is_fixed_downloaded_and_stops_at_a_breakpoint(served, page):
     page.wait_for_function("document.querySelector('[data-testid=ps-acc]').textContent === '2'")
     page.click("[data-testid=prog-stop]")
     page.wait_for_function("document.querySelector('[data-testid=ps-mode]').textContent.startsWith('stopped')")
+    assert page.inner_text("[data-testid=ps-break]") == "–"
     # A line inserted above moves the breakpoint with its line; after the
     # next download the program stops there, now line 5.
     page.evaluate("() => window.tmclEditor.replaceRange('// one line more\\n', { line: 0, ch: 0 })")
@@ -213,8 +214,9 @@ def test_a_program_is_fixed_downloaded_and_stops_at_a_breakpoint(served, page):
     page.click("[data-testid=prog-download]")
     page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
     page.click("[data-testid=prog-run]")
-    # The stopped program's PC (2) already maps to line 5 with the new map, so
-    # the break itself is what to wait for; then the line it shows.
+    # A stopped program stands at no breakpoint (its PC, 2, maps to line 5
+    # with the new map before it runs), so the break is the new hit; then
+    # the line it shows.
     page.wait_for_function("document.querySelector('[data-testid=ps-break]').textContent === 'at address 2'")
     assert page.get_attribute("[data-testid=editor]", "data-current-line") == "5"
     page.click("[data-testid=prog-stop]")

@@ -135,11 +135,12 @@ pub fn state_of(target: &dyn Target, id: usize) -> Result<Value, TargetError> {
         2 => "step",
         _ => "reset",
     };
-    // A breakpoint is where a stopped program stands: a stale hit (a run or
-    // continue under way, a counter read before the hit was noted) is not
-    // one.
+    // A breakpoint is where a paused program stands (step mode, its counter
+    // on the hit): a stale hit is not one, whether a run or continue is
+    // under way, the counter was read before the hit was noted, or the
+    // program was stopped (128) or downloaded since.
     let pc = (status & 0xFFFF) as u16;
-    let breakpoint = t.breakpoint_hit(id).filter(|&b| b == pc && mode != "running");
+    let breakpoint = t.breakpoint_hit(id).filter(|&b| b == pc && mode == "step");
     let user: Vec<Option<i32>> = replies[3..].iter().map(|raw| (raw[2] >= 100).then(|| word(raw))).collect();
     let snap = t.snapshot(id);
     // The comparison flags JC tests (EQ/ZE, LT, GT) and the error flags.

@@ -149,9 +149,15 @@ fn a_breakpoint_stops_the_program_on_its_line_with_the_accumulator_shown() {
     assert_eq!((st["pc"].as_u64(), st["accumulator"].as_i64()), (Some(2), Some(1)));
     assert!(st["stack_depth"].is_number() && st["flags"].is_string(), "a virtual module shows flags and stack depth: {st}");
     post(&m("continue"), json!({}));
-    assert!(eventually(5.0, || get(&m("state")).1["accumulator"] == 2));
+    assert!(eventually(5.0, || {
+        let st = get(&m("state")).1;
+        st["accumulator"] == 2 && st["breakpoint"] == 2
+    }));
+    // Stopped (128) on the breakpoint's address, the program no longer
+    // stands at a breakpoint: the next run must not look paused there.
     let (_, st) = post(&m("stop"), json!({}));
-    assert_eq!(st["mode"], "stopped");
+    assert_eq!((st["mode"].as_str(), st["pc"].as_u64()), (Some("stopped"), Some(2)), "{st}");
+    assert!(st["breakpoint"].is_null(), "{st}");
     let (code, e) = post(&m("jump"), json!({}));
     assert_eq!(code, 400, "{e}");
 }
