@@ -409,11 +409,25 @@ def test_one_module_found_among_a_thousand(page, fleet_dir, start):
     # A word that is an address brings that module first.
     page.fill("[data-testid=module-filter]", "bus-3 250")
     assert "address 250" in items.first.inner_text() and "bus-3" in items.first.inner_text()
+    # While the picked module's profile is on its way, the panels still act
+    # on the module picked before: the title still names that one, so a
+    # command typed meanwhile goes where the title says.
+    held = []
+    page.route("**/api/modules/*/profile", lambda route: held.append(route))
     items.first.click()
+    while not held:
+        page.wait_for_timeout(20)
+    assert "address 1 " in page.inner_text("[data-testid=module-title]")
+    page.fill("[data-testid=direct-input]", "SAP 4, 0, 1111")
+    page.press("[data-testid=direct-input]", "Enter")
+    page.locator("[data-testid=direct-reply]").wait_for()
+    for route in held:
+        route.continue_()
+    page.unroute("**/api/modules/*/profile")
     page.wait_for_function("document.querySelector('[data-testid=module-title]').textContent.includes('address 250')")
     page.fill("[data-testid=direct-input]", "SAP 4, 0, 1250")
     page.press("[data-testid=direct-input]", "Enter")
-    page.locator("[data-testid=direct-reply]").wait_for()
+    page.locator("[data-testid=direct-reply] >> nth=1").wait_for()
     page.fill("[data-testid=module-filter]", "250")
     assert items.count() == 4  # address 250 of each bus
     shot(page, "modules")
@@ -422,6 +436,8 @@ def test_one_module_found_among_a_thousand(page, fleet_dir, start):
         assert interface.get_axis_parameter(4, 0) == 1250
     with ConnectionManager(f"--interface serial_tmcl --port {tmp_path}/bus-0 --module-id 250").connect() as interface:
         assert interface.get_axis_parameter(4, 0) != 1250
+    with ConnectionManager(f"--interface serial_tmcl --port {tmp_path}/bus-0 --module-id 1").connect() as interface:
+        assert interface.get_axis_parameter(4, 0) == 1111
 
 
 def test_charts_follow_a_chosen_motor_and_the_world_sets_an_analog_input(page, start):

@@ -66,13 +66,19 @@ function onSample(msg) {
   }
 }
 
+let picks = 0;
 async function pick(modules, info, id) {
   const mod = modules[id];
-  document.getElementById("module-title").textContent = `${mod.profile ?? "unknown type"} · address ${mod.address} · ${mod.firmware}`;
+  const mine = ++picks;
   const profile = mod.profile ? await get(`/api/modules/${id}/profile`) : null;
+  // A later pick wins, whichever profile arrives first.
+  if (mine !== picks) return;
   if (live) live.close();
   const ctx = { id, module: mod, profile, info, virtual: mod.virtual, resubscribe: () => resubscribe(ctx) };
   for (const p of Object.values(panels)) p.setModule(ctx);
+  // The title names the module the panels now act on: a command typed as
+  // soon as it shows goes to that module.
+  document.getElementById("module-title").textContent = `${mod.profile ?? "unknown type"} · address ${mod.address} · ${mod.firmware}`;
   live = openLive(id, onSample);
   resubscribe(ctx);
   window.tmclsimReady = true;
