@@ -5,10 +5,11 @@
 
 use std::sync::Arc;
 use tmclsim_firmware::snapshot::ModuleSnapshot;
+use tmclsim_host::SharedBus;
 use tmclsim_ide::target::{ModuleEntry, Target, TargetError};
 use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
+use tmclsim_server::LinkHandle;
 use tmclsim_server::frame_log::{self, Direction};
-use tmclsim_server::{LinkHandle, SharedBus};
 
 struct Place {
     bus: Arc<SharedBus>,
