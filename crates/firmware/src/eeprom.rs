@@ -76,14 +76,34 @@ impl Eeprom {
         serde_json::to_string_pretty(self).expect("EEPROM image serialises")
     }
 
-    pub fn from_json(text: &str) -> Result<Eeprom, String> {
-        let e: Eeprom = serde_json::from_str(text).map_err(|e| format!("EEPROM file is not readable: {e}"))?;
+    pub fn from_json(text: &str) -> Result<Eeprom, ImageTextError> {
+        let e: Eeprom = serde_json::from_str(text).map_err(|e| ImageTextError::Unreadable(e.to_string()))?;
         if e.format != FORMAT {
-            return Err(format!("EEPROM file has format {}, this tmclsim reads {FORMAT}", e.format));
+            return Err(ImageTextError::Format(e.format));
         }
         Ok(e)
     }
 }
+
+/// Why the text of an EEPROM image is not taken ([`Eeprom::from_json`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ImageTextError {
+    /// Not JSON of an image; what the parser says.
+    Unreadable(String),
+    /// An image of another format version.
+    Format(u32),
+}
+
+impl std::fmt::Display for ImageTextError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ImageTextError::Unreadable(e) => write!(f, "EEPROM file is not readable: {e}"),
+            ImageTextError::Format(n) => write!(f, "EEPROM file has format {n}, this tmclsim reads {FORMAT}"),
+        }
+    }
+}
+
+impl std::error::Error for ImageTextError {}
 
 #[cfg(test)]
 mod tests {
@@ -97,10 +117,10 @@ mod tests {
         e.set_coordinate(0, 3, 99);
         e.program.insert(0, [2, 0, 0, 0, 0, 3, 0xE8]);
         assert_eq!(Eeprom::from_json(&e.to_json()), Ok(e));
-        assert!(Eeprom::from_json("{ torn").unwrap_err().starts_with("EEPROM file is not readable: "));
+        assert!(Eeprom::from_json("{ torn").unwrap_err().to_string().starts_with("EEPROM file is not readable: "));
         let other = Eeprom { format: FORMAT + 1, ..Eeprom::new("TMCM-1141") };
         assert_eq!(
-            Eeprom::from_json(&other.to_json()).unwrap_err(),
+            Eeprom::from_json(&other.to_json()).unwrap_err().to_string(),
             format!("EEPROM file has format {}, this tmclsim reads {FORMAT}", FORMAT + 1)
         );
     }

@@ -144,28 +144,52 @@ impl Eeprom {
 
     /// The image checked against the module it is for (docs/behaviour.md
     /// rule 88): it must be that module's, and hold nothing the module
-    /// never stores. The error is a sentence to put after the file's name.
-    pub fn check(&self, profile: &Profile) -> Result<(), String> {
+    /// never stores. The error reads as a sentence to put after the file's
+    /// name.
+    pub fn check(&self, profile: &Profile) -> Result<(), ImageError> {
         let name = &profile.module.name;
         if self.module != *name {
-            return Err(format!("the file holds the EEPROM of a {}, not of a {name}", self.module));
+            return Err(ImageError::OtherModule { image: self.module.clone(), module: name.clone() });
         }
         let refused = self.refused_entries(profile);
         if refused.is_empty() {
             return Ok(());
         }
-        let mut list: Vec<String> = refused.iter().take(LISTED).map(Refused::to_string).collect();
-        if refused.len() > LISTED {
-            list.push(format!("and {} more", refused.len() - LISTED));
-        }
-        let (what, these) = if refused.len() == 1 { ("an entry", "it") } else { ("entries", "them") };
-        Err(format!(
-            "refused: {what} a {name} never stores, so the file was edited or damaged: {}; correct or remove {these} \
-             (or remove the file to start from factory defaults)",
-            list.join("; ")
-        ))
+        Err(ImageError::Refused { module: name.clone(), entries: refused })
     }
 }
+
+/// Why an image is not loaded into a module ([`Eeprom::check`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ImageError {
+    /// The image is another module's.
+    OtherModule { image: String, module: String },
+    /// Entries the module never stores (at least one).
+    Refused { module: String, entries: Vec<Refused> },
+}
+
+impl std::fmt::Display for ImageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ImageError::OtherModule { image, module } => write!(f, "the file holds the EEPROM of a {image}, not of a {module}"),
+            ImageError::Refused { module, entries } => {
+                let mut list: Vec<String> = entries.iter().take(LISTED).map(Refused::to_string).collect();
+                if entries.len() > LISTED {
+                    list.push(format!("and {} more", entries.len() - LISTED));
+                }
+                let (what, these) = if entries.len() == 1 { ("an entry", "it") } else { ("entries", "them") };
+                write!(
+                    f,
+                    "refused: {what} a {module} never stores, so the file was edited or damaged: {}; correct or remove {these} \
+                     (or remove the file to start from factory defaults)",
+                    list.join("; ")
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for ImageError {}
 
 #[cfg(test)]
 mod tests {
@@ -218,7 +242,7 @@ mod tests {
                 "global \"0/75\" = 2147483647: GP 75 (Telegram pause time) of bank 0 takes 0…255",
             ]
         );
-        let message = e.check(&p).unwrap_err();
+        let message = e.check(&p).unwrap_err().to_string();
         assert!(
             message.starts_with("refused: entries a TMCM-1141 never stores, so the file was edited or damaged: axis \"0/4\""),
             "{message}"
@@ -230,7 +254,7 @@ mod tests {
         let mut e = Eeprom::new("TMCM-1141");
         e.set_axis(0, 12, 2);
         assert_eq!(reasons(&e, &p), ["axis \"0/12\" = 2: AP 12 (Right limit switch disable) of motor 0 takes 0…1"]);
-        assert!(e.check(&p).unwrap_err().starts_with("refused: an entry a TMCM-1141 never stores"));
+        assert!(e.check(&p).unwrap_err().to_string().starts_with("refused: an entry a TMCM-1141 never stores"));
     }
 
     #[test]
@@ -271,7 +295,7 @@ mod tests {
             assert!(r.iter().any(|l| l == expected), "{expected} not in {r:#?}");
         }
         assert_eq!(r.len(), 14, "{r:#?}");
-        let message = e.check(&p).unwrap_err();
+        let message = e.check(&p).unwrap_err().to_string();
         assert!(message.contains("; and 4 more; correct or remove them"), "{message}");
     }
 
@@ -296,6 +320,6 @@ mod tests {
     fn another_modules_image_is_refused_before_its_cells() {
         let mut e = Eeprom::new("TMCM-351");
         e.set_axis(2, 4, 100);
-        assert_eq!(e.check(&profile("tmcm-1141")).unwrap_err(), "the file holds the EEPROM of a TMCM-351, not of a TMCM-1141");
+        assert_eq!(e.check(&profile("tmcm-1141")).unwrap_err().to_string(), "the file holds the EEPROM of a TMCM-351, not of a TMCM-1141");
     }
 }

@@ -128,7 +128,7 @@ impl Module {
         match Command::decode(ins) {
             Ok(Command::Gap { param, motor }) => reply(self.peek_axis_parameter(param, motor)),
             Ok(Command::Ggp { param, bank }) => reply(self.peek_global_parameter(param, bank)),
-            Ok(Command::Gio { port, bank }) => reply(self.get_input(port, bank)),
+            Ok(Command::Gio { port, bank }) => reply(self.io.read_port(&self.profile, &self.world, port, bank)),
             Ok(Command::FirmwareVersion { binary: false }) => Some(self.special_version()),
             Ok(Command::FirmwareVersion { binary: true }) => reply(Ok(self.profile.version_word())),
             Ok(Command::ReadMemory { address: a }) => match self.read_memory(a) {

@@ -109,64 +109,41 @@ impl Module {
     }
 
     /// One program instruction; `Err` when it failed and was skipped
-    /// (docs/behaviour.md rule 21).
+    /// (docs/behaviour.md rule 21). The control commands are refused by
+    /// opcode; every other command goes to the one dispatch.
     fn program_instruction(&mut self, ins: Instruction, at: u64) -> Result<(), Status> {
         if !self.profile.has_opcode(ins.opcode) || opcode::is_control(ins.opcode) {
             return Err(Status::InvalidCommand);
         }
         let cmd = Command::decode(ins).map_err(|e| e.status())?;
-        let program = &mut self.program;
-        match cmd {
-            Command::Ja { address } => program.pc = program.target(address)?,
-            Command::Jc { condition, address } => {
-                let a = program.target(address)?;
-                if self.registers.holds(condition) {
-                    program.pc = a;
-                }
-            }
-            Command::Csub { address } => program.call(program.target(address)?),
-            Command::Call { condition, address } => {
-                let a = program.target(address)?;
-                if self.registers.holds(condition) {
-                    program.call(a);
-                }
-            }
-            Command::Rsub => program.return_from_subroutine(),
-            Command::Djnz { var, address } => {
-                let a = program.target(address)?;
-                let i = var as usize;
-                if i >= self.profile.module.user_variables as usize {
-                    return Err(Status::InvalidValue);
-                }
-                let v = self.user_variable(i).wrapping_sub(1);
-                self.set_user_variable(i, v);
-                if v > 0 {
-                    self.program.pc = a;
-                }
-            }
-            Command::Rst { address } => {
-                program.restart_at(program.target(address)?);
-                self.registers = Default::default();
-            }
-            Command::Stop => program.mode = RunMode::Stop,
-            Command::Reti => {
-                if let Some(registers) = program.return_from_interrupt() {
-                    self.registers = registers;
-                }
-            }
-            Command::Wait { condition, motor, ticks } => {
-                let ticks = if ticks == -1 { self.registers.accumulator } else { ticks }.max(0) as u64;
-                let until = (ticks > 0 || condition == WaitCondition::Ticks).then_some(at + ticks * TICK_NS);
-                if condition != WaitCondition::Ticks {
-                    self.motor(motor)?;
-                }
-                self.program.wait = Some(Wait { condition, motor, until_ns: until });
-                self.check_wait();
-            }
-            _ => {
-                self.run_command(cmd, ins, Origin::Program)?;
-            }
+        self.dispatch(cmd, ins, Origin::Program, at).map(|_| ())
+    }
+
+    /// DJNZ: decrements a user variable and jumps while it stays above 0.
+    pub(crate) fn decrement_and_jump(&mut self, var: u8, address: i32) -> Result<(), Status> {
+        let a = self.program.target(address)?;
+        let i = var as usize;
+        if i >= self.profile.module.user_variables as usize {
+            return Err(Status::InvalidValue);
         }
+        let v = self.globals.user_variable(i).wrapping_sub(1);
+        self.globals.set_user_variable(i, v);
+        if v > 0 {
+            self.program.pc = a;
+        }
+        Ok(())
+    }
+
+    /// WAIT: the program waits from `at` until the condition holds or the
+    /// ticks (or the accumulator's, with -1) have passed.
+    pub(crate) fn start_wait(&mut self, condition: WaitCondition, motor: u8, ticks: i32, at: u64) -> Result<(), Status> {
+        let ticks = if ticks == -1 { self.registers.accumulator } else { ticks }.max(0) as u64;
+        let until = (ticks > 0 || condition == WaitCondition::Ticks).then_some(at + ticks * TICK_NS);
+        if condition != WaitCondition::Ticks {
+            self.motor(motor)?;
+        }
+        self.program.wait = Some(Wait { condition, motor, until_ns: until });
+        self.check_wait();
         Ok(())
     }
 

@@ -71,7 +71,7 @@ impl Module {
             axes: Vec::new(),
             globals: Globals::default(),
             io: Io::default(),
-            persistence: Persistence::new(eeprom),
+            persistence: Persistence::new(eeprom, profile.features.eeprom_lock),
             registers: Registers::default(),
             interrupts: Interrupts::default(),
             link: Link::default(),
@@ -122,14 +122,14 @@ impl Module {
     }
 
     pub fn eeprom(&self) -> &Eeprom {
-        &self.persistence.eeprom
+        self.persistence.eeprom()
     }
 
     /// Puts back an EEPROM image that is known to be stored, after writes
     /// that could not be (docs/behaviour.md rule 82): the RAM stays as it
     /// is, and this is no new write.
     pub fn restore_eeprom(&mut self, image: Eeprom) {
-        self.persistence.eeprom = image;
+        self.persistence.replace(image);
     }
 
     /// Changes whenever a command wrote the EEPROM.
@@ -204,13 +204,9 @@ impl Module {
         let profile = self.profile.clone();
         if let Some(magic) = profile.features.eeprom_magic {
             // Any magic but 0xE4 re-initialises the EEPROM (TMCM-351 GP 64).
-            if self.persistence.eeprom.global(0, magic.parameter).is_some_and(|v| v != magic.value) {
-                self.persistence.eeprom.clear();
-                self.persistence.eeprom.set_global(0, magic.parameter, magic.value);
-                self.persistence.mark_written();
-            }
+            self.persistence.check_magic(magic.parameter, magic.value);
         }
-        let ee = &self.persistence.eeprom;
+        let ee = self.persistence.eeprom();
         let restored = !ee.axis.is_empty() || !ee.global.is_empty() || !ee.coordinates.is_empty();
         self.globals.clear();
         for bank in 0..4u8 {
@@ -252,9 +248,6 @@ impl Module {
             self.axes.push(Axis::new(params, coordinates, mech, self.now_ns));
         }
         self.persistence.restored = restored;
-        self.io.outputs = 0;
-        self.io.pullups =
-            profile.ports.iter().find(|p| p.direction == tmclsim_profile::PortDirection::Pullup).is_none_or(|p| p.default != 0);
         self.registers = Registers::default();
         self.interrupts.reset();
         self.link.restart_heartbeat(self.now_ns);
@@ -267,20 +260,21 @@ impl Module {
         self.program.trace = trace.map(|_| Vec::new());
         self.program.breakpoints = breakpoints;
         self.program.instruction_ns = instruction_ns;
-        for (&a, bytes) in &self.persistence.eeprom.program {
+        for (&a, bytes) in &self.persistence.eeprom().program {
             if let Some(w) = self.program.memory.get_mut(a as usize) {
                 *w = tmclsim_protocol::Instruction::from_bytes(bytes);
             }
         }
         self.program.download_pointer = self.program.length() as u16;
         self.program.next_ns = self.now_ns;
-        self.io.last_inputs = self.world.digital_inputs;
-        self.io.last_switches = (0..self.axes.len())
+        let pullups = profile.ports.iter().find(|p| p.direction == tmclsim_profile::PortDirection::Pullup).is_none_or(|p| p.default != 0);
+        let switches = (0..self.axes.len())
             .map(|m| {
                 let (l, r, _) = self.switches(m);
                 (l, r)
             })
             .collect();
+        self.io.power_on(pullups, self.world.digital_inputs, switches);
         for m in 0..self.axes.len() {
             self.closed_loop_power_on(m);
         }

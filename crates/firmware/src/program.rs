@@ -172,6 +172,108 @@ impl Program {
         self.hit_breakpoint = None;
     }
 
+    /// STOP: the program ends.
+    pub fn stop(&mut self) {
+        self.mode = RunMode::Stop;
+    }
+
+    // ----- program control, 128–135: the host's part ----------------
+
+    /// 128: stops the program; a reset program stays reset.
+    pub fn stop_application(&mut self) {
+        if self.mode != RunMode::Reset {
+            self.mode = RunMode::Stop;
+        }
+    }
+
+    /// 129 with an address: the program goes on from there, with an empty
+    /// stack, no handler and no WAIT.
+    pub fn run_from(&mut self, address: i32) -> Result<(), Status> {
+        let a = self.target(address)?;
+        self.restart_at(a);
+        self.hit_breakpoint = None;
+        Ok(())
+    }
+
+    /// 130: step mode; the next instruction runs now.
+    pub fn step_mode(&mut self, now_ns: u64) {
+        self.mode = RunMode::Step;
+        self.hit_breakpoint = None;
+        self.next_ns = now_ns;
+    }
+
+    /// 131: reset (the caller clears the registers).
+    pub fn reset_application(&mut self) {
+        self.reset();
+        self.mode = RunMode::Reset;
+    }
+
+    /// 132: download mode from `address` on; the program stops.
+    pub fn enter_download(&mut self, address: i32) -> Result<(), Status> {
+        let a = self.target(address)?;
+        self.mode = RunMode::Stop;
+        self.download = Some(a);
+        self.download_pointer = a;
+        Ok(())
+    }
+
+    /// 133: leaves download mode; true when it was on.
+    pub fn exit_download(&mut self) -> bool {
+        self.download.take().is_some()
+    }
+
+    /// Stores a word in download mode and moves on: the address it went to.
+    pub fn store_download(&mut self, ins: Instruction) -> Result<u16, Status> {
+        let address = self.download.ok_or(Status::NotAvailable)?;
+        let slot = self.memory.get_mut(address as usize).ok_or(Status::InvalidValue)?;
+        *slot = ins;
+        self.download = Some(address + 1);
+        self.download_pointer = address + 1;
+        Ok(address)
+    }
+
+    /// 134: the word at `address`, unless the program is protected against
+    /// reading.
+    pub fn read(&self, address: i32, read_protected: bool) -> Result<Instruction, Status> {
+        if !(0..self.memory.len() as i32).contains(&address) {
+            return Err(Status::InvalidValue);
+        }
+        if read_protected {
+            return Err(Status::EepromLocked);
+        }
+        Ok(self.memory[address as usize])
+    }
+
+    /// 135 types 0 and 1: mode, whether a WAIT waits, and the download
+    /// pointer (type 0) or the program counter (1).
+    pub fn status_word(&self, kind: u8) -> i32 {
+        let address = if kind == 0 { self.download_pointer } else { self.counter() };
+        ((self.mode as i32) << 24) | ((self.wait.is_some() as i32) << 16) | address as i32
+    }
+
+    /// Loads a program from address 0 (the rest of memory empties); the
+    /// program stops.
+    pub fn load(&mut self, words: &[Instruction]) -> Result<(), Status> {
+        if words.len() > self.memory.len() {
+            return Err(Status::InvalidValue);
+        }
+        self.mode = RunMode::Stop;
+        for (a, w) in self.memory.iter_mut().enumerate() {
+            *w = words.get(a).copied().unwrap_or_default();
+        }
+        self.download_pointer = words.len() as u16;
+        Ok(())
+    }
+
+    /// Empties program memory and resets the interpreter (lifting the code
+    /// protection against reading, SGP 81).
+    pub fn erase(&mut self) {
+        for w in self.memory.iter_mut() {
+            *w = Instruction::default();
+        }
+        self.reset();
+    }
+
     /// Length of the program: up to the last word that is not empty.
     pub fn length(&self) -> usize {
         self.memory.iter().rposition(|i| *i != Instruction::default()).map_or(0, |p| p + 1)
@@ -182,6 +284,32 @@ impl Program {
     /// A branch target: an address inside program memory.
     pub fn target(&self, address: i32) -> Result<u16, Status> {
         if (0..self.memory.len() as i32).contains(&address) { Ok(address as u16) } else { Err(Status::InvalidValue) }
+    }
+
+    /// JA: goes on at `address`.
+    pub fn jump(&mut self, address: i32) -> Result<(), Status> {
+        self.pc = self.target(address)?;
+        Ok(())
+    }
+
+    /// JC: goes on at `address` when the condition holds (the address is
+    /// checked either way).
+    pub fn jump_if(&mut self, holds: bool, address: i32) -> Result<(), Status> {
+        let a = self.target(address)?;
+        if holds {
+            self.pc = a;
+        }
+        Ok(())
+    }
+
+    /// CSUB (`holds` true), CALL: calls the subroutine at `address` when
+    /// the condition holds (the address is checked either way).
+    pub fn call_if(&mut self, holds: bool, address: i32) -> Result<(), Status> {
+        let a = self.target(address)?;
+        if holds {
+            self.call(a);
+        }
+        Ok(())
     }
 
     /// CSUB, CALL: the return address goes on the stack; a call with a

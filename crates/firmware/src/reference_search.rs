@@ -9,6 +9,29 @@
 //! direction, take the middle of the two points. At the end the motor
 //! moves to the reference point at the slow speed, and the position
 //! counter is set to zero there.
+//!
+//! The search is a state machine of its own: after every step of motion
+//! [`ReferenceSearch::step`] looks at the axis it runs on through
+//! [`SearchAxis`], the little it needs of an axis (its position, its
+//! switches, stopping, moving to a point, zeroing its counter).
+
+/// What a reference search needs of the axis it runs on.
+pub trait SearchAxis {
+    /// Where the ramp generator is, in motor coordinates.
+    fn position(&self) -> f64;
+    /// Whether a switch reads active (as wired, before any inversion of
+    /// the search mode) with the motor at `probe`.
+    fn switch_at(&self, switch: Switch, probe: f64) -> bool;
+    /// A switch stopped the motor at once: the next seek starts from
+    /// standstill.
+    fn halt(&mut self);
+    /// Moves to the reference point in position mode; true when the motor
+    /// already stands there.
+    fn approach(&mut self, reference: f64) -> bool;
+    /// At the reference point: the position counter becomes 0 here, with
+    /// the distance between the switches (AP 196) when the mode measures it.
+    fn zero_here(&mut self, distance: Option<f64>);
+}
 
 /// Which input a seek watches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,6 +158,31 @@ impl ReferenceSearch {
         };
         let dir = seeks[0].0.dir;
         Some(ReferenceSearch { seeks, next: 0, marks: Vec::new(), result, invert_home, dir, finish: None })
+    }
+
+    /// Lets the search look at its axis after a step of motion (`crossed`:
+    /// the step ended at a switch edge; `arrived`: at its target): next
+    /// seek, final positioning, zeroing. False once the search is over.
+    pub fn step(&mut self, axis: &mut impl SearchAxis, crossed: bool, arrived: bool) -> bool {
+        if self.finish.is_none() && crossed {
+            let x = axis.position();
+            let invert_home = self.invert_home;
+            let changed = self.look(x, |s, probe| axis.switch_at(s, probe) ^ (s == Switch::Home && invert_home));
+            if changed {
+                axis.halt();
+            }
+            if let Some((reference, distance)) = self.finish {
+                // Move to the reference point at the switch speed.
+                if axis.approach(reference) {
+                    axis.zero_here(distance);
+                    return false;
+                }
+            }
+        } else if let (Some((_, distance)), true) = (self.finish, arrived) {
+            axis.zero_here(distance);
+            return false;
+        }
+        true
     }
 
     /// The seek in progress (`None` once the reference point is known).

@@ -40,5 +40,6 @@ pub fn ok(m: &mut Module, line: &str) -> i32 {
 pub fn in_program(m: &mut Module, line: &str) -> Result<i32, Status> {
     let ins = instruction(line);
     let cmd = Command::decode(ins).unwrap_or_else(|e| panic!("{line}: {e:?}"));
-    m.run_command(cmd, ins, Origin::Program)
+    let at = m.now_ns();
+    m.dispatch(cmd, ins, Origin::Program, at).map(|o| o.value)
 }

@@ -123,12 +123,12 @@ impl Module {
     /// their bank 3 trigger setting selects.
     fn look_at_inputs(&mut self) {
         let inputs = self.world.digital_inputs;
-        if inputs != self.io.last_inputs {
+        if inputs != self.io.last_inputs() {
             self.inputs_changed(inputs);
         }
-        for m in 0..self.axes.len().min(self.io.last_switches.len()) {
+        for m in 0..self.axes.len().min(self.io.switches_seen()) {
             let (l, r, _) = self.switches(m);
-            if (l, r) != self.io.last_switches[m] {
+            if (l, r) != self.io.last_switches(m) {
                 self.switches_changed(m, (l, r));
             }
         }
@@ -136,26 +136,24 @@ impl Module {
 
     #[inline(never)]
     fn inputs_changed(&mut self, inputs: u32) {
-        let changed = inputs ^ self.io.last_inputs;
+        let changed = self.io.see_inputs(inputs);
         for n in 0..8u8 {
             if changed & (1 << n) != 0 {
                 let rising = inputs & (1 << n) != 0;
                 self.trigger(Source::InputChange(n), rising);
             }
         }
-        self.io.last_inputs = inputs;
     }
 
     #[inline(never)]
     fn switches_changed(&mut self, m: usize, (l, r): (bool, bool)) {
-        let (pl, pr) = self.io.last_switches[m];
+        let (pl, pr) = self.io.see_switches(m, (l, r));
         if l != pl {
             self.trigger(Source::StopLeft(m as u8), l);
         }
         if r != pr {
             self.trigger(Source::StopRight(m as u8), r);
         }
-        self.io.last_switches[m] = (l, r);
     }
 
     /// An edge on an input: raise its interrupt if bank 3 selects the edge

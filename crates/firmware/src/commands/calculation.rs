@@ -1,139 +1,16 @@
-//! The calculation commands: CALC, COMP, CALCX, the CALCV family (CALCVV,
-//! CALCVA, CALCAV, CALCVX, CALCXV, CALCV), the indexed user variables
-//! (AIV, SIV, GIV) and CLE.
+//! The calculation family: CALC, COMP, CALCX, the CALCV family, the
+//! indexed user variables and CLE. The operations are the calculation
+//! part's (`state/calculator.rs`); the module lends it the registers and
+//! the user variables (bank 2) for one command.
 
-use crate::commands::Exec;
 use crate::module::Module;
-use crate::outcome::Origin;
-use crate::state::registers::Compare;
-use tmclsim_protocol::{CalcOp, Command, Status};
+use crate::state::calculator::Calculator;
 
 impl Module {
-    /// CALC, COMP, CALCX, CALCVV…CALCV, AIV, SIV, GIV, CLE.
-    pub(crate) fn calculation_command(&mut self, cmd: Command, echo: i32, origin: Origin) -> Exec {
-        use Command::*;
-        match cmd {
-            Calc { op, value } => {
-                let a = self.registers.accumulator;
-                let r = calculate(op, a, value)?;
-                self.registers.load(r);
-                Ok(echo)
-            }
-            Comp { value } => {
-                self.registers.compare = Compare::of(self.registers.accumulator, value);
-                Ok(echo)
-            }
-            CalcX { op } => {
-                let (a, x) = (self.registers.accumulator, self.registers.x);
-                match op {
-                    CalcOp::Load => self.registers.x = a,
-                    CalcOp::Swap => {
-                        self.registers.x = a;
-                        self.registers.load(x);
-                    }
-                    CalcOp::Not => self.registers.x = !x,
-                    _ => {
-                        let r = calculate(op, a, x)?;
-                        self.registers.load(r);
-                    }
-                }
-                Ok(echo)
-            }
-            CalcVV { op, var1, var2 } => {
-                let i2 = self.user_variable_index(var2)?;
-                let (a, b) = (self.user_variable(var1 as usize), self.user_variable(i2));
-                self.calc_into(op, a, b, |m, v| m.set_user_variable(var1 as usize, v), |m, v| m.set_user_variable(i2, v))?;
-                Ok(echo)
-            }
-            CalcVA { op, var } => {
-                let (v, a) = (self.user_variable(var as usize), self.registers.accumulator);
-                self.calc_into(op, v, a, |m, r| m.set_user_variable(var as usize, r), |m, r| m.registers.load(r))?;
-                Ok(echo)
-            }
-            CalcAV { op, var } => {
-                let (a, v) = (self.registers.accumulator, self.user_variable(var as usize));
-                self.calc_into(op, a, v, |m, r| m.registers.load(r), |m, r| m.set_user_variable(var as usize, r))?;
-                Ok(echo)
-            }
-            CalcVX { op, var } => {
-                let (v, x) = (self.user_variable(var as usize), self.registers.x);
-                self.calc_into(op, v, x, |m, r| m.set_user_variable(var as usize, r), |m, r| m.registers.x = r)?;
-                Ok(echo)
-            }
-            CalcXV { op, var } => {
-                let (x, v) = (self.registers.x, self.user_variable(var as usize));
-                self.calc_into(op, x, v, |m, r| m.registers.x = r, |m, r| m.set_user_variable(var as usize, r))?;
-                Ok(echo)
-            }
-            CalcV { op, var, value } => {
-                let v = self.user_variable(var as usize);
-                // NOT inverts the variable itself, the value is ignored
-                // (manual 3.7.45).
-                let value = if op == CalcOp::Not { v } else { value };
-                self.calc_into(op, v, value, |m, r| m.set_user_variable(var as usize, r), |_, _| {})?;
-                Ok(echo)
-            }
-            Siv { value } => {
-                if let Ok(i) = self.user_variable_index(self.registers.x) {
-                    self.set_user_variable(i, value);
-                }
-                Ok(echo)
-            }
-            Aiv => {
-                if let Ok(i) = self.user_variable_index(self.registers.x) {
-                    self.set_user_variable(i, self.registers.accumulator);
-                }
-                Ok(echo)
-            }
-            Giv => match self.user_variable_index(self.registers.x) {
-                Ok(i) => {
-                    let v = self.user_variable(i);
-                    Ok(self.loaded(v, origin))
-                }
-                Err(_) => Ok(echo),
-            },
-            Cle { flag } => {
-                self.registers.clear_errors(flag);
-                Ok(echo)
-            }
-            _ => unreachable!("not a calculation command: {cmd:?}"),
-        }
-    }
-
-    /// The CALCVV family: `target op= source`, with NOT and LOAD copying
-    /// from the source, SWAP exchanging, COMP comparing.
-    fn calc_into(
-        &mut self,
-        op: CalcOp,
-        target: i32,
-        source: i32,
-        set_target: impl FnOnce(&mut Module, i32),
-        set_source: impl FnOnce(&mut Module, i32),
-    ) -> Exec {
-        match op {
-            CalcOp::Comp => {
-                self.registers.compare = Compare::of(target, source);
-                Ok(target)
-            }
-            CalcOp::Swap => {
-                set_target(self, source);
-                set_source(self, target);
-                Ok(source)
-            }
-            CalcOp::Not => {
-                set_target(self, !source);
-                Ok(!source)
-            }
-            _ => {
-                let r = calculate(op, target, source)?;
-                set_target(self, r);
-                Ok(r)
-            }
-        }
-    }
-
-    fn user_variable_index(&self, i: i32) -> Result<usize, Status> {
-        if (0..self.profile.module.user_variables as i32).contains(&i) { Ok(i as usize) } else { Err(Status::InvalidValue) }
+    /// The registers and user variables, for one calculation command.
+    pub(crate) fn calculator(&mut self) -> Calculator<'_> {
+        let count = self.profile.module.user_variables as usize;
+        Calculator::new(&mut self.registers, &mut self.globals[2], count)
     }
 
     /// A user variable (bank 2), for tools.
@@ -141,40 +18,10 @@ impl Module {
         self.globals[2].get(i).copied().unwrap_or(0)
     }
 
+    #[cfg(test)]
     pub(crate) fn user_variable(&self, i: usize) -> i32 {
-        self.globals[2][i]
+        self.globals.user_variable(i)
     }
-
-    pub(crate) fn set_user_variable(&mut self, i: usize, v: i32) {
-        self.globals[2][i] = v;
-    }
-}
-
-/// 32-bit two's complement arithmetic (docs/behaviour.md rule 19).
-fn calculate(op: CalcOp, a: i32, b: i32) -> Exec {
-    Ok(match op {
-        CalcOp::Add => a.wrapping_add(b),
-        CalcOp::Sub => a.wrapping_sub(b),
-        CalcOp::Mul => a.wrapping_mul(b),
-        CalcOp::Div => {
-            if b == 0 {
-                return Err(Status::InvalidValue);
-            }
-            a.wrapping_div(b)
-        }
-        CalcOp::Mod => {
-            if b == 0 {
-                return Err(Status::InvalidValue);
-            }
-            a.wrapping_rem(b)
-        }
-        CalcOp::And => a & b,
-        CalcOp::Or => a | b,
-        CalcOp::Xor => a ^ b,
-        CalcOp::Not => !a,
-        CalcOp::Load => b,
-        CalcOp::Swap | CalcOp::Comp => unreachable!("handled by the caller"),
-    })
 }
 
 #[cfg(test)]

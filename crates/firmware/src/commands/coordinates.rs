@@ -1,79 +1,57 @@
-//! The coordinate commands: SCO, GCO, CCO, ACO — coordinates in RAM, and
-//! with motor 255 (or GP 84) in the EEPROM.
+//! The coordinate commands: SCO, GCO, CCO, ACO — coordinates in the axes'
+//! RAM, and with motor 255 (or GP 84) in the EEPROM part.
 
-use crate::commands::Exec;
 use crate::module::Module;
-use crate::outcome::Origin;
 use crate::parameter_numbers::gp;
-use tmclsim_protocol::{Command, Status};
+use tmclsim_protocol::Status;
 
 impl Module {
-    /// SCO, GCO, CCO, ACO.
-    pub(crate) fn coordinate_command(&mut self, cmd: Command, echo: i32, origin: Origin) -> Exec {
-        use Command::*;
-        match cmd {
-            Sco { coordinate, motor, value } => self.set_coordinate(coordinate, motor, Some(value)).map(|_| echo),
-            Aco { coordinate, motor } => {
-                let a = self.registers.accumulator;
-                self.set_coordinate(coordinate, motor, Some(a)).map(|_| echo)
-            }
-            Cco { coordinate, motor } => {
-                let m = self.motor(motor)?;
-                let pos = self.actual_position(m);
-                self.set_coordinate(coordinate, motor, Some(pos))?;
-                Ok(pos)
-            }
-            Gco { coordinate, motor } => {
-                if motor == 255 {
-                    self.coordinates_from_eeprom(coordinate)?;
-                    return Ok(echo);
-                }
-                let m = self.motor(motor)?;
-                let v = *self.axes[m].coordinates.get(coordinate as usize).ok_or(Status::WrongType)?;
-                Ok(self.loaded(v, origin))
-            }
-            _ => unreachable!("not a coordinate command: {cmd:?}"),
-        }
-    }
-
-    fn set_coordinate(&mut self, n: u8, motor: u8, value: Option<i32>) -> Result<(), Status> {
-        if n as usize > self.profile.module.coordinates as usize {
+    /// SCO, ACO: sets coordinate `n` of a motor; with motor 255 copies it
+    /// (0: all but coordinate 0) from RAM to the EEPROM.
+    pub(crate) fn set_coordinate(&mut self, n: u8, motor: u8, value: i32) -> Result<(), Status> {
+        let count = self.profile.module.coordinates;
+        if n > count {
             return Err(Status::WrongType);
         }
         if motor == 255 {
-            if self.eeprom_locked() {
-                return Err(Status::EepromLocked);
-            }
             // SCO n, 255, 0: RAM → EEPROM (0 = all but coordinate 0).
-            let range = if n == 0 { 1..=self.profile.module.coordinates } else { n..=n };
-            for m in 0..self.axes.len() {
-                for c in range.clone() {
-                    let v = self.axes[m].coordinates[c as usize];
-                    self.persistence.eeprom.set_coordinate(m as u8, c, v);
-                }
-            }
-            self.persistence.mark_written();
-            return Ok(());
+            let range = if n == 0 { 1..=count } else { n..=n };
+            let coordinates: Vec<&[i32]> = self.axes.iter().map(|a| a.coordinates.as_slice()).collect();
+            return self.persistence.store_coordinates(&self.globals, &coordinates, range);
         }
         let m = self.motor(motor)?;
-        let v = value.unwrap_or(0);
-        self.axes[m].coordinates[n as usize] = v;
+        self.axes[m].coordinates[n as usize] = value;
         if n > 0 && self.globals[0][gp::COORDINATE_STORAGE as usize] == 1 {
-            self.persistence.eeprom.set_coordinate(motor, n, v);
-            self.persistence.mark_written();
+            self.persistence.store_coordinate(motor, n, value);
         }
         Ok(())
     }
 
+    /// CCO: coordinate `n` becomes the actual position, which the reply
+    /// carries.
+    pub(crate) fn capture_coordinate(&mut self, n: u8, motor: u8) -> Result<i32, Status> {
+        let m = self.motor(motor)?;
+        let pos = self.actual_position(m);
+        self.set_coordinate(n, motor, pos)?;
+        Ok(pos)
+    }
+
+    /// GCO: coordinate `n` of a motor.
+    pub(crate) fn coordinate(&self, n: u8, motor: u8) -> Result<i32, Status> {
+        let m = self.motor(motor)?;
+        self.axes[m].coordinates.get(n as usize).copied().ok_or(Status::WrongType)
+    }
+
     /// GCO n, 255: EEPROM → RAM (0 = all but coordinate 0).
-    fn coordinates_from_eeprom(&mut self, n: u8) -> Result<(), Status> {
-        if n as usize > self.profile.module.coordinates as usize {
+    pub(crate) fn coordinates_from_eeprom(&mut self, n: u8) -> Result<(), Status> {
+        let count = self.profile.module.coordinates;
+        if n > count {
             return Err(Status::WrongType);
         }
-        let range = if n == 0 { 1..=self.profile.module.coordinates } else { n..=n };
-        for m in 0..self.axes.len() {
+        let range = if n == 0 { 1..=count } else { n..=n };
+        for (m, axis) in self.axes.iter_mut().enumerate() {
             for c in range.clone() {
-                self.axes[m].coordinates[c as usize] = self.persistence.eeprom.coordinate(m as u8, c).unwrap_or(0);
+                axis.coordinates[c as usize] = self.persistence.coordinate(m as u8, c);
             }
         }
         Ok(())

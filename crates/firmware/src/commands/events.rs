@@ -1,47 +1,11 @@
-//! Interrupt configuration and events: EI, DI, VECT, and 138, which arms
-//! the target-reached events of MVP; the event frames it produces.
+//! Interrupts and events: EI, DI, VECT and 138 are the interrupt part's
+//! (`state/interrupts.rs`); here the event frames that the arrival of an
+//! armed move produces, addressed as the link last spoke.
 
-use crate::commands::Exec;
 use crate::module::Module;
-use tmclsim_protocol::{Command, FRAME_LEN, Reply, Status, opcode};
+use tmclsim_protocol::{FRAME_LEN, Reply, Status, opcode};
 
 impl Module {
-    /// EI, DI, VECT, 138.
-    pub(crate) fn event_command(&mut self, cmd: Command, echo: i32) -> Exec {
-        use Command::*;
-        match cmd {
-            Ei { interrupt } | Di { interrupt } => {
-                let enable = matches!(cmd, Ei { .. });
-                if interrupt == 255 {
-                    self.interrupts.global = enable;
-                } else {
-                    self.profile.interrupt(interrupt).ok_or(Status::WrongType)?;
-                    self.interrupts.enabled[interrupt as usize] = enable;
-                }
-                Ok(echo)
-            }
-            Vect { interrupt, address } => {
-                if interrupt == 255 || self.profile.interrupt(interrupt).is_none() {
-                    return Err(Status::WrongType);
-                }
-                if address < 0 || address >= self.profile.module.program_memory as i32 {
-                    return Err(Status::InvalidValue);
-                }
-                self.interrupts.vectors[interrupt as usize] = Some(address as u16);
-                Ok(echo)
-            }
-            TargetReachedEvent { every_move, mask } => {
-                let valid = (1u32 << self.axes.len()) - 1;
-                if mask <= 0 || mask as u32 & !valid != 0 {
-                    return Err(Status::InvalidValue);
-                }
-                self.interrupts.event_arm = Some((every_move, mask as u32));
-                Ok(mask)
-            }
-            _ => unreachable!("not an interrupt or event command: {cmd:?}"),
-        }
-    }
-
     /// Unsolicited frames (138 events) produced since the last call.
     pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
         std::mem::take(&mut self.interrupts.events)

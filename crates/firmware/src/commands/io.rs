@@ -1,105 +1,17 @@
-//! The I/O commands: SIO and GIO (single ports and the 255 bit vectors,
-//! pull-ups, analog inputs and the supply) and SAC, the SPI transfer of the
-//! TMCM-351.
+//! The I/O family: SIO, GIO and SAC are the I/O part's
+//! (`state/io.rs`), which the executor hands them to; here the module's
+//! view of its outputs for tools, and the family's tests.
 
-use crate::commands::Exec;
 use crate::module::Module;
-use crate::outcome::Origin;
-use tmclsim_profile::PortDirection;
-use tmclsim_protocol::{Command, Status};
 
 impl Module {
-    /// SIO, GIO, SAC.
-    pub(crate) fn io_command(&mut self, cmd: Command, echo: i32, origin: Origin) -> Exec {
-        use Command::*;
-        match cmd {
-            Sio { port, bank, value } => self.set_output(port, bank, value).map(|_| echo),
-            Gio { port, bank } => {
-                let v = self.get_input(port, bank)?;
-                Ok(self.loaded(v, origin))
-            }
-            Sac { bus, count, value } => self.io.spi_transfer(bus, count, value),
-            _ => unreachable!("not an I/O command: {cmd:?}"),
-        }
-    }
-
-    fn set_output(&mut self, port: u8, bank: u8, value: i32) -> Result<(), Status> {
-        let has = |d: PortDirection| self.profile.ports.iter().any(|p| p.direction == d && p.bank == bank);
-        if has(PortDirection::Pullup) {
-            if self.profile.port(PortDirection::Pullup, bank, port).is_none() {
-                return Err(Status::WrongType);
-            }
-            if !(0..=1).contains(&value) {
-                return Err(Status::InvalidValue);
-            }
-            self.io.pullups = value == 1;
-            return Ok(());
-        }
-        if !has(PortDirection::Output) {
-            return Err(Status::InvalidValue);
-        }
-        if port == 255 {
-            let v = if value == -1 { self.registers.accumulator } else { value };
-            if !(0..=255).contains(&v) {
-                return Err(Status::InvalidValue);
-            }
-            let mask = self.output_mask(bank);
-            self.io.set_outputs(mask, v as u32);
-            return Ok(());
-        }
-        if self.profile.port(PortDirection::Output, bank, port).is_none() {
-            return Err(Status::WrongType);
-        }
-        if !(0..=1).contains(&value) {
-            return Err(Status::InvalidValue);
-        }
-        self.io.set_output(port, value == 1);
-        Ok(())
-    }
-
-    fn output_mask(&self, bank: u8) -> u32 {
-        self.profile
-            .ports
-            .iter()
-            .filter(|p| p.direction == PortDirection::Output && p.bank == bank && p.number < 32)
-            .fold(0, |m, p| m | 1 << p.number)
-    }
-
-    pub(crate) fn get_input(&self, port: u8, bank: u8) -> Exec {
-        let mut in_bank = self.profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup);
-        let Some(first) = in_bank.clone().next() else {
-            return Err(Status::InvalidValue);
-        };
-        if port == 255 {
-            return Ok(if first.direction == PortDirection::Output {
-                (self.io.outputs & self.output_mask(bank)) as i32
-            } else {
-                in_bank.filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | (self.world.digital(p.number) as i32) << p.number)
-            });
-        }
-        let p = in_bank.find(|p| p.number == port).ok_or(Status::WrongType)?;
-        Ok(match p.direction {
-            PortDirection::Output => (self.io.outputs >> port & 1) as i32,
-            _ if p.max == 1 => self.world.digital(port) as i32,
-            // The supply voltage channel is the one with a 0.1 V unit.
-            _ if p.role == Some(tmclsim_profile::PortRole::Supply) => self.world.supply_decivolts as i32,
-            _ => {
-                let v = self.world.analog_inputs.get(port as usize).copied().unwrap_or(0) as i64;
-                // The world's ADC values are 12 bit (0…4095). A plain analog
-                // input (no unit) with a coarser ADC reads them at its own
-                // resolution: range 0…1023 reads a quarter.
-                if p.unit.is_none() && (1..4095).contains(&p.max) { (v * (p.max + 1) / 4096) as i32 } else { v as i32 }
-            }
-        })
-    }
-
     /// The states of the digital outputs, bit n = OUTn.
     pub fn outputs(&self) -> u32 {
-        self.io.outputs
+        self.io.outputs()
     }
 
     pub fn pullups(&self) -> bool {
-        self.io.pullups
+        self.io.pullups()
     }
 }
 

@@ -2,79 +2,70 @@
 //! masks), MVPA, RORA, ROLA and RFS; the group index (AP 213) that shares
 //! them between motors; and the reference search as the module runs it.
 
-use crate::commands::Exec;
 use crate::module::Module;
 use crate::motion::{Motion, RampMode};
 use crate::parameter_numbers::ap;
-use crate::reference_search::{ReferenceSearch, Switch};
-use tmclsim_protocol::{Command, MoveMode, RfsAction, Status};
+use crate::reference_search::{ReferenceSearch, SearchAxis, Switch};
+use tmclsim_protocol::{MoveMode, RfsAction, Status};
 
 impl Module {
-    /// ROR, ROL, MST, MVP, MVPA, RORA, ROLA, RFS.
-    pub(crate) fn motion_command(&mut self, cmd: Command, echo: i32) -> Exec {
-        use Command::*;
-        match cmd {
-            Ror { motor, velocity } => self.for_group(motor, |s, m| s.rotate(m, velocity, 1)).map(|_| echo),
-            Rol { motor, velocity } => self.for_group(motor, |s, m| s.rotate(m, velocity, -1)).map(|_| echo),
-            Mst { motor } => self
-                .for_group(motor, |s, m| {
-                    let m = s.motor(m)?;
-                    s.motor_stop(m);
-                    Ok(())
-                })
-                .map(|_| echo),
-            Mvp { mode: MoveMode::Coordinate, motor, value } if motor & 0xC0 != 0 && self.axes.len() > 1 => {
-                self.move_coordinate_mask(motor, value).map(|_| echo)
-            }
-            Mvp { mode, motor, value } => self.for_group(motor, |s, m| s.move_to(mode, m, value)).map(|_| echo),
-            Mvpa { mode, motor } => {
-                let a = self.registers.accumulator;
-                self.move_to(mode, motor, a).map(|_| echo)
-            }
-            Rola { motor } => self.rotate(motor, self.registers.accumulator, -1).map(|_| echo),
-            Rora { motor } => self.rotate(motor, self.registers.accumulator, 1).map(|_| echo),
-            Rfs { action, motor } => {
-                let m = self.motor(motor)?;
-                match action {
-                    RfsAction::Start => self.for_group(motor, |s, g| s.start_reference_search(g as usize))?,
-                    RfsAction::Stop => self.for_group(motor, |s, g| {
-                        if s.axes[g as usize].rfs.take().is_some() {
-                            s.motor_stop(g as usize);
-                        }
-                        Ok(())
-                    })?,
-                    RfsAction::Status => return Ok(self.reference_search_active(m) as i32),
-                }
-                Ok(echo)
-            }
-            _ => unreachable!("not a motion command: {cmd:?}"),
-        }
+    /// ROR, ROL: rotation of `motor` and its group.
+    pub(crate) fn rotate_group(&mut self, motor: u8, velocity: i32, sign: i32) -> Result<(), Status> {
+        self.for_group(motor, |s, m| s.rotate(m, velocity, sign))
     }
 
-    fn rotate(&mut self, motor: u8, velocity: i32, sign: i32) -> Result<(), Status> {
+    /// MST: `motor` and its group stop.
+    pub(crate) fn stop_group(&mut self, motor: u8) -> Result<(), Status> {
+        self.for_group(motor, |s, m| {
+            let m = s.motor(m)?;
+            s.motor_stop(m);
+            Ok(())
+        })
+    }
+
+    /// MVP: a move of `motor` and its group; MVP COORD with a motor mask on
+    /// a module with more than one motor.
+    pub(crate) fn move_group(&mut self, mode: MoveMode, motor: u8, value: i32) -> Result<(), Status> {
+        if mode == MoveMode::Coordinate && motor & 0xC0 != 0 && self.axes.len() > 1 {
+            return self.move_coordinate_mask(motor, value);
+        }
+        self.for_group(motor, |s, m| s.move_to(mode, m, value))
+    }
+
+    /// RFS START and STOP (`None`: the reply echoes the value) and STATUS
+    /// (whether a search runs).
+    pub(crate) fn reference_search_command(&mut self, action: RfsAction, motor: u8) -> Result<Option<i32>, Status> {
+        let m = self.motor(motor)?;
+        match action {
+            RfsAction::Start => self.for_group(motor, |s, g| s.start_reference_search(g as usize))?,
+            RfsAction::Stop => self.for_group(motor, |s, g| {
+                if s.axes[g as usize].rfs.take().is_some() {
+                    s.motor_stop(g as usize);
+                }
+                Ok(())
+            })?,
+            RfsAction::Status => return Ok(Some(self.reference_search_active(m) as i32)),
+        }
+        Ok(None)
+    }
+
+    pub(crate) fn rotate(&mut self, motor: u8, velocity: i32, sign: i32) -> Result<(), Status> {
         let m = self.motor(motor)?;
         if !(-2047..=2047).contains(&velocity) {
             return Err(Status::InvalidValue);
         }
-        self.clear_motion_errors(m);
         let axis = &mut self.axes[m];
-        axis.end_overrides();
-        axis.params[ap::TARGET_SPEED as usize] = velocity * sign;
-        axis.set_ramp_mode(RampMode::Velocity);
-        axis.notify_on_arrival = false;
+        axis.clear_motion_errors();
+        axis.run_at(velocity * sign);
         Ok(())
     }
 
     /// MST: velocity mode with target speed 0.
     pub(crate) fn motor_stop(&mut self, m: usize) {
-        let axis = &mut self.axes[m];
-        axis.end_overrides();
-        axis.params[ap::TARGET_SPEED as usize] = 0;
-        axis.set_ramp_mode(RampMode::Velocity);
-        axis.notify_on_arrival = false;
+        self.axes[m].run_at(0);
     }
 
-    fn move_to(&mut self, mode: MoveMode, motor: u8, value: i32) -> Result<(), Status> {
+    pub(crate) fn move_to(&mut self, mode: MoveMode, motor: u8, value: i32) -> Result<(), Status> {
         let m = self.motor(motor)?;
         let target = match mode {
             MoveMode::Absolute => value,
@@ -87,7 +78,7 @@ impl Module {
         if mode == MoveMode::Absolute && !self.profile.axis_parameter(ap::TARGET_POSITION).is_some_and(|p| p.accepts(value)) {
             return Err(Status::InvalidValue);
         }
-        self.clear_motion_errors(m);
+        self.axes[m].clear_motion_errors();
         let axis = &mut self.axes[m];
         axis.end_overrides();
         // MVP selects position mode; soft mode, once chosen, stays.
@@ -165,10 +156,6 @@ impl Module {
         Ok(())
     }
 
-    fn clear_motion_errors(&mut self, m: usize) {
-        self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 0;
-    }
-
     /// Sets AP 0 and the target the ramp generator runs to: the short way
     /// round in the module's position counter width.
     pub(crate) fn set_target(&mut self, m: usize, target: i32) {
@@ -193,7 +180,7 @@ impl Module {
             tmclsim_profile::ReferenceSearchFamily::Tmc428 => ReferenceSearch::new_tmc428(mode),
         };
         let rfs = rfs.ok_or(Status::InvalidValue)?;
-        self.clear_motion_errors(m);
+        self.axes[m].clear_motion_errors();
         let axis = &mut self.axes[m];
         axis.notify_on_arrival = false;
         axis.set_ramp_mode(RampMode::Velocity);
@@ -202,58 +189,60 @@ impl Module {
         Ok(())
     }
 
-    /// Lets the reference search look at the switches after a step of
-    /// motion: next seek, final positioning, zeroing.
+    /// Lets the reference search look at its axis after a step of motion.
     pub(crate) fn reference_search_step(&mut self, m: usize, crossed: bool, arrived: bool) {
         let Some(mut rfs) = self.axes[m].rfs.take() else { return };
-        let motion = &self.axes[m].motion;
-        if rfs.finish.is_none() && crossed {
-            let x = motion.x;
-            let invert_home = rfs.invert_home;
-            let changed = rfs.look(x, |s, probe| {
-                let (l, r, h) = self.switches_at(m, probe);
-                match s {
-                    Switch::Left => l,
-                    Switch::Right => r,
-                    Switch::Home => h ^ invert_home,
-                }
-            });
-            if changed {
-                // The switch stops the motor at once; the next seek starts
-                // from standstill.
-                self.axes[m].motion.v = 0.0;
-            }
-            if let Some((reference, distance)) = rfs.finish {
-                // Move to the reference point at the switch speed.
-                let axis = &mut self.axes[m];
-                axis.set_ramp_mode(RampMode::Position);
-                axis.motion.target = reference.round();
-                if axis.motion.x != axis.motion.target || axis.motion.v != 0.0 {
-                    self.axes[m].rfs = Some(rfs);
-                } else {
-                    self.finish_reference_search(m, distance);
-                }
-                return;
-            }
-        } else if let (Some((_, distance)), true) = (rfs.finish, arrived) {
-            self.finish_reference_search(m, distance);
-            return;
+        if rfs.step(&mut SearchedAxis { module: self, m }, crossed, arrived) {
+            self.axes[m].rfs = Some(rfs);
         }
-        self.axes[m].rfs = Some(rfs);
     }
 
     /// At the reference point: AP 197 keeps the old count, the counter
     /// becomes 0 here, AP 196 gets the switch distance.
     fn finish_reference_search(&mut self, m: usize, distance: Option<f64>) {
-        {
-            let last = self.actual_position(m);
-            self.axes[m].params[ap::LAST_REFERENCE_POSITION as usize] = last;
-            if let Some(d) = distance {
-                self.axes[m].params[ap::END_SWITCH_DISTANCE as usize] = d.round() as i32;
-            }
-            self.write_axis_parameter(m, ap::ACTUAL_POSITION, 0);
-            self.set_target(m, 0);
+        let last = self.actual_position(m);
+        self.axes[m].params[ap::LAST_REFERENCE_POSITION as usize] = last;
+        if let Some(d) = distance {
+            self.axes[m].params[ap::END_SWITCH_DISTANCE as usize] = d.round() as i32;
         }
+        self.write_axis_parameter(m, ap::ACTUAL_POSITION, 0);
+        self.set_target(m, 0);
+    }
+}
+
+/// The axis a reference search runs on, as the search sees it.
+struct SearchedAxis<'a> {
+    module: &'a mut Module,
+    m: usize,
+}
+
+impl SearchAxis for SearchedAxis<'_> {
+    fn position(&self) -> f64 {
+        self.module.axes[self.m].motion.x
+    }
+
+    fn switch_at(&self, switch: Switch, probe: f64) -> bool {
+        let (l, r, h) = self.module.switches_at(self.m, probe);
+        match switch {
+            Switch::Left => l,
+            Switch::Right => r,
+            Switch::Home => h,
+        }
+    }
+
+    fn halt(&mut self) {
+        self.module.axes[self.m].motion.v = 0.0;
+    }
+
+    fn approach(&mut self, reference: f64) -> bool {
+        let axis = &mut self.module.axes[self.m];
+        axis.set_ramp_mode(RampMode::Position);
+        axis.motion.target = reference.round();
+        axis.motion.x == axis.motion.target && axis.motion.v == 0.0
+    }
+
+    fn zero_here(&mut self, distance: Option<f64>) {
+        self.module.finish_reference_search(self.m, distance);
     }
 }
 

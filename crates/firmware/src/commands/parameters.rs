@@ -1,71 +1,57 @@
 //! The parameter commands: SAP, GAP, STAP, RSAP, AAP for axis parameters
 //! and SGP, GGP, STGP, RSGP, AGP for global parameters — their access and
 //! range checks, the side effects of writes and the measured values reads
-//! compute. The executor hands each command straight to its method here.
+//! compute. The tables, access and range checks are the parameter
+//! tables' (`state/parameters.rs`), the stores and restores the EEPROM
+//! part's (`state/persistence.rs`); here the module coordinates them with
+//! the axes, the program and virtual time.
 
 use crate::closed_loop::cl;
 use crate::module::Module;
 use crate::motion::{self, RampMode};
 use crate::parameter_numbers::{ap, gp};
-use tmclsim_profile::{Access, Parameter};
-use tmclsim_protocol::{Instruction, Status};
+use crate::state::parameters::{axis_spec, global_spec, takes};
+use tmclsim_protocol::Status;
 
 impl Module {
     /// STAP: stores an axis parameter's value in the EEPROM.
     pub(crate) fn store_axis_parameter(&mut self, param: u8, motor: u8) -> Result<(), Status> {
         let m = self.motor(motor)?;
-        self.axis_spec(param, |a| a.eeprom)?;
-        if self.eeprom_locked() {
-            return Err(Status::EepromLocked);
-        }
-        let v = self.axes[m].params[param as usize];
-        self.persistence.eeprom.set_axis(motor, param, v);
-        self.persistence.mark_written();
-        Ok(())
+        axis_spec(&self.profile, param, |a| a.eeprom)?;
+        self.persistence.store_axis(&self.globals, motor, param, self.axes[m].params[param as usize])
     }
 
     /// RSAP: an axis parameter takes its value from the EEPROM again.
     pub(crate) fn restore_axis_parameter(&mut self, param: u8, motor: u8) -> Result<(), Status> {
         let m = self.motor(motor)?;
-        let spec = self.axis_spec(param, |a| a.eeprom)?;
-        // As at power-up: a stored value out of range is not taken (rule 88).
-        let v = self.persistence.eeprom.axis(motor, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
+        let v = self.persistence.restore_axis(motor, axis_spec(&self.profile, param, |a| a.eeprom)?);
         self.write_axis_parameter(m, param, v);
         Ok(())
     }
 
     /// STGP: stores a global parameter's value in the EEPROM.
     pub(crate) fn store_global_parameter(&mut self, param: u8, bank: u8) -> Result<(), Status> {
-        self.global_spec(param, bank, |a| a.eeprom)?;
-        if self.eeprom_locked() {
-            return Err(Status::EepromLocked);
-        }
-        let v = self.globals[bank as usize][param as usize];
-        self.persistence.store_global(bank, param, v);
-        Ok(())
+        global_spec(&self.profile, param, bank, |a| a.eeprom)?;
+        self.persistence.store_global_checked(&self.globals, bank, param)
     }
 
     /// RSGP: a global parameter takes its value from the EEPROM again.
     pub(crate) fn restore_global_parameter(&mut self, param: u8, bank: u8) -> Result<(), Status> {
-        let spec = self.global_spec(param, bank, |a| a.eeprom)?;
-        let v = self.persistence.eeprom.global(bank, param).filter(|&v| spec.accepts(v)).unwrap_or(spec.default_word());
+        let v = self.persistence.restore_global(bank, global_spec(&self.profile, param, bank, |a| a.eeprom)?);
         self.globals[bank as usize][param as usize] = v;
         Ok(())
     }
 
     pub fn set_axis_parameter(&mut self, param: u8, motor: u8, value: i32) -> Result<(), Status> {
         let m = self.motor(motor)?;
-        let spec = self.axis_spec(param, |a| a.write)?;
-        if !spec.accepts(value) {
-            return Err(Status::InvalidValue);
-        }
+        takes(axis_spec(&self.profile, param, |a| a.write)?, value)?;
         self.write_axis_parameter(m, param, value);
         Ok(())
     }
 
     pub fn get_axis_parameter(&mut self, param: u8, motor: u8) -> Result<i32, Status> {
         let m = self.motor(motor)?;
-        self.axis_spec(param, |a| a.read)?;
+        axis_spec(&self.profile, param, |a| a.read)?;
         Ok(self.read_axis_parameter(m, param))
     }
 
@@ -73,13 +59,8 @@ impl Module {
     /// an observer's look (docs/behaviour.md rule 86).
     pub fn peek_axis_parameter(&self, param: u8, motor: u8) -> Result<i32, Status> {
         let m = self.motor(motor)?;
-        self.axis_spec(param, |a| a.read)?;
+        axis_spec(&self.profile, param, |a| a.read)?;
         Ok(self.axis_parameter_value(m, param))
-    }
-
-    fn axis_spec(&self, param: u8, need: impl Fn(Access) -> bool) -> Result<&Parameter, Status> {
-        let spec = self.profile.axis_parameter(param).ok_or(Status::WrongType)?;
-        if need(spec.access) { Ok(spec) } else { Err(Status::WrongType) }
     }
 
     /// Writes a parameter with its side effects (no access check).
@@ -164,24 +145,14 @@ impl Module {
     }
 
     pub fn set_global_parameter(&mut self, param: u8, bank: u8, value: i32) -> Result<(), Status> {
-        let spec = self.global_spec(param, bank, |a| a.write)?;
-        if !spec.accepts(value) {
-            return Err(Status::InvalidValue);
-        }
+        let spec = global_spec(&self.profile, param, bank, |a| a.write)?;
+        takes(spec, value)?;
         let auto = spec.access.auto;
-        if bank == 0 && self.profile.features.eeprom_lock == Some(param) {
-            // 1234 locks, 4321 unlocks; the state itself is kept.
-            let locked = match value {
-                1234 => 1,
-                4321 => 0,
-                _ => return Err(Status::InvalidValue),
-            };
-            self.globals[0][param as usize] = locked;
-            self.persistence.store_global(0, param, locked);
-            return Ok(());
+        if self.persistence.is_lock(bank, param) {
+            return self.persistence.set_lock(&mut self.globals, param, value);
         }
-        if auto && self.eeprom_locked() {
-            return Err(Status::EepromLocked);
+        if auto {
+            self.persistence.check_unlocked(&self.globals)?;
         }
         match (bank, param) {
             (0, gp::TICK_TIMER) => self.globals.set_tick_timer(self.now_ns, value as i64),
@@ -190,12 +161,8 @@ impl Module {
                 let old = self.globals[0][param as usize];
                 if matches!(old, 1 | 3) && matches!(value, 0 | 2) {
                     // Lifting the protection against reading erases the program.
-                    for w in self.program.memory.iter_mut() {
-                        *w = Instruction::default();
-                    }
-                    self.program.reset();
-                    self.persistence.eeprom.program.clear();
-                    self.persistence.mark_written();
+                    self.program.erase();
+                    self.persistence.erase_program();
                 }
                 self.globals[0][param as usize] = value;
             }
@@ -228,7 +195,7 @@ impl Module {
     /// What GGP would answer, without its effects (GP 133 does not move to
     /// its next number): an observer's look (docs/behaviour.md rule 86).
     pub fn peek_global_parameter(&self, param: u8, bank: u8) -> Result<i32, Status> {
-        self.global_spec(param, bank, |a| a.read)?;
+        global_spec(&self.profile, param, bank, |a| a.read)?;
         Ok(match (bank, param) {
             (0, gp::TICK_TIMER) => self.globals.tick_timer(self.now_ns),
             (0, gp::APPLICATION_STATUS) => self.program.mode as i32,
@@ -237,20 +204,6 @@ impl Module {
             (0, gp::RANDOM) => self.globals.peek_random(),
             _ => self.globals[bank as usize][param as usize],
         })
-    }
-
-    fn global_spec(&self, param: u8, bank: u8, need: impl Fn(Access) -> bool) -> Result<&Parameter, Status> {
-        if !self.profile.has_bank(bank) {
-            return Err(Status::InvalidValue);
-        }
-        let spec = self.profile.global_parameter(bank, param).ok_or(Status::WrongType)?;
-        if need(spec.access) { Ok(spec) } else { Err(Status::WrongType) }
-    }
-
-    /// The lock parameter (features `eeprom_lock`, GP 73 on the TMCM-351)
-    /// reads 1: the configuration EEPROM is locked.
-    pub(crate) fn eeprom_locked(&self) -> bool {
-        self.profile.features.eeprom_lock.is_some_and(|n| self.globals[0][n as usize] == 1)
     }
 }
 

@@ -6,95 +6,44 @@ use crate::module::Module;
 use crate::outcome::{Outcome, Special};
 use crate::parameter_numbers::gp;
 use crate::program::RunMode;
-use tmclsim_protocol::frame::memory_reply;
-use tmclsim_protocol::{Command, Instruction, Status};
+use tmclsim_protocol::{Instruction, Status};
 
 impl Module {
-    /// 128–135: program control over any link.
-    pub(crate) fn control(&mut self, cmd: Command) -> Result<Outcome, Status> {
-        let memory = self.program.memory.len() as i32;
-        let ok = Outcome::ok;
-        match cmd {
-            Command::StopApplication => {
-                if self.program.mode != RunMode::Reset {
-                    self.program.mode = RunMode::Stop;
-                }
-                Ok(ok(0))
-            }
-            Command::RunApplication { from } => {
-                if let Some(address) = from {
-                    if !(0..memory).contains(&address) {
-                        return Err(Status::InvalidValue);
-                    }
-                    self.program.pc = address as u16;
-                    self.program.stack.clear();
-                    self.program.wait = None;
-                    self.program.handler = None;
-                    self.program.hit_breakpoint = None;
-                }
-                self.start_program();
-                Ok(ok(from.unwrap_or(0)))
-            }
-            Command::StepApplication => {
-                self.program.mode = RunMode::Step;
-                self.program.hit_breakpoint = None;
-                self.program.next_ns = self.now_ns;
-                self.step_program();
-                Ok(ok(0))
-            }
-            Command::ResetApplication => {
-                self.program.reset();
-                self.program.mode = RunMode::Reset;
-                self.registers = Default::default();
-                Ok(ok(0))
-            }
-            Command::EnterDownload { address } => {
-                if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 2 | 3) || self.eeprom_locked() {
-                    return Err(Status::EepromLocked);
-                }
-                if !(0..memory).contains(&address) {
-                    return Err(Status::InvalidValue);
-                }
-                self.program.mode = RunMode::Stop;
-                self.program.download = Some(address as u16);
-                self.program.download_pointer = address as u16;
-                Ok(ok(address))
-            }
-            Command::ExitDownload => {
-                if self.program.download.take().is_some() {
-                    // The downloaded words are in the EEPROM image; save it.
-                    self.persistence.mark_written();
-                }
-                Ok(ok(0))
-            }
-            Command::ReadMemory { address } => {
-                let stored = self.read_memory(address)?;
-                Ok(Outcome { status: Status::Ok, value: address, special: Special::Frame(memory_reply(self.host_address(), stored)) })
-            }
-            Command::ApplicationStatus { kind } => Ok(ok(self.application_status(kind))),
-            _ => Err(Status::InvalidCommand),
+    /// 129: runs the program, from `from` when given; the reply carries it.
+    pub(crate) fn run_application(&mut self, from: Option<i32>) -> Result<i32, Status> {
+        if let Some(address) = from {
+            self.program.run_from(address)?;
         }
+        self.start_program();
+        Ok(from.unwrap_or(0))
+    }
+
+    /// 130: executes one instruction now.
+    pub(crate) fn step_application(&mut self) {
+        self.program.step_mode(self.now_ns);
+        self.step_program();
+    }
+
+    /// 132: download mode, unless the code protection (GP 81) or the
+    /// EEPROM lock forbids writing the program.
+    pub(crate) fn enter_download(&mut self, address: i32) -> Result<i32, Status> {
+        if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 2 | 3) || self.persistence.locked(&self.globals) {
+            return Err(Status::EepromLocked);
+        }
+        self.program.enter_download(address)?;
+        Ok(address)
     }
 
     /// 134: the word at `address` of the program memory.
     pub(crate) fn read_memory(&self, address: i32) -> Result<Instruction, Status> {
-        if !(0..self.program.memory.len() as i32).contains(&address) {
-            return Err(Status::InvalidValue);
-        }
-        if matches!(self.globals[0][gp::CODE_PROTECTION as usize], 1 | 3) {
-            return Err(Status::EepromLocked);
-        }
-        Ok(self.program.memory[address as usize])
+        self.program.read(address, matches!(self.globals[0][gp::CODE_PROTECTION as usize], 1 | 3))
     }
 
     /// 135: the program's status word (types 0, 1), the accumulator (2)
     /// or the X register (3).
     pub(crate) fn application_status(&self, kind: u8) -> i32 {
-        let p = &self.program;
-        let word = |address: u16| ((p.mode as i32) << 24) | ((p.wait.is_some() as i32) << 16) | address as i32;
         match kind {
-            0 => word(p.download_pointer),
-            1 => word(p.counter()),
+            0 | 1 => self.program.status_word(kind),
             2 => self.registers.accumulator,
             _ => self.registers.x,
         }
@@ -102,34 +51,21 @@ impl Module {
 
     /// Stores a word in download mode (status 101), docs/behaviour.md rule 15.
     pub(crate) fn download_word(&mut self, ins: Instruction) -> Outcome {
-        let Some(address) = self.program.download else {
-            return Outcome::error(Status::NotAvailable, ins.value);
-        };
-        let Some(slot) = self.program.memory.get_mut(address as usize) else {
-            return Outcome::error(Status::InvalidValue, ins.value);
-        };
-        *slot = ins;
-        self.persistence.eeprom.program.insert(address, ins.to_bytes());
-        // Each word is in the EEPROM when it is acknowledged, as on the module.
-        self.persistence.mark_written();
-        self.program.download = Some(address + 1);
-        self.program.download_pointer = address + 1;
-        Outcome { status: Status::Loaded, value: ins.value, special: Special::None }
+        match self.program.store_download(ins) {
+            Ok(address) => {
+                // Each word is in the EEPROM when it is acknowledged, as on the module.
+                self.persistence.store_program_word(address, ins);
+                Outcome { status: Status::Loaded, value: ins.value, special: Special::None }
+            }
+            Err(status) => Outcome::error(status, ins.value),
+        }
     }
 
     /// Loads a program into memory from address 0 (as a download would)
     /// and stores it in the EEPROM.
     pub fn load_program(&mut self, words: &[Instruction]) -> Result<(), Status> {
-        if words.len() > self.program.memory.len() {
-            return Err(Status::InvalidValue);
-        }
-        self.program.mode = RunMode::Stop;
-        for (a, w) in self.program.memory.iter_mut().enumerate() {
-            *w = words.get(a).copied().unwrap_or_default();
-        }
-        self.persistence.eeprom.program = words.iter().enumerate().map(|(a, w)| (a as u16, w.to_bytes())).collect();
-        self.persistence.mark_written();
-        self.program.download_pointer = words.len() as u16;
+        self.program.load(words)?;
+        self.persistence.store_program(words);
         Ok(())
     }
 

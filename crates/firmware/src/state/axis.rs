@@ -66,6 +66,20 @@ impl Axis {
         self.motion.mode = mode;
     }
 
+    /// ROR, ROL, MST: velocity mode at `speed` (AP 2), no override, no
+    /// arrival to report.
+    pub fn run_at(&mut self, speed: i32) {
+        self.end_overrides();
+        self.params[ap::TARGET_SPEED as usize] = speed;
+        self.set_ramp_mode(RampMode::Velocity);
+        self.notify_on_arrival = false;
+    }
+
+    /// A new motion command clears the motion errors of AP 207.
+    pub fn clear_motion_errors(&mut self) {
+        self.params[ap::EXTENDED_ERROR_FLAGS as usize] = 0;
+    }
+
     /// The plain ramp (no override, torque mode or reference search):
     /// the one last worked out while the parameters it comes from are
     /// the same, else `work_out`'s.

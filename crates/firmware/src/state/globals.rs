@@ -27,6 +27,15 @@ impl Globals {
         self.banks = [[0; 256]; 4];
     }
 
+    /// User variable `i` (bank 2).
+    pub fn user_variable(&self, i: usize) -> i32 {
+        self.banks[2][i]
+    }
+
+    pub fn set_user_variable(&mut self, i: usize, v: i32) {
+        self.banks[2][i] = v;
+    }
+
     /// GP 132: milliseconds since it was set, 31 bits.
     pub fn tick_timer(&self, now_ns: u64) -> i32 {
         let ms = (now_ns - self.tick_base_ns) / 1_000_000;

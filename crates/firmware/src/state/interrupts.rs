@@ -1,8 +1,9 @@
-//! Interrupt configuration (enabled flags, vectors, the global enable; EI,
-//! DI, VECT) and the target-reached events of 138: which motors are armed
-//! and the event frames waiting to go out.
+//! The interrupt part: the configuration (enabled flags, vectors, the
+//! global enable) that EI, DI and VECT set, and the target-reached events
+//! of 138: which motors are armed and the event frames waiting to go out.
 
-use tmclsim_protocol::FRAME_LEN;
+use tmclsim_profile::Profile;
+use tmclsim_protocol::{FRAME_LEN, Status};
 
 #[derive(Clone, Debug)]
 pub struct Interrupts {
@@ -31,6 +32,42 @@ impl Interrupts {
         self.global = false;
         self.event_arm = None;
         self.events.clear();
+    }
+
+    /// EI, DI: interrupt 255 is the global enable; the others must be in
+    /// the profile's interrupt table.
+    pub fn enable(&mut self, profile: &Profile, interrupt: u8, on: bool) -> Result<(), Status> {
+        if interrupt == 255 {
+            self.global = on;
+        } else {
+            profile.interrupt(interrupt).ok_or(Status::WrongType)?;
+            self.enabled[interrupt as usize] = on;
+        }
+        Ok(())
+    }
+
+    /// VECT: the handler of an interrupt, an address inside program memory.
+    pub fn set_vector(&mut self, profile: &Profile, interrupt: u8, address: i32) -> Result<(), Status> {
+        if interrupt == 255 || profile.interrupt(interrupt).is_none() {
+            return Err(Status::WrongType);
+        }
+        if address < 0 || address >= profile.module.program_memory as i32 {
+            return Err(Status::InvalidValue);
+        }
+        self.vectors[interrupt as usize] = Some(address as u16);
+        Ok(())
+    }
+
+    /// 138: arms the target-reached events of the motors in `mask` (of
+    /// `axes` motors) for the next move or every move; the reply carries
+    /// the mask.
+    pub fn arm_events(&mut self, every_move: bool, mask: i32, axes: usize) -> Result<i32, Status> {
+        let valid = (1u32 << axes) - 1;
+        if mask <= 0 || mask as u32 & !valid != 0 {
+            return Err(Status::InvalidValue);
+        }
+        self.event_arm = Some((every_move, mask as u32));
+        Ok(mask)
     }
 
     /// Interrupt `n` is enabled and has a vector: a program can take it.

@@ -1,19 +1,24 @@
-//! The module's I/O as the firmware keeps it: the digital outputs, the
-//! pull-ups, the inputs and stop switches as last seen (for input-change and
-//! switch interrupts), and the shift registers behind SAC's chip selects.
+//! The I/O part: the digital outputs, the pull-ups, the inputs and stop
+//! switches as last seen (for input-change and switch interrupts), and the
+//! shift registers behind SAC's chip selects; and the I/O commands on
+//! them: SIO and GIO (single ports and the 255 bit vectors, pull-ups,
+//! analog inputs and the supply, as the profile's port table says) and
+//! SAC, the SPI transfer of the TMCM-351. Inputs come from the world.
 
+use crate::world::World;
+use tmclsim_profile::{PortDirection, PortRole, Profile};
 use tmclsim_protocol::Status;
 
 #[derive(Clone, Debug)]
 pub struct Io {
     /// Bit n = OUTn.
-    pub outputs: u32,
-    pub pullups: bool,
+    outputs: u32,
+    pullups: bool,
     /// Digital inputs and stop switches at the last look.
-    pub last_inputs: u32,
-    pub last_switches: Vec<(bool, bool)>,
+    last_inputs: u32,
+    last_switches: Vec<(bool, bool)>,
     /// SAC: the shift register of the SPI device on each chip select.
-    pub spi: [u32; 3],
+    spi: [u32; 3],
 }
 
 impl Default for Io {
@@ -37,6 +42,117 @@ impl Io {
         self.outputs = (self.outputs & !mask) | (bits & mask);
     }
 
+    /// SIO: sets an output, the outputs of a bank (port 255, with -1 the
+    /// accumulator's bits) or, on a bank of pull-ups, the pull-ups.
+    pub fn set_port(&mut self, profile: &Profile, port: u8, bank: u8, value: i32, accumulator: i32) -> Result<(), Status> {
+        let has = |d: PortDirection| profile.ports.iter().any(|p| p.direction == d && p.bank == bank);
+        if has(PortDirection::Pullup) {
+            if profile.port(PortDirection::Pullup, bank, port).is_none() {
+                return Err(Status::WrongType);
+            }
+            if !(0..=1).contains(&value) {
+                return Err(Status::InvalidValue);
+            }
+            self.pullups = value == 1;
+            return Ok(());
+        }
+        if !has(PortDirection::Output) {
+            return Err(Status::InvalidValue);
+        }
+        if port == 255 {
+            let v = if value == -1 { accumulator } else { value };
+            if !(0..=255).contains(&v) {
+                return Err(Status::InvalidValue);
+            }
+            self.set_outputs(output_mask(profile, bank), v as u32);
+            return Ok(());
+        }
+        if profile.port(PortDirection::Output, bank, port).is_none() {
+            return Err(Status::WrongType);
+        }
+        if !(0..=1).contains(&value) {
+            return Err(Status::InvalidValue);
+        }
+        self.set_output(port, value == 1);
+        Ok(())
+    }
+
+    /// GIO: an output read back, a digital or analog input of the world,
+    /// the supply; port 255 reads a bank's outputs or digital inputs as
+    /// bits.
+    pub fn read_port(&self, profile: &Profile, world: &World, port: u8, bank: u8) -> Result<i32, Status> {
+        let mut in_bank = profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup);
+        let Some(first) = in_bank.clone().next() else {
+            return Err(Status::InvalidValue);
+        };
+        if port == 255 {
+            return Ok(if first.direction == PortDirection::Output {
+                (self.outputs & output_mask(profile, bank)) as i32
+            } else {
+                in_bank.filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | (world.digital(p.number) as i32) << p.number)
+            });
+        }
+        let p = in_bank.find(|p| p.number == port).ok_or(Status::WrongType)?;
+        Ok(match p.direction {
+            PortDirection::Output => (self.outputs >> port & 1) as i32,
+            _ if p.max == 1 => world.digital(port) as i32,
+            // The supply voltage channel is the one with a 0.1 V unit.
+            _ if p.role == Some(PortRole::Supply) => world.supply_decivolts as i32,
+            _ => {
+                let v = world.analog_inputs.get(port as usize).copied().unwrap_or(0) as i64;
+                // The world's ADC values are 12 bit (0…4095). A plain analog
+                // input (no unit) with a coarser ADC reads them at its own
+                // resolution: range 0…1023 reads a quarter.
+                if p.unit.is_none() && (1..4095).contains(&p.max) { (v * (p.max + 1) / 4096) as i32 } else { v as i32 }
+            }
+        })
+    }
+
+    /// The states of the digital outputs, bit n = OUTn.
+    pub fn outputs(&self) -> u32 {
+        self.outputs
+    }
+
+    pub fn pullups(&self) -> bool {
+        self.pullups
+    }
+
+    /// Power-up: outputs off, pull-ups as the profile's default, the inputs
+    /// and switches as they are now.
+    pub fn power_on(&mut self, pullups: bool, inputs: u32, switches: Vec<(bool, bool)>) {
+        self.outputs = 0;
+        self.pullups = pullups;
+        self.last_inputs = inputs;
+        self.last_switches = switches;
+    }
+
+    /// The digital inputs at the last look.
+    pub fn last_inputs(&self) -> u32 {
+        self.last_inputs
+    }
+
+    /// A look at the digital inputs: the bits that changed since the last.
+    pub fn see_inputs(&mut self, inputs: u32) -> u32 {
+        let changed = inputs ^ self.last_inputs;
+        self.last_inputs = inputs;
+        changed
+    }
+
+    /// Axes whose stop switches are watched.
+    pub fn switches_seen(&self) -> usize {
+        self.last_switches.len()
+    }
+
+    /// The stop switches (left, right) of axis `m` at the last look.
+    pub fn last_switches(&self, m: usize) -> (bool, bool) {
+        self.last_switches[m]
+    }
+
+    /// A look at the stop switches of axis `m`: what they were before.
+    pub fn see_switches(&mut self, m: usize, now: (bool, bool)) -> (bool, bool) {
+        std::mem::replace(&mut self.last_switches[m], now)
+    }
+
     /// SAC: an SPI transfer of `count` bytes on chip select `bus`. The
     /// simulated device on each bus is a shift register: it answers with
     /// what the previous transfer sent.
@@ -50,6 +166,15 @@ impl Io {
         *slot = value as u32 & mask;
         Ok(answer as i32)
     }
+}
+
+/// The outputs of a bank, as bits.
+fn output_mask(profile: &Profile, bank: u8) -> u32 {
+    profile
+        .ports
+        .iter()
+        .filter(|p| p.direction == PortDirection::Output && p.bank == bank && p.number < 32)
+        .fold(0, |m, p| m | 1 << p.number)
 }
 
 #[cfg(test)]
