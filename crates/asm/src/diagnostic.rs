@@ -171,7 +171,7 @@ impl Reporter {
     pub fn finish(self) -> Vec<Diagnostic> {
         let shown = self.items.len();
         let files = &self.files;
-        let file = |index: usize| files.get(index).map_or_else(String::new, |f| f.to_string());
+        let file = |index: usize| files.get(index).map_or_else(String::new, ToString::to_string);
         let mut out: Vec<Diagnostic> =
             self.items.into_sorted_vec().into_iter().map(|r| Diagnostic::new(file(r.file), r.line, r.column, r.message)).collect();
         if self.total > shown {

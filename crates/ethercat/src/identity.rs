@@ -25,7 +25,7 @@ impl Identity {
             name: profile.module.name.clone(),
             vendor_id: e.vendor_id,
             product_code: e.product_code,
-            revision: (major as u32) << 16 | minor as u32,
+            revision: u32::from(major) << 16 | u32::from(minor),
             order_code: e.order_code.clone(),
             group: e.group.clone(),
         })

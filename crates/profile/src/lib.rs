@@ -124,7 +124,7 @@ impl Parameter {
     /// it). Ranges above 2^31−1 (the timer periods of bank 3) read the 32
     /// bits as unsigned.
     pub fn accepts(&self, value: i32) -> bool {
-        let v = if self.max > i32::MAX as i64 { value as u32 as i64 } else { value as i64 };
+        let v = if self.max > i64::from(i32::MAX) { i64::from(value as u32) } else { i64::from(value) };
         (self.min..=self.max).contains(&v) && (self.ranges.is_empty() || self.ranges.iter().any(|&(lo, hi)| (lo..=hi).contains(&v)))
     }
 
@@ -535,12 +535,12 @@ impl Profile {
 
     /// 136 type 1 value: `[type high][type low][major][minor]`.
     pub fn version_word(&self) -> i32 {
-        ((self.module.type_number as u32) << 16 | (self.module.firmware[0] as u32) << 8 | self.module.firmware[1] as u32) as i32
+        (u32::from(self.module.type_number) << 16 | u32::from(self.module.firmware[0]) << 8 | u32::from(self.module.firmware[1])) as i32
     }
 
     /// Position counter mask for modules with 24-bit positions.
     pub fn position_bits(&self) -> u32 {
-        self.module.position_bits as u32
+        u32::from(self.module.position_bits)
     }
 }
 

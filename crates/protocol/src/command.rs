@@ -617,9 +617,9 @@ impl Command {
             ExitDownload => i(op::EXIT_DOWNLOAD, 0, 0, 0),
             ReadMemory { address } => i(op::READ_MEMORY, 0, 0, address),
             ApplicationStatus { kind } => i(op::APPLICATION_STATUS, kind, 0, 0),
-            FirmwareVersion { binary } => i(op::FIRMWARE_VERSION, binary as u8, 0, 0),
+            FirmwareVersion { binary } => i(op::FIRMWARE_VERSION, u8::from(binary), 0, 0),
             FactoryDefaults { key } => i(op::FACTORY_DEFAULTS, 0, 0, key),
-            TargetReachedEvent { every_move, mask } => i(op::TARGET_REACHED_EVENT, every_move as u8, 0, mask),
+            TargetReachedEvent { every_move, mask } => i(op::TARGET_REACHED_EVENT, u8::from(every_move), 0, mask),
             AsciiMode => i(op::ASCII_MODE, 0, 0, 0),
             Reset { key } => i(op::RESET, 0, 0, key),
         }
