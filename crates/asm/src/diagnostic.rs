@@ -19,13 +19,19 @@ use crate::limits::MAX_SUGGESTION_WORK;
 /// line 0 and column 0.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
+    /// The file's name as diagnostics show it (the main file as given, an
+    /// include as its resolver names it).
     pub file: String,
+    /// 1-based line; 0 for an error of the whole file.
     pub line: usize,
+    /// 1-based column in characters; 0 for an error of the whole file.
     pub column: usize,
+    /// What is wrong, in words.
     pub message: String,
 }
 
 impl Diagnostic {
+    /// A diagnostic at `line`:`column` of `file`.
     pub fn new(file: impl Into<String>, line: usize, column: usize, message: impl Into<String>) -> Diagnostic {
         Diagnostic { file: file.into(), line, column, message: message.into() }
     }

@@ -2,6 +2,11 @@
 //! The command as a library ([`run`]), so that the binary and the Python
 //! package's `tmclsim` command are one program.
 
+// The library is the command itself (the binary's and the Python
+// package's): its interface is the command line, documented by --help and
+// the manual page.
+#![allow(missing_docs)]
+
 use clap::{Args, CommandFactory, Parser, Subcommand};
 use std::net::SocketAddr;
 use std::path::PathBuf;

@@ -51,6 +51,7 @@ pub enum LoadError {
 }
 
 impl LoadError {
+    /// The message for the user, whichever kind of failure.
     pub fn message(&self) -> &str {
         match self {
             LoadError::Unreadable(m) | LoadError::Refused(m) => m,

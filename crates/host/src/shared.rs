@@ -52,6 +52,7 @@ pub struct Stats {
 }
 
 impl Stats {
+    /// The counts of two buses together: sums, and the larger of the maxima.
     pub fn merged(self, o: Stats) -> Stats {
         Stats {
             frames: self.frames + o.frames,
@@ -112,6 +113,7 @@ impl SharedBus {
         self.state.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
+    /// The counters of this bus's clock and frames so far.
     pub fn stats(&self) -> Stats {
         *self.stats.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
@@ -145,6 +147,7 @@ impl SharedBus {
         self.lock().bus.len()
     }
 
+    /// No module on the link.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -154,6 +157,7 @@ impl SharedBus {
         *self.faults.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
+    /// Replaces the link faults in force.
     pub fn set_link_faults(&self, f: LinkFaults) {
         *self.faults.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = f;
     }
@@ -184,6 +188,7 @@ impl SharedBus {
         self.wake();
     }
 
+    /// Whether time stands still between calls of [`SharedBus::advance`].
     pub fn is_stepped(&self) -> bool {
         self.lock().bus.clock().is_stepped()
     }

@@ -22,12 +22,14 @@ pub struct EthercatHandle {
     /// Saves EEPROM writes; ends once the frame thread has ended and
     /// every write it handed over is saved.
     saver: Option<std::thread::JoinHandle<()>>,
+    /// The slaves, shared with the frame thread.
     pub segment: Arc<Mutex<Segment>>,
     /// Frames processed and frames ignored (not EtherCAT or malformed).
     pub counters: Arc<Mutex<(u64, u64)>>,
 }
 
 impl EthercatHandle {
+    /// Stops the frame thread and waits until every EEPROM write is saved.
     pub fn stop(mut self) {
         self.shutdown();
     }
@@ -37,6 +39,8 @@ impl EthercatHandle {
         self.join();
     }
 
+    /// Waits, without asking it to stop, until the frame thread ends and
+    /// every EEPROM write is saved.
     pub fn wait(mut self) {
         self.join();
     }

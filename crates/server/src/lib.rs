@@ -115,6 +115,7 @@ impl Default for ServerConfig {
 /// The endpoints a running server listens on.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Endpoints {
+    /// The TCP listener's address (the port the system chose for port 0).
     pub tcp: Option<SocketAddr>,
     /// The symlink a host opens, and the pty device it points to.
     pub pty: Option<(PathBuf, PathBuf)>,
@@ -138,7 +139,9 @@ impl Endpoints {
 /// One served link: its endpoints and the bus of its module(s).
 #[derive(Clone)]
 pub struct LinkHandle {
+    /// Where the link is served.
     pub endpoints: Endpoints,
+    /// The bus of the link's modules, shared with its tasks.
     pub bus: Arc<SharedBus>,
 }
 
@@ -202,7 +205,9 @@ impl Drop for ServerHandle {
 
 /// What one link serves and how.
 pub struct LinkSpec {
+    /// The modules on the link, each with the file its EEPROM is saved in.
     pub modules: Vec<(Module, Option<Arc<EepromFile>>)>,
+    /// The link's endpoints and options.
     pub config: ServerConfig,
 }
 

@@ -22,6 +22,7 @@ struct Debug {
     halt: Option<(Arc<AtomicBool>, std::thread::JoinHandle<()>)>,
 }
 
+/// The modules on one TMCL link, as the app's target.
 pub struct LinkTarget {
     /// The target itself, for the stepping thread of a run with
     /// breakpoints.
