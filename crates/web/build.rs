@@ -1,4 +1,5 @@
-// The assets are compiled in: a change under assets/ rebuilds the crate.
+//! Build script: the app's assets are embedded, so a change under assets/
+//! rebuilds the crate.
 fn main() {
     println!("cargo:rerun-if-changed=assets");
 }

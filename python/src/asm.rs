@@ -26,7 +26,7 @@ fn profile_by_name(name: Option<&str>) -> PyResult<Option<Arc<Profile>>> {
 }
 
 fn resolver(include_path: Option<Vec<PathBuf>>) -> FileResolver {
-    include_path.into_iter().flatten().fold(FileResolver::new(), |r, dir| r.with_search_dir(dir))
+    include_path.into_iter().flatten().fold(FileResolver::new(), tmclsim_server::sources::FileResolver::with_search_dir)
 }
 
 fn instructions_from(seq: &Bound<'_, PyAny>) -> PyResult<Vec<tmclsim_protocol::Instruction>> {
@@ -53,7 +53,7 @@ pub fn program_from(obj: &Bound<'_, PyAny>, profile: Option<&Arc<Profile>>) -> P
     }
     if let Ok(text) = obj.cast::<PyString>() {
         let text = text.to_cow()?;
-        return tmclsim_asm::assemble(&text, "program.tmc", &FileResolver::new(), profile.map(|p| p.as_ref()))
+        return tmclsim_asm::assemble(&text, "program.tmc", &FileResolver::new(), profile.map(AsRef::as_ref))
             .map_err(|d| assembly_error(py, &d));
     }
     if obj.is_instance_of::<PyBytes>() || obj.is_instance_of::<PyByteArray>() {
@@ -63,7 +63,7 @@ pub fn program_from(obj: &Bound<'_, PyAny>, profile: Option<&Arc<Profile>>) -> P
     }
     if py.import("os")?.getattr("PathLike").and_then(|c| obj.is_instance(&c))? {
         let path: PathBuf = obj.extract()?;
-        return tmclsim_server::sources::assemble_file(&path, profile.map(|p| p.as_ref())).map_err(|d| assembly_error(py, &d));
+        return tmclsim_server::sources::assemble_file(&path, profile.map(AsRef::as_ref)).map_err(|d| assembly_error(py, &d));
     }
     Ok(AsmProgram { instructions: instructions_from(obj)?, ..AsmProgram::default() })
 }

@@ -15,6 +15,9 @@
 //! The pure-Python part (`tmclsim/__init__.py`) subclasses `Module` and
 //! `Server` to add the world convenience methods and PyTrinamic helpers.
 
+// An extension module: its API is Python's, documented in _tmclsim.pyi.
+#![allow(missing_docs)]
+
 mod advance;
 mod asm;
 mod bus;

@@ -239,7 +239,7 @@ impl Module {
         // An address GP 66 does not take would be stored in the EEPROM
         // file, and the file refused at the next start (rule 88).
         if let (Some(a), Some(p)) = (address, profile.global_parameter(0, SERIAL_ADDRESS))
-            && !p.accepts(a as i32)
+            && !p.accepts(i32::from(a))
         {
             return Err(value_error(format!("address {a}: a {} takes {} (GP 66)", profile.module.name, p.range_text())));
         }
@@ -571,7 +571,7 @@ impl Module {
     /// Switches the module off and on: RAM from factory defaults, then
     /// what the EEPROM holds (as 255 does). The carriage stays where it is.
     fn power_cycle(&mut self) -> PyResult<()> {
-        self.with(|m| m.reset())
+        self.with(tmclsim_firmware::Module::reset)
     }
 
     /// eeprom_save(path) -> None
@@ -650,10 +650,10 @@ impl Module {
     #[pyo3(signature = (start=None))]
     fn run(&mut self, start: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
         match start {
-            None => self.with(|m| m.start_program()),
+            None => self.with(tmclsim_firmware::Module::start_program),
             Some(at) => {
                 let address = self.resolve_address(at)?;
-                self.program_instruction(at.py(), Ins::new(opcode::RUN_APPLICATION, 1, 0, address as i32)).map(|_| ())
+                self.program_instruction(at.py(), Ins::new(opcode::RUN_APPLICATION, 1, 0, i32::from(address))).map(|_| ())
             }
         }
     }
@@ -672,7 +672,7 @@ impl Module {
     /// Pauses a running program as a debugger does; ``run()`` or ``step()``
     /// go on from there.
     fn pause(&mut self) -> PyResult<()> {
-        self.with(|m| m.pause_program())
+        self.with(tmclsim_firmware::Module::pause_program)
     }
 
     /// step(timeout=10.0) -> bool
@@ -778,24 +778,24 @@ impl Module {
     /// ``speed_n`` after the instruction. numpy arrays when numpy is
     /// installed, lists otherwise.
     fn take_trace<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let records = self.with(|m| m.take_trace())?;
+        let records = self.with(tmclsim_firmware::Module::take_trace)?;
         let axes = self.profile.module.axes as usize;
         let numpy = py.import("numpy").ok();
         let np = numpy.as_ref();
         let ints = |f: &dyn Fn(&tmclsim_firmware::program::TraceRecord) -> i64| records.iter().map(f).collect::<Vec<i64>>();
         let d = PyDict::new(py);
         d.set_item("time", float_column(py, np, records.iter().map(|r| r.time_ns as f64 * 1e-9).collect())?)?;
-        d.set_item("pc", column(py, np, ints(&|r| r.pc as i64))?)?;
-        d.set_item("opcode", column(py, np, ints(&|r| r.instruction.opcode as i64))?)?;
-        d.set_item("type", column(py, np, ints(&|r| r.instruction.kind as i64))?)?;
-        d.set_item("motor", column(py, np, ints(&|r| r.instruction.motor as i64))?)?;
-        d.set_item("value", column(py, np, ints(&|r| r.instruction.value as i64))?)?;
-        d.set_item("accumulator", column(py, np, ints(&|r| r.registers.accumulator as i64))?)?;
-        d.set_item("x", column(py, np, ints(&|r| r.registers.x as i64))?)?;
-        d.set_item("failed", column(py, np, ints(&|r| r.failed.unwrap_or(0) as i64))?)?;
+        d.set_item("pc", column(py, np, ints(&|r| i64::from(r.pc)))?)?;
+        d.set_item("opcode", column(py, np, ints(&|r| i64::from(r.instruction.opcode)))?)?;
+        d.set_item("type", column(py, np, ints(&|r| i64::from(r.instruction.kind)))?)?;
+        d.set_item("motor", column(py, np, ints(&|r| i64::from(r.instruction.motor)))?)?;
+        d.set_item("value", column(py, np, ints(&|r| i64::from(r.instruction.value)))?)?;
+        d.set_item("accumulator", column(py, np, ints(&|r| i64::from(r.registers.accumulator)))?)?;
+        d.set_item("x", column(py, np, ints(&|r| i64::from(r.registers.x)))?)?;
+        d.set_item("failed", column(py, np, ints(&|r| i64::from(r.failed.unwrap_or(0))))?)?;
         for a in 0..axes {
-            d.set_item(format!("position_{a}"), column(py, np, ints(&|r| r.axes.get(a).map_or(0, |x| x.0) as i64))?)?;
-            d.set_item(format!("speed_{a}"), column(py, np, ints(&|r| r.axes.get(a).map_or(0, |x| x.1) as i64))?)?;
+            d.set_item(format!("position_{a}"), column(py, np, ints(&|r| i64::from(r.axes.get(a).map_or(0, |x| x.0))))?)?;
+            d.set_item(format!("speed_{a}"), column(py, np, ints(&|r| i64::from(r.axes.get(a).map_or(0, |x| x.1))))?)?;
         }
         Ok(d)
     }
@@ -857,15 +857,15 @@ pub fn _time_core(module: &Bound<'_, Module>, operation: &str, calls: u32) -> Py
             let mut sink = 0i64;
             for n in 0..calls {
                 sink += match operation {
-                    "send_frame" => std::hint::black_box(m.handle_frame(std::hint::black_box(&frame))).map_or(0, |r| r[7] as i64),
-                    "get_axis_parameter" => m.get_axis_parameter(std::hint::black_box(4), 0).unwrap_or(0) as i64,
+                    "send_frame" => std::hint::black_box(m.handle_frame(std::hint::black_box(&frame))).map_or(0, |r| i64::from(r[7])),
+                    "get_axis_parameter" => i64::from(m.get_axis_parameter(std::hint::black_box(4), 0).unwrap_or(0)),
                     "set_axis_parameter" => m.set_axis_parameter(4, 0, std::hint::black_box(1000 + (n % 2) as i32)).map_or(0, |_| 1),
-                    "get_global_parameter" => m.get_global_parameter(std::hint::black_box(66), 0).unwrap_or(0) as i64,
+                    "get_global_parameter" => i64::from(m.get_global_parameter(std::hint::black_box(66), 0).unwrap_or(0)),
                     other => return Err(value_error(format!("unknown operation '{other}'"))),
                 };
             }
             std::hint::black_box(sink);
-            Ok(started.elapsed().as_secs_f64() / calls.max(1) as f64)
+            Ok(started.elapsed().as_secs_f64() / f64::from(calls.max(1)))
         })
     })?
 }

@@ -178,7 +178,7 @@ impl Server {
             let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
             PyErr::warn(py, &category, &message, 1)?;
         }
-        for r in refs.iter_mut() {
+        for r in &mut refs {
             r.served = true;
         }
         shared.set_stepped(stepped);

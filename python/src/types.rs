@@ -305,7 +305,7 @@ pub fn exact_text(ins: Ins) -> String {
 /// A value as the wire carries it: −2**31 … 2**32 − 1, the upper half
 /// wrapping to negative numbers.
 pub fn wire_value(v: i64) -> PyResult<i32> {
-    if (i32::MIN as i64..=u32::MAX as i64).contains(&v) {
+    if (i64::from(i32::MIN)..=i64::from(u32::MAX)).contains(&v) {
         Ok(v as u32 as i32)
     } else {
         Err(value_error(format!("{v} does not fit in 32 bits")))

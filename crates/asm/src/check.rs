@@ -84,7 +84,7 @@ impl<'a> Checker<'a> {
             op::MVP => {
                 self.motor(motor, false);
                 if kind == 2 {
-                    self.coordinate(value as i64, self.e.value_column);
+                    self.coordinate(i64::from(value), self.e.value_column);
                 }
             }
             op::SAP => {
@@ -123,7 +123,7 @@ impl<'a> Checker<'a> {
             op::GIO => self.input(kind, motor),
             op::JC | op::JA | op::CSUB | op::CALL | op::RST => self.address(value),
             op::DJNZ => {
-                self.user_variable(kind as i64, self.e.type_column);
+                self.user_variable(i64::from(kind), self.e.type_column);
                 self.address(value);
             }
             op::EI | op::DI => self.interrupt(kind, true),
@@ -134,18 +134,18 @@ impl<'a> Checker<'a> {
             // WAIT TICKS has no motor ("don't care").
             op::WAIT if kind != 0 => self.motor(motor, false),
             op::SCO | op::GCO => {
-                self.coordinate(kind as i64, self.e.type_column);
+                self.coordinate(i64::from(kind), self.e.type_column);
                 self.motor(motor, true);
             }
             op::CCO | op::ACO => {
-                self.coordinate(kind as i64, self.e.type_column);
+                self.coordinate(i64::from(kind), self.e.type_column);
                 self.motor(motor, false);
             }
             op::CALCVV => {
-                self.user_variable(motor as i64, self.e.motor_column);
-                self.user_variable(value as i64, self.e.value_column);
+                self.user_variable(i64::from(motor), self.e.motor_column);
+                self.user_variable(i64::from(value), self.e.value_column);
             }
-            op::CALCVA | op::CALCAV | op::CALCVX | op::CALCXV | op::CALCV => self.user_variable(motor as i64, self.e.motor_column),
+            op::CALCVA | op::CALCAV | op::CALCVX | op::CALCXV | op::CALCV => self.user_variable(i64::from(motor), self.e.motor_column),
             _ => {}
         }
     }
@@ -213,14 +213,14 @@ impl<'a> Checker<'a> {
         if p.accepts(value) {
             return;
         }
-        let shown = if p.max > i32::MAX as i64 { value as u32 as i64 } else { value as i64 };
+        let shown = if p.max > i64::from(i32::MAX) { i64::from(value as u32) } else { i64::from(value) };
         let message = format!("value {shown} is out of range for {what} ({}): {}...{}", p.name, p.min, p.max);
         self.report(self.e.value_column, message);
     }
 
     fn address(&mut self, target: i32) {
-        let size = self.profile.module.program_memory as i64;
-        if !(0..size).contains(&(target as i64)) {
+        let size = i64::from(self.profile.module.program_memory);
+        if !(0..size).contains(&i64::from(target)) {
             let message = format!("jump target {target} is outside the program memory of the {} (0...{})", self.module(), size - 1);
             self.report(self.e.value_column, message);
         }
@@ -245,7 +245,7 @@ impl<'a> Checker<'a> {
     }
 
     fn coordinate(&mut self, number: i64, column: usize) {
-        let max = self.profile.module.coordinates as i64;
+        let max = i64::from(self.profile.module.coordinates);
         if !(0..=max).contains(&number) {
             let message = format!("coordinate {number} does not exist on the {} (0...{max})", self.module());
             self.report(column, message);
@@ -253,7 +253,7 @@ impl<'a> Checker<'a> {
     }
 
     fn user_variable(&mut self, number: i64, column: usize) {
-        let count = self.profile.module.user_variables as i64;
+        let count = i64::from(self.profile.module.user_variables);
         if !(0..count).contains(&number) {
             let message = format!("user variable {number} does not exist on the {} (0...{})", self.module(), count - 1);
             self.report(column, message);

@@ -19,13 +19,19 @@ use crate::limits::MAX_SUGGESTION_WORK;
 /// line 0 and column 0.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
+    /// The file's name as diagnostics show it (the main file as given, an
+    /// include as its resolver names it).
     pub file: String,
+    /// 1-based line; 0 for an error of the whole file.
     pub line: usize,
+    /// 1-based column in characters; 0 for an error of the whole file.
     pub column: usize,
+    /// What is wrong, in words.
     pub message: String,
 }
 
 impl Diagnostic {
+    /// A diagnostic at `line`:`column` of `file`.
     pub fn new(file: impl Into<String>, line: usize, column: usize, message: impl Into<String>) -> Diagnostic {
         Diagnostic { file: file.into(), line, column, message: message.into() }
     }
@@ -171,7 +177,7 @@ impl Reporter {
     pub fn finish(self) -> Vec<Diagnostic> {
         let shown = self.items.len();
         let files = &self.files;
-        let file = |index: usize| files.get(index).map_or_else(String::new, |f| f.to_string());
+        let file = |index: usize| files.get(index).map_or_else(String::new, ToString::to_string);
         let mut out: Vec<Diagnostic> =
             self.items.into_sorted_vec().into_iter().map(|r| Diagnostic::new(file(r.file), r.line, r.column, r.message)).collect();
         if self.total > shown {

@@ -89,7 +89,7 @@ fn byte(value: i64, what: &str) -> Result<u8, String> {
 /// Fits a value into the 32-bit field: −2^31…2^32−1, the upper half wraps
 /// to the negative numbers the wire carries (as `protocol::mnemonic` does).
 pub fn word(value: i64) -> Result<i32, String> {
-    if (i32::MIN as i64..=u32::MAX as i64).contains(&value) {
+    if (i64::from(i32::MIN)..=i64::from(u32::MAX)).contains(&value) {
         Ok(value as u32 as i32)
     } else {
         Err(format!("value {value} does not fit in 32 bits (-2147483648...4294967295)"))

@@ -127,7 +127,7 @@ impl Table {
 
     /// The first slot to look at for a hash.
     fn home(&self, hash: u32) -> usize {
-        ((hash as u64 * self.index.len() as u64) >> 32) as usize
+        ((u64::from(hash) * self.index.len() as u64) >> 32) as usize
     }
 
     fn find(&self, name: &str) -> Option<usize> {
@@ -168,7 +168,7 @@ impl Table {
         self.entries.push(entry);
         let hash = self.hash(name);
         let slot = self.home(hash);
-        place(&mut self.index, slot, (hash as u64) << 32 | self.entries.len() as u64);
+        place(&mut self.index, slot, u64::from(hash) << 32 | self.entries.len() as u64);
         self.sorted = None;
         self.entries.len() - 1
     }
@@ -290,11 +290,11 @@ impl Evaluator {
         match &self.names {
             Names::Table(t) => match t.find(name) {
                 Some(e) if t.entries[e].is_constant() => Found::Constant(t.entries[e].data as usize),
-                Some(e) => Found::Value(t.entries[e].data as i64),
+                Some(e) => Found::Value(i64::from(t.entries[e].data)),
                 None => Found::Unknown,
             },
             Names::Maps { labels, constants } => match (labels.get(name), constants.get(name)) {
-                (Some(&address), _) => Found::Value(address as i64),
+                (Some(&address), _) => Found::Value(i64::from(address)),
                 (_, Some(&value)) => Found::Value(value),
                 _ => Found::Unknown,
             },

@@ -20,6 +20,7 @@ pub struct IncludedFile {
     pub key: String,
     /// The name diagnostics use for the file.
     pub name: String,
+    /// The file's source text.
     pub text: String,
 }
 
@@ -57,14 +58,17 @@ pub fn built_in(name: &str) -> Option<IncludedFile> {
 /// up relative to the including file's directory first, then as written.
 #[derive(Clone, Debug, Default)]
 pub struct MemoryResolver {
+    /// Path → source text.
     pub files: BTreeMap<String, String>,
 }
 
 impl MemoryResolver {
+    /// A resolver that finds no file yet.
     pub fn new() -> MemoryResolver {
         MemoryResolver::default()
     }
 
+    /// Adds a file at the path `name`.
     pub fn with(mut self, name: &str, text: &str) -> MemoryResolver {
         self.files.insert(name.to_string(), text.to_string());
         self

@@ -23,7 +23,10 @@ pub struct SourceLine {
 /// program's main file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LinePlace {
+    /// The file as the user wrote it (its end must match a file's name);
+    /// `None` for the main file.
     pub file: Option<String>,
+    /// 1-based line.
     pub line: u32,
 }
 

@@ -31,14 +31,14 @@ thread_local! {
 fn stage(what: &str) {
     STAGES.with(|s| {
         if let Some(stages) = &*s.borrow() {
-            stages.start(what)
+            stages.start(what);
         }
     });
 }
 
 pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
     let frames: Vec<[u8; 9]> = MIX.iter().map(|l| Request::new(1, parse_line(l).unwrap()).encode()).collect();
-    row!("tmclsim bench: command mix {MIX:?}, {} cores\n", std::thread::available_parallelism().map_or(1, |n| n.get()));
+    row!("tmclsim bench: command mix {MIX:?}, {} cores\n", std::thread::available_parallelism().map_or(1, std::num::NonZero::get));
     row!("| measurement | commands | result |");
     row!("|---|---:|---|");
 
@@ -61,7 +61,7 @@ fn measure(args: &crate::BenchArgs, frames: &[[u8; 9]]) -> Result<(), String> {
     let mut sink = 0u64;
     for i in 0..n {
         if let Some(r) = m.handle_frame(&frames[i % frames.len()]) {
-            sink = sink.wrapping_add(r[7] as u64);
+            sink = sink.wrapping_add(u64::from(r[7]));
         }
     }
     let dt = t.elapsed();
@@ -194,7 +194,7 @@ fn programs() -> Result<(), String> {
     let t = Instant::now();
     let p = tmclsim_asm::assemble(&src, "bench.tmc", &tmclsim_asm::NoIncludes, None).map_err(|d| tmclsim_asm::render(&d))?;
     let wall = t.elapsed().as_secs_f64();
-    row!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), lines as f64 / wall / 1e6);
+    row!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), f64::from(lines) / wall / 1e6);
     Ok(())
 }
 

@@ -48,7 +48,7 @@ pub fn unanswered(error: &str) -> bool {
 /// The profile named, or the one of the type the module reports.
 pub fn profile(client: &mut Client, named: Option<&str>) -> Result<Option<Arc<Profile>>, String> {
     if let Some(name) = named {
-        return Profile::built_in(name).map(Some);
+        return Ok(Some(Profile::built_in(name)?));
     }
     let reply = client.request(Instruction::new(opcode::FIRMWARE_VERSION, 1, 0, 0))?;
     let type_number = (reply.value as u32) >> 16;

@@ -180,9 +180,9 @@ impl Debugger {
 
 /// `prog.tmc:6 (1, Loop)`, or `address 1 (Loop)` without a source map.
 pub fn place(program: &Program, address: u16) -> String {
-    let labels: Vec<&str> = program.symbols.iter().filter(|(_, a)| **a == address as u32).map(|(l, _)| l.as_str()).collect();
+    let labels: Vec<&str> = program.symbols.iter().filter(|(_, a)| **a == u32::from(address)).map(|(l, _)| l.as_str()).collect();
     let label = if labels.is_empty() { String::new() } else { format!(", {}", labels.join(", ")) };
-    match program.source_of(address as u32) {
+    match program.source_of(u32::from(address)) {
         Some(s) => format!("{}:{} ({address}{label})", s.file, s.line),
         None => format!("address {address}{}", if labels.is_empty() { String::new() } else { format!(" ({})", labels.join(", ")) }),
     }
@@ -190,7 +190,7 @@ pub fn place(program: &Program, address: u16) -> String {
 
 /// The source text of an instruction, or its mnemonic form.
 fn text_at(program: &Program, address: u16) -> String {
-    match (program.source_of(address as u32), program.instructions.get(address as usize)) {
+    match (program.source_of(u32::from(address)), program.instructions.get(address as usize)) {
         (Some(s), _) => s.text.clone(),
         (None, Some(i)) => mnemonic::format(*i),
         (None, None) => "(end of program)".into(),
@@ -396,9 +396,9 @@ impl Quantity {
         let split = |rest: &[&str]| -> (Vec<String>, Option<i64>) {
             match rest.split_last() {
                 Some((last, words)) if !words.is_empty() && mnemonic::parse_number(last).is_some() => {
-                    (words.iter().map(|w| w.to_string()).collect(), mnemonic::parse_number(last))
+                    (words.iter().map(ToString::to_string).collect(), mnemonic::parse_number(last))
                 }
-                _ => (rest.iter().map(|w| w.to_string()).collect(), None),
+                _ => (rest.iter().map(ToString::to_string).collect(), None),
             }
         };
         match first.to_ascii_lowercase().as_str() {
@@ -447,7 +447,7 @@ impl Quantity {
                 match rest {
                     [n] => mnemonic::parse_number(n)
                         .and_then(|n| u16::try_from(n).ok())
-                        .filter(|n| u32::from(*n) < count as u32)
+                        .filter(|n| u32::from(*n) < u32::from(count))
                         .map(Quantity::Variable)
                         .ok_or_else(|| format!("user variables are 0…{}", count.saturating_sub(1))),
                     _ => Err("var takes a user variable number, e.g. var 42".into()),

@@ -264,7 +264,7 @@ pub fn bench(args: FleetBenchArgs) -> Result<ExitCode, String> {
         rtt_links(&args.fleet),
         args.rate,
         wall.as_secs_f64(),
-        std::thread::available_parallelism().map_or(1, |n| n.get())
+        std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
     );
     println!();
     println!("| measurement | result |");
@@ -283,7 +283,7 @@ pub fn bench(args: FleetBenchArgs) -> Result<ExitCode, String> {
 }
 
 fn rtt_links(path: &std::path::Path) -> usize {
-    load(path).map(|l| l.len()).unwrap_or(0)
+    load(path).map_or(0, |l| l.len())
 }
 
 fn us(d: Duration) -> f64 {

@@ -2,6 +2,11 @@
 //! The command as a library ([`run`]), so that the binary and the Python
 //! package's `tmclsim` command are one program.
 
+// The library is the command itself (the binary's and the Python
+// package's): its interface is the command line, documented by --help and
+// the manual page.
+#![allow(missing_docs)]
+
 use clap::{Args, CommandFactory, Parser, Subcommand};
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -368,7 +373,7 @@ fn man(path: &[String]) -> Result<ExitCode, String> {
     let mut page = &cli;
     for (n, name) in path.iter().enumerate() {
         page = page.find_subcommand(name).ok_or_else(|| {
-            let names: Vec<&str> = page.get_subcommands().map(|c| c.get_name()).filter(|n| *n != "help").collect();
+            let names: Vec<&str> = page.get_subcommands().map(clap::Command::get_name).filter(|n| *n != "help").collect();
             let parent = ["tmclsim".to_string()].into_iter().chain(path[..n].iter().cloned()).collect::<Vec<_>>().join(" ");
             if names.is_empty() {
                 format!("'{parent}' has no commands")

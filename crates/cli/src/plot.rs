@@ -65,11 +65,11 @@ impl Samples {
         self.time.push(m.now_ns() as f64 * 1e-9);
         for (a, s) in self.axes.iter_mut().enumerate() {
             let axis = m.axis(a);
-            s.position.push(m.actual_position(a) as f64);
-            s.target.push(axis.target_word as f64);
-            s.speed.push(m.actual_speed(a) as f64);
-            s.load.push(axis.driver.load_value as f64);
-            s.current.push(m.motor_current(a) as f64);
+            s.position.push(f64::from(m.actual_position(a)));
+            s.target.push(f64::from(axis.target_word));
+            s.speed.push(f64::from(m.actual_speed(a)));
+            s.load.push(f64::from(axis.driver.load_value));
+            s.current.push(f64::from(m.motor_current(a)));
         }
         self.outputs.push(m.outputs());
     }
@@ -167,7 +167,7 @@ impl Samples {
                 .iter()
                 .enumerate()
                 .map(|(k, &n)| {
-                    let levels: Vec<f64> = self.outputs.iter().map(|o| k as f64 * 1.5 + (o >> n & 1) as f64).collect();
+                    let levels: Vec<f64> = self.outputs.iter().map(|o| k as f64 * 1.5 + f64::from(o >> n & 1)).collect();
                     (format!("OUT{n}"), PALETTE[k % PALETTE.len()], series(&levels))
                 })
                 .collect();
@@ -270,10 +270,10 @@ mod tests {
     #[test]
     fn decimation_keeps_every_extreme() {
         let points: Vec<(f64, f64)> =
-            (0..100_000).map(|i| (i as f64, ((i * 7919) % 1000) as f64 - (i == 54_321) as i32 as f64 * 5000.0)).collect();
+            (0..100_000).map(|i| (f64::from(i), f64::from((i * 7919) % 1000) - f64::from(i32::from(i == 54_321)) * 5000.0)).collect();
         let d = decimate(points.clone());
         assert!(d.len() <= super::MAX_POINTS, "{}", d.len());
-        assert!(d.contains(&(54_321.0, -5000.0 + (54_321 * 7919 % 1000) as f64)), "the single dip survives");
+        assert!(d.contains(&(54_321.0, -5000.0 + f64::from(54_321 * 7919 % 1000))), "the single dip survives");
         assert!(d.windows(2).all(|w| w[0].0 < w[1].0), "in time order");
         assert_eq!((d[0], *d.last().unwrap()), (points[0], *points.last().unwrap()));
         assert_eq!(decimate(points[..10].to_vec()), points[..10].to_vec(), "short series stay as they are");

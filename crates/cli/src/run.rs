@@ -4,12 +4,15 @@
 use crate::asm::assemble;
 use crate::debugger::{Debug, Debugger, inspect};
 use crate::duration::parse_duration;
-use std::io::{BufRead, Write};
-use std::path::PathBuf;
+use std::fs::File;
+use std::io::{BufRead, BufWriter, Write};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Instant;
+use tmclsim_asm::Program;
 use tmclsim_firmware::program::RunMode;
-use tmclsim_firmware::{Bus, Module};
+use tmclsim_firmware::{Bus, Module, Profile};
 use tmclsim_protocol::mnemonic;
 
 #[derive(clap::Args)]
@@ -95,6 +98,31 @@ pub(crate) fn setup(module: &mut Module, path: &std::path::Path) -> Result<(), S
 
 pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let (program, profile) = assemble(&args.source, &args.module)?;
+    let (mut module, breakpoints) = prepare(&args, &program, &profile)?;
+    let mut trace = args.trace.as_deref().map(|path| open_trace(&mut module, path)).transpose()?;
+    check_outputs(&args)?;
+    let outputs = profile.ports.iter().filter(|p| p.direction == tmclsim_firmware::profile::PortDirection::Output).count() as u32;
+    let mut samples =
+        (args.plot.is_some() || args.samples.is_some()).then(|| crate::plot::Samples::new(profile.module.axes as usize, outputs));
+    module.start_program();
+    // The run drives a bus of one in stepped time, as every front end does.
+    let mut bus = Bus::single(module);
+    let started = Instant::now();
+    drive(&mut bus, &args, &program, breakpoints.is_empty(), &mut trace, &mut samples)?;
+    let module = bus.module_mut(0);
+    if let Some(mut w) = trace {
+        write_trace(&mut w, module)?;
+        w.flush().map_err(|e| e.to_string())?;
+    }
+    let wall = started.elapsed();
+    summary(module, &program, wall);
+    write_outputs(&args, samples.as_ref())?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The module of the run: in its world, with the program loaded, the setup
+/// given and the breakpoints set (which are returned as well).
+fn prepare(args: &RunArgs, program: &Program, profile: &Arc<Profile>) -> Result<(Module, Vec<u16>), String> {
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
     let mut module = Module::with_world(profile.clone(), tmclsim_firmware::Eeprom::new(&profile.module.name), world);
     module.load_program(&program.instructions).map_err(|s| format!("the program does not fit the module: {s}"))?;
@@ -103,23 +131,27 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     }
     let mut breakpoints = Vec::new();
     for b in &args.breakpoints {
-        breakpoints.push(crate::debugger::resolve(b, &program).map_err(|e| format!("--break {e}"))?);
+        breakpoints.push(crate::debugger::resolve(b, program).map_err(|e| format!("--break {e}"))?);
     }
     module.set_breakpoints(&breakpoints);
-    let mut trace = match &args.trace {
-        Some(path) => {
-            module.set_trace(true);
-            let f = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let mut w = std::io::BufWriter::new(f);
-            let mut header = "time_s,pc,instruction,accumulator,x,failed_status".to_string();
-            for m in 0..profile.module.axes {
-                header.push_str(&format!(",position_{m},speed_{m}"));
-            }
-            writeln!(w, "{header}").map_err(|e| e.to_string())?;
-            Some(w)
-        }
-        None => None,
-    };
+    Ok((module, breakpoints))
+}
+
+/// Turns the module's trace on and starts the trace CSV with its header.
+fn open_trace(module: &mut Module, path: &Path) -> Result<BufWriter<File>, String> {
+    module.set_trace(true);
+    let f = File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut w = BufWriter::new(f);
+    let mut header = "time_s,pc,instruction,accumulator,x,failed_status".to_string();
+    for m in 0..module.profile().module.axes {
+        header.push_str(&format!(",position_{m},speed_{m}"));
+    }
+    writeln!(w, "{header}").map_err(|e| e.to_string())?;
+    Ok(w)
+}
+
+/// The plot's format and the sampling step, before the run.
+fn check_outputs(args: &RunArgs) -> Result<(), String> {
     if let Some(path) = &args.plot
         && !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png") || e.eq_ignore_ascii_case("svg"))
     {
@@ -128,22 +160,27 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     if args.sample == Some(0) {
         return Err("--sample: the step is more than 0".into());
     }
-    let outputs = profile.ports.iter().filter(|p| p.direction == tmclsim_firmware::profile::PortDirection::Output).count() as u32;
-    let mut samples =
-        (args.plot.is_some() || args.samples.is_some()).then(|| crate::plot::Samples::new(profile.module.axes as usize, outputs));
-    module.start_program();
-    // The run drives a bus of one in stepped time, as every front end does.
-    let mut bus = Bus::single(module);
-    let started = Instant::now();
+    Ok(())
+}
+
+/// Runs the bus to the end of the run in slices: a plot gets 2000 samples,
+/// a trace is written as it comes, the debugger takes over at breakpoints
+/// (or from the start with `--debug`).
+fn drive(
+    bus: &mut Bus,
+    args: &RunArgs,
+    program: &Program,
+    no_breakpoints: bool,
+    trace: &mut Option<BufWriter<File>>,
+    samples: &mut Option<crate::plot::Samples>,
+) -> Result<(), String> {
     let end = args.duration;
-    // The run goes in slices: a plot gets 2000 samples, a trace is written
-    // as it comes, the debugger takes over at breakpoints.
     let slice = match args.sample {
         Some(step) => step,
-        None if breakpoints.is_empty() => (end / 2000).max(1_000_000),
+        None if no_breakpoints => (end / 2000).max(1_000_000),
         None => 1_000_000,
     };
-    if let Some(s) = &mut samples {
+    if let Some(s) = samples {
         s.take(bus.module(0));
     }
     let mut debugging = args.debug;
@@ -151,8 +188,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     let stdin = std::io::stdin();
     let mut lines = stdin.lock().lines();
     // A bar for long runs; none while a debugger may talk on the terminal.
-    let mut progress = (breakpoints.is_empty() && !args.debug)
-        .then(|| crate::progress::Progress::new(end / 1_000_000, "{bar:40} {pos}/{len} ms of virtual time"));
+    let mut progress =
+        (no_breakpoints && !args.debug).then(|| crate::progress::Progress::new(end / 1_000_000, "{bar:40} {pos}/{len} ms of virtual time"));
     while bus.now_ns() < end {
         if let Some(p) = &mut progress {
             p.set(bus.now_ns() / 1_000_000);
@@ -161,7 +198,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         // program runs on past the breakpoint it stood on.
         let at_breakpoint = bus.module(0).program().hit_breakpoint.is_some() && bus.module(0).program().mode != RunMode::Run;
         if debugging || at_breakpoint {
-            let answer = debugger.session(&mut bus, &program, &mut lines, end)?;
+            let answer = debugger.session(bus, program, &mut lines, end)?;
             match answer {
                 Debug::Continue => debugging = false,
                 Debug::Quit => break,
@@ -170,10 +207,10 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         }
         let next = bus.now_ns().saturating_add(slice).min(end);
         bus.advance_to(next);
-        if let Some(w) = &mut trace {
+        if let Some(w) = trace {
             write_trace(w, bus.module_mut(0))?;
         }
-        if let Some(s) = &mut samples {
+        if let Some(s) = samples {
             s.take(bus.module(0));
         }
         let p = bus.module(0).program();
@@ -185,23 +222,21 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     if let Some(p) = progress {
         p.finish();
     }
-    let module = bus.module_mut(0);
-    if let Some(mut w) = trace {
-        write_trace(&mut w, module)?;
-        w.flush().map_err(|e| e.to_string())?;
-    }
-    let wall = started.elapsed();
-    summary(module, &program, wall);
-    if let (Some(path), Some(s)) = (&args.samples, &samples) {
+    Ok(())
+}
+
+/// Writes the samples' CSV and the plot, where asked for.
+fn write_outputs(args: &RunArgs, samples: Option<&crate::plot::Samples>) -> Result<(), String> {
+    if let (Some(path), Some(s)) = (&args.samples, samples) {
         s.write_csv(path)?;
         println!("samples: {} ({} rows)", path.display(), s.len());
     }
-    if let (Some(path), Some(s)) = (&args.plot, &samples) {
+    if let (Some(path), Some(s)) = (&args.plot, samples) {
         let seconds = |ns: u64| ns as f64 * 1e-9;
         s.write_plot(path, args.from.map(seconds), args.to.map(seconds))?;
         println!("plot: {}", path.display());
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 fn write_trace(w: &mut impl Write, module: &mut Module) -> Result<(), String> {

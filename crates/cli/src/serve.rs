@@ -213,7 +213,7 @@ fn serve(
     match (ep.control, &token) {
         (Some(addr), None) => println!("  control: {addr}  (tmclsim world --control {addr} help)"),
         (Some(addr), Some(t)) => {
-            println!("  control: {addr}  token {t}  (send \"auth {t}\" first: tmclsim world --control {addr} auth {t} help)")
+            println!("  control: {addr}  token {t}  (send \"auth {t}\" first: tmclsim world --control {addr} auth {t} help)");
         }
         (None, _) => {}
     }

@@ -168,12 +168,12 @@ impl Esc {
 
     /// Process data watchdog time in nanoseconds (0: off).
     pub fn watchdog_ns(&self) -> u64 {
-        let divider = rd16(&self.mem, reg::WD_DIVIDER) as u64;
-        rd16(&self.mem, reg::WD_PROCESS_DATA) as u64 * (divider + 2) * 40
+        let divider = u64::from(rd16(&self.mem, reg::WD_DIVIDER));
+        u64::from(rd16(&self.mem, reg::WD_PROCESS_DATA)) * (divider + 2) * 40
     }
 
     pub fn set_watchdog_expired(&mut self, expired: bool) {
-        self.mem[reg::WD_STATUS as usize] = (!expired) as u8;
+        self.mem[reg::WD_STATUS as usize] = u8::from(!expired);
     }
 
     /// The slave puts a reply into the input mailbox (SM1).
@@ -337,8 +337,8 @@ impl Esc {
                 continue;
             }
             let log_start = u32::from_le_bytes([f[0], f[1], f[2], f[3]]);
-            let len = u16::from_le_bytes([f[4], f[5]]) as u32;
-            let phys = u16::from_le_bytes([f[8], f[9]]) as u32;
+            let len = u32::from(u16::from_le_bytes([f[4], f[5]]));
+            let phys = u32::from(u16::from_le_bytes([f[8], f[9]]));
             let kind = f[11];
             let lo = address.max(log_start);
             let hi = (address + data.len() as u32).min(log_start + len);
@@ -406,7 +406,7 @@ impl Esc {
                 let mut data = frame[range.clone()].to_vec();
                 let (r, w) = self.logical(logical, &mut data, d.command != 11, d.command != 10);
                 frame[range.clone()].copy_from_slice(&data);
-                wkc += r as u16 + if w { 2 - (d.command == 11) as u16 } else { 0 };
+                wkc += u16::from(r) + if w { 2 - u16::from(d.command == 11) } else { 0 };
             }
             // ARMW, FRMW: the addressed slave reads, the others write.
             13 | 14 => {

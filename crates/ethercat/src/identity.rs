@@ -25,7 +25,7 @@ impl Identity {
             name: profile.module.name.clone(),
             vendor_id: e.vendor_id,
             product_code: e.product_code,
-            revision: (major as u32) << 16 | minor as u32,
+            revision: u32::from(major) << 16 | u32::from(minor),
             order_code: e.order_code.clone(),
             group: e.group.clone(),
         })
@@ -33,9 +33,31 @@ impl Identity {
 
     /// [`Identity::of`], or an error naming a module that is no EtherCAT
     /// slave.
-    pub fn required(profile: &Profile) -> Result<Identity, String> {
-        Identity::of(profile)
-            .ok_or_else(|| format!("{} is no EtherCAT slave (its profile has no [features.ethercat])", profile.module.name))
+    pub fn required(profile: &Profile) -> Result<Identity, NotASlave> {
+        Identity::of(profile).ok_or_else(|| NotASlave { module: profile.module.name.clone() })
+    }
+}
+
+/// A module whose profile has no `[features.ethercat]`: it cannot be an
+/// EtherCAT slave.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NotASlave {
+    /// The module's name (`TMCM-1141`).
+    pub module: String,
+}
+
+impl std::fmt::Display for NotASlave {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} is no EtherCAT slave (its profile has no [features.ethercat])", self.module)
+    }
+}
+
+impl std::error::Error for NotASlave {}
+
+/// For callers whose errors are text (the command line).
+impl From<NotASlave> for String {
+    fn from(e: NotASlave) -> String {
+        e.to_string()
     }
 }
 

@@ -16,6 +16,9 @@
 //! returns the frame as it leaves the last slave. The raw-socket link
 //! lives in the server crate.
 
+// Not yet: the ESC registers and SII layout still lack docs.
+#![allow(missing_docs)]
+
 pub mod esc;
 pub mod frame;
 pub mod identity;
@@ -24,6 +27,6 @@ pub mod segment;
 pub mod sii;
 pub mod slave;
 
-pub use identity::Identity;
+pub use identity::{Identity, NotASlave};
 pub use segment::Segment;
 pub use slave::Slave;

@@ -4,7 +4,7 @@
 //! its effects, as on every other front end).
 
 use crate::frame;
-use crate::identity::Identity;
+use crate::identity::{Identity, NotASlave};
 use crate::slave::Slave;
 use tmclsim_firmware::{Bus, Module};
 
@@ -17,7 +17,7 @@ pub struct Segment {
 impl Segment {
     /// One slave per module, in line, with serial numbers 1, 2, …; an
     /// error names a module whose profile makes it no EtherCAT slave.
-    pub fn new(modules: Vec<Module>) -> Result<Segment, String> {
+    pub fn new(modules: Vec<Module>) -> Result<Segment, NotASlave> {
         let n = modules.len();
         let slaves = modules
             .iter()
@@ -27,7 +27,7 @@ impl Segment {
                 s.esc.next_port_open = i + 1 < n;
                 Ok(s)
             })
-            .collect::<Result<_, String>>()?;
+            .collect::<Result<_, NotASlave>>()?;
         Ok(Segment { slaves, bus: Bus::new(modules) })
     }
 

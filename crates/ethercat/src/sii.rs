@@ -52,7 +52,7 @@ fn push_u32(w: &mut Vec<u16>, v: u32) {
 
 /// Bytes → words (odd lengths padded).
 fn words(bytes: &[u8]) -> Vec<u16> {
-    bytes.chunks(2).map(|c| c[0] as u16 | (*c.get(1).unwrap_or(&0) as u16) << 8).collect()
+    bytes.chunks(2).map(|c| u16::from(c[0]) | u16::from(*c.get(1).unwrap_or(&0)) << 8).collect()
 }
 
 fn category(w: &mut Vec<u16>, kind: u16, bytes: &[u8]) {
@@ -142,7 +142,7 @@ mod tests {
     fn identity_and_categories() {
         let id = Identity::of(&tmclsim_firmware::Profile::built_in("tmcm-1310").unwrap()).unwrap();
         let w = image(&id, 7);
-        let u32_at = |i: usize| (w[i] as u32) | (w[i + 1] as u32) << 16;
+        let u32_at = |i: usize| u32::from(w[i]) | u32::from(w[i + 1]) << 16;
         assert_eq!((u32_at(8), u32_at(10), u32_at(12), u32_at(14)), (0x286, 1310, 0x0001_000E, 7));
         assert_eq!(w[0x18], MAILBOX_OUT);
         // Walk the categories.

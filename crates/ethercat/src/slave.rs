@@ -237,7 +237,7 @@ impl Slave {
     fn object(&self, index: u16, subindex: u8) -> Result<Vec<u8>, u32> {
         use mailbox::abort;
         let u32s = |v: u32| v.to_le_bytes().to_vec();
-        let mapping = |index: u16, sub: u8| u32s((index as u32) << 16 | (sub as u32) << 8 | 32);
+        let mapping = |index: u16, sub: u8| u32s(u32::from(index) << 16 | u32::from(sub) << 8 | 32);
         let missing = Err(abort::SUBINDEX_MISSING);
         Ok(match (index, subindex) {
             (0x1000, 0) => u32s(0),
@@ -269,7 +269,7 @@ impl Slave {
 
     fn serial(&self) -> u32 {
         let w = &self.esc.sii;
-        w[14] as u32 | (w[15] as u32) << 16
+        u32::from(w[14]) | u32::from(w[15]) << 16
     }
 
     /// One TMCL request over the mailbox: `[address][opcode][type][motor]

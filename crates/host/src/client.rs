@@ -46,7 +46,9 @@ impl Stream for Box<dyn serialport::SerialPort> {
 /// A link to one module address: TCP or a serial port.
 pub struct Client {
     stream: Box<dyn Stream + Send>,
+    /// The module address every request goes to.
     pub address: u8,
+    /// How long a reply may take to arrive completely.
     pub timeout: Duration,
 }
 
@@ -150,6 +152,7 @@ pub struct RawLink {
     /// fail with `WouldBlock` or `TimedOut`, so a reading thread can look
     /// up now and then.
     pub reader: Box<dyn Read + Send>,
+    /// Writes go straight to the link (TCP waits up to 5 s).
     pub writer: Box<dyn Write + Send>,
 }
 
@@ -187,6 +190,7 @@ fn no_reply(got: usize) -> String {
     }
 }
 
+/// Bytes as upper-case hex pairs separated by spaces (`01 06 …`).
 pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02X}")).collect::<Vec<_>>().join(" ")
 }

@@ -51,6 +51,7 @@ pub enum LoadError {
 }
 
 impl LoadError {
+    /// The message for the user, whichever kind of failure.
     pub fn message(&self) -> &str {
         match self {
             LoadError::Unreadable(m) | LoadError::Refused(m) => m,
@@ -128,7 +129,7 @@ pub fn load_for(path: &Path, profile: &Profile) -> Result<(Eeprom, bool), LoadEr
 /// user's file, a read-only file system). `None`: no such file, or one
 /// tmclsim may replace.
 pub fn read_only(path: &Path) -> Option<String> {
-    let meta = std::fs::metadata(path).ok().filter(|m| m.is_file())?;
+    let meta = std::fs::metadata(path).ok().filter(std::fs::Metadata::is_file)?;
     let mode = meta.permissions().mode() & 0o7777;
     if mode & 0o200 == 0 {
         return Some(format!("the file is read-only (mode {mode:04o}: no write permission for its owner)"));
@@ -195,7 +196,7 @@ fn write_atomic(path: &Path, image: &Eeprom) -> std::io::Result<()> {
     }
     // The file keeps its permissions; a new one gets what a created file
     // gets (0666 less the umask).
-    let mode = std::fs::metadata(path).ok().filter(|m| m.is_file()).map(|m| m.permissions().mode() & 0o7777);
+    let mode = std::fs::metadata(path).ok().filter(std::fs::Metadata::is_file).map(|m| m.permissions().mode() & 0o7777);
     let mut tmp = tempfile::Builder::new()
         .prefix(&format!(".{name}."))
         .suffix(".tmp")

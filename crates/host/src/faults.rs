@@ -3,6 +3,7 @@
 
 use std::time::Duration;
 
+/// The faults a link applies to the replies it sends (none by default).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LinkFaults {
     /// Drop this many of the next replies.

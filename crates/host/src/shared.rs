@@ -52,6 +52,7 @@ pub struct Stats {
 }
 
 impl Stats {
+    /// The counts of two buses together: sums, and the larger of the maxima.
     pub fn merged(self, o: Stats) -> Stats {
         Stats {
             frames: self.frames + o.frames,
@@ -109,22 +110,23 @@ impl SharedBus {
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, State> {
-        self.state.lock().unwrap_or_else(|p| p.into_inner())
+        self.state.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
+    /// The counters of this bus's clock and frames so far.
     pub fn stats(&self) -> Stats {
-        *self.stats.lock().unwrap_or_else(|p| p.into_inner())
+        *self.stats.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
     /// `wake` is called whenever something changed the bus's plans (a
     /// request, an advance, the clock switched): a server's clock task
     /// waits for it. It replaces the one set before.
     pub fn set_waker(&self, wake: impl Fn() + Send + Sync + 'static) {
-        *self.waker.lock().unwrap_or_else(|p| p.into_inner()) = Some(Arc::new(wake));
+        *self.waker.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(Arc::new(wake));
     }
 
     fn wake(&self) {
-        let waker = self.waker.lock().unwrap_or_else(|p| p.into_inner()).clone();
+        let waker = self.waker.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         if let Some(wake) = waker {
             wake();
         }
@@ -132,7 +134,7 @@ impl SharedBus {
 
     /// The clock woke `late_ns` after a due time.
     pub fn record_wakeup(&self, late_ns: u64) {
-        let mut s = self.stats.lock().unwrap_or_else(|p| p.into_inner());
+        let mut s = self.stats.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         s.wakeups += 1;
         if late_ns > 1_000_000 {
             s.missed_deadlines += 1;
@@ -145,23 +147,25 @@ impl SharedBus {
         self.lock().bus.len()
     }
 
+    /// No module on the link.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 
     /// The link faults in force.
     pub fn link_faults(&self) -> LinkFaults {
-        *self.faults.lock().unwrap_or_else(|p| p.into_inner())
+        *self.faults.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
+    /// Replaces the link faults in force.
     pub fn set_link_faults(&self, f: LinkFaults) {
-        *self.faults.lock().unwrap_or_else(|p| p.into_inner()) = f;
+        *self.faults.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = f;
     }
 
     /// Passes an outgoing frame through the link faults: `None` drops it;
     /// the duration is an extra delay.
     pub fn outgoing(&self, frame: [u8; FRAME_LEN]) -> (Option<[u8; FRAME_LEN]>, Duration) {
-        let mut f = self.faults.lock().unwrap_or_else(|p| p.into_inner());
+        let mut f = self.faults.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let delay = f.delay;
         (f.apply(frame), delay)
     }
@@ -184,6 +188,7 @@ impl SharedBus {
         self.wake();
     }
 
+    /// Whether time stands still between calls of [`SharedBus::advance`].
     pub fn is_stepped(&self) -> bool {
         self.lock().bus.clock().is_stepped()
     }
@@ -255,7 +260,7 @@ impl SharedBus {
     /// Handles one frame from link `link`, whose events go to `sink`.
     /// Returns the replies and how long to wait before sending them.
     pub fn handle(&self, link: u64, sink: &EventSink, frame: &[u8; FRAME_LEN]) -> (Vec<[u8; FRAME_LEN]>, Duration) {
-        self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
+        self.stats.lock().unwrap_or_else(std::sync::PoisonError::into_inner).frames += 1;
         let mut s = self.lock();
         // The addressed modules first catch up on their own, so that what
         // their programs store is not taken for the request's.
@@ -273,7 +278,7 @@ impl SharedBus {
 
     /// Handles a CAN frame: every module sees it, those it is for answer.
     pub fn handle_can(&self, link: u64, sink: &EventSink, frame: &CanFrame) -> Vec<CanFrame> {
-        self.stats.lock().unwrap_or_else(|p| p.into_inner()).frames += 1;
+        self.stats.lock().unwrap_or_else(std::sync::PoisonError::into_inner).frames += 1;
         let mut s = self.lock();
         let before = Self::generations(&mut s, Bus::catch_up);
         let mut replies = s.bus.handle_can(frame);

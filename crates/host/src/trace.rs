@@ -35,6 +35,7 @@ pub enum Dir {
 }
 
 impl Dir {
+    /// The word a trace file uses: `host` or `module`.
     pub fn as_str(self) -> &'static str {
         match self {
             Dir::Host => "host",
@@ -46,10 +47,13 @@ impl Dir {
 /// One frame of a trace, with the line it stands on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Entry {
+    /// 1-based line of the trace file.
     pub line: usize,
     /// Nanoseconds since the start of the recording.
     pub t_ns: u64,
+    /// Who sent the frame.
     pub dir: Dir,
+    /// The frame's nine bytes.
     pub frame: [u8; FRAME_LEN],
 }
 
@@ -195,6 +199,7 @@ pub struct Writer<W: Write> {
 }
 
 impl<W: Write> Writer<W> {
+    /// A writer of a new trace whose time starts at 0.
     pub fn new(out: W) -> Self {
         Writer { out, last_ns: 0, entries: 0 }
     }
@@ -275,6 +280,7 @@ pub fn windowed(ins: Instruction) -> bool {
 /// The outcome of comparing one recorded reply.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Verdict {
+    /// The replies agree.
     Match,
     /// A difference, with a note on what the virtual module's value could
     /// have been (empty when the replies speak for themselves).

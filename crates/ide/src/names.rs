@@ -26,7 +26,7 @@ pub fn snake(name: &str) -> String {
 
 /// The lookup key of a name: its letters and digits in lower case.
 pub fn key(name: &str) -> String {
-    name.chars().filter(|c| c.is_ascii_alphanumeric()).map(|c| c.to_ascii_lowercase()).collect()
+    name.chars().filter(char::is_ascii_alphanumeric).map(|c| c.to_ascii_lowercase()).collect()
 }
 
 /// Which table a command's type operand names.

@@ -9,8 +9,13 @@
 //! search, stall detection, encoder, CAN identifiers, EEPROM lock, …). The
 //! firmware and the assembler read them; neither knows module names.
 
+// Not yet: the profile schema's fields still lack docs.
+#![allow(missing_docs)]
+
+mod error;
 mod features;
 
+pub use error::{FeatureProblem, ParameterProblem, ProfileError};
 pub use features::{CanIds, EepromMagic, Encoder, Features, ReferenceSearchFamily, StallDetection};
 
 use serde::Deserialize;
@@ -30,7 +35,8 @@ pub struct Access {
 }
 
 impl Access {
-    pub fn parse(text: &str) -> Result<Access, String> {
+    /// Reads the letters of a manual's access column (`RWE`, `R`, …).
+    pub fn parse(text: &str) -> Result<Access, ProfileError> {
         let mut a = Access::default();
         for c in text.chars() {
             match c {
@@ -38,7 +44,7 @@ impl Access {
                 'W' => a.write = true,
                 'E' => a.eeprom = true,
                 'A' => a.auto = true,
-                _ => return Err(format!("unknown access letter '{c}' in \"{text}\"")),
+                _ => return Err(ProfileError::AccessLetter { letter: c, text: text.to_string() }),
             }
         }
         Ok(a)
@@ -124,7 +130,7 @@ impl Parameter {
     /// it). Ranges above 2^31−1 (the timer periods of bank 3) read the 32
     /// bits as unsigned.
     pub fn accepts(&self, value: i32) -> bool {
-        let v = if self.max > i32::MAX as i64 { value as u32 as i64 } else { value as i64 };
+        let v = if self.max > i64::from(i32::MAX) { i64::from(value as u32) } else { i64::from(value) };
         (self.min..=self.max).contains(&v) && (self.ranges.is_empty() || self.ranges.iter().any(|&(lo, hi)| (lo..=hi).contains(&v)))
     }
 
@@ -260,7 +266,10 @@ struct ParameterRow {
     default_source: DefaultSource,
     #[serde(default)]
     unit: Option<String>,
+    /// Where the row's facts come from (a manual's page): for readers of
+    /// the file, not for the simulation.
     #[serde(default)]
+    #[allow(dead_code)]
     source: Option<String>,
     #[serde(default)]
     note: Option<String>,
@@ -347,79 +356,23 @@ include!(concat!(env!("OUT_DIR"), "/built_in.rs"));
 
 impl Profile {
     /// Parses and checks a profile.
-    pub fn from_toml(text: &str) -> Result<Profile, String> {
-        let file: ProfileFile = toml::from_str(text).map_err(|e| e.to_string())?;
+    pub fn from_toml(text: &str) -> Result<Profile, ProfileError> {
+        let file: ProfileFile = toml::from_str(text).map_err(ProfileError::Toml)?;
         let mut axis: Vec<Option<Parameter>> = vec![None; 256];
-        let mut global: [Vec<Option<Parameter>>; BANKS] = std::array::from_fn(|_| vec![None; 256]);
-        let expand = |row: &ParameterRow, table: &mut Vec<Option<Parameter>>| -> Result<(), String> {
-            let access = Access::parse(&row.access)?;
-            if !(row.min..=row.max).contains(&row.default) {
-                return Err(format!("parameter {} ({}): default {} outside {}…{}", row.number, row.name, row.default, row.min, row.max));
-            }
-            if row.ranges.iter().any(|&[lo, hi]| lo > hi || lo < row.min || hi > row.max) {
-                return Err(format!(
-                    "parameter {} ({}): ranges must lie within {}…{}, each from ≤ to",
-                    row.number, row.name, row.min, row.max
-                ));
-            }
-            if !row.ranges.is_empty() && !row.ranges.iter().any(|&[lo, hi]| (lo..=hi).contains(&row.default)) {
-                return Err(format!("parameter {} ({}): default {} outside its ranges", row.number, row.name, row.default));
-            }
-            if row.default_source == DefaultSource::Sibling && row.note.as_deref().is_none_or(|n| n.trim().is_empty()) {
-                return Err(format!(
-                    "parameter {} ({}): default_source \"sibling\" needs a note naming the module or code the default comes from",
-                    row.number, row.name
-                ));
-            }
-            let _ = &row.source;
-            if row.each.as_ref().is_some_and(|e| row.last.is_none() || !e.contains("{}")) {
-                return Err(format!(
-                    "parameter {} ({}): `each` names the parameters of a range (with `last`), `{{}}` for the number",
-                    row.number, row.name
-                ));
-            }
-            for n in row.number..=row.last.unwrap_or(row.number) {
-                if table[n as usize].is_some() {
-                    return Err(format!("parameter {n} ({}) is defined twice", row.name));
-                }
-                table[n as usize] = Some(Parameter {
-                    number: n,
-                    name: row.name.clone(),
-                    own_name: row.each.as_ref().map(|e| e.replace("{}", &n.to_string())),
-                    access,
-                    min: row.min,
-                    max: row.max,
-                    default: row.default,
-                    default_source: row.default_source,
-                    unit: row.unit.clone(),
-                    note: row.note.clone(),
-                    ranges: row.ranges.iter().map(|&[lo, hi]| (lo, hi)).collect(),
-                    quantity: row.quantity,
-                });
-            }
-            Ok(())
-        };
         for row in &file.axis_parameter {
             expand(row, &mut axis)?;
         }
+        let mut global: [Vec<Option<Parameter>>; BANKS] = std::array::from_fn(|_| vec![None; 256]);
         for row in &file.global_parameter {
-            let bank = row.bank.ok_or_else(|| format!("global parameter {} has no bank", row.number))? as usize;
-            if bank >= BANKS {
-                return Err(format!("global parameter {}: bank {bank} does not exist", row.number));
-            }
-            expand(row, &mut global[bank])?;
-        }
-        let mut opcode_set = [false; 256];
-        for &o in &file.module.opcodes {
-            opcode_set[o as usize] = true;
-        }
-        let mut ascii_set = [false; 256];
-        for &o in &file.module.ascii_opcodes {
-            ascii_set[o as usize] = true;
+            let bank = row.bank.ok_or(ProfileError::NoBank { number: row.number })?;
+            let table = global.get_mut(bank as usize).ok_or(ProfileError::NoSuchBank { number: row.number, bank })?;
+            expand(row, table)?;
         }
         if file.module.axes == 0 {
-            return Err("a module has at least one axis".into());
+            return Err(ProfileError::NoAxis);
         }
+        let opcode_set = set_of(&file.module.opcodes);
+        let ascii_set = set_of(&file.module.ascii_opcodes);
         let sources: Vec<(InterruptSource, u8)> =
             file.interrupt.iter().filter_map(|i| InterruptSource::from_symbol(&i.symbol).map(|s| (s, i.number))).collect();
         let timer = |t: u8| sources.iter().find(|(s, _)| *s == InterruptSource::Timer(t)).map(|(_, n)| *n);
@@ -436,23 +389,27 @@ impl Profile {
             opcode_set,
             ascii_set,
         };
-        check_features(&profile)?;
+        check_features(&profile).map_err(ProfileError::Features)?;
         Ok(profile)
     }
 
     /// A built-in profile by name (`tmcm-1141`, case-insensitive, the
     /// `tmcm-` prefix optional).
-    pub fn built_in(name: &str) -> Result<Arc<Profile>, String> {
+    pub fn built_in(name: &str) -> Result<Arc<Profile>, ProfileError> {
         let key = name.to_ascii_lowercase();
         let key = if key.starts_with("tmcm-") { key } else { format!("tmcm-{key}") };
         // Each built-in profile is parsed once per process and shared.
-        static PARSED: [std::sync::OnceLock<Result<Arc<Profile>, String>>; BUILT_IN.len()] =
+        static PARSED: [std::sync::OnceLock<Result<Arc<Profile>, ProfileError>>; BUILT_IN.len()] =
             [const { std::sync::OnceLock::new() }; BUILT_IN.len()];
         let i = BUILT_IN
             .iter()
             .position(|(n, _)| *n == key)
-            .ok_or_else(|| format!("no built-in profile '{name}' (known: {})", Profile::names().join(", ")))?;
-        PARSED[i].get_or_init(|| Profile::from_toml(BUILT_IN[i].1).map(Arc::new).map_err(|e| format!("profile {key}: {e}"))).clone()
+            .ok_or_else(|| ProfileError::NotBuiltIn { name: name.to_string(), known: Profile::names() })?;
+        PARSED[i]
+            .get_or_init(|| {
+                Profile::from_toml(BUILT_IN[i].1).map(Arc::new).map_err(|e| ProfileError::BuiltIn { name: key, error: Box::new(e) })
+            })
+            .clone()
     }
 
     /// The built-in profiles' names, sorted (`tmcm-1110`, `tmcm-1140`, …).
@@ -535,21 +492,80 @@ impl Profile {
 
     /// 136 type 1 value: `[type high][type low][major][minor]`.
     pub fn version_word(&self) -> i32 {
-        ((self.module.type_number as u32) << 16 | (self.module.firmware[0] as u32) << 8 | self.module.firmware[1] as u32) as i32
+        (u32::from(self.module.type_number) << 16 | u32::from(self.module.firmware[0]) << 8 | u32::from(self.module.firmware[1])) as i32
     }
 
     /// Position counter mask for modules with 24-bit positions.
     pub fn position_bits(&self) -> u32 {
-        self.module.position_bits as u32
+        u32::from(self.module.position_bits)
     }
 }
 
 /// GP 65: the baud rate code that the features' `baud_rates` is indexed by.
 const BAUD_RATE: u8 = 65;
 
+/// A lookup table of the opcodes listed.
+fn set_of(opcodes: &[u8]) -> [bool; 256] {
+    let mut set = [false; 256];
+    for &o in opcodes {
+        set[o as usize] = true;
+    }
+    set
+}
+
+/// Checks one row of a parameter table and enters the parameters it
+/// defines (one, or `number…last`) into `table`.
+fn expand(row: &ParameterRow, table: &mut [Option<Parameter>]) -> Result<(), ProfileError> {
+    let access = Access::parse(&row.access)?;
+    check_row(row).map_err(|problem| ProfileError::Parameter { number: row.number, name: row.name.clone(), problem })?;
+    for n in row.number..=row.last.unwrap_or(row.number) {
+        if table[n as usize].is_some() {
+            return Err(ProfileError::DefinedTwice { number: n, name: row.name.clone() });
+        }
+        table[n as usize] = Some(Parameter {
+            number: n,
+            name: row.name.clone(),
+            own_name: row.each.as_ref().map(|e| e.replace("{}", &n.to_string())),
+            access,
+            min: row.min,
+            max: row.max,
+            default: row.default,
+            default_source: row.default_source,
+            unit: row.unit.clone(),
+            note: row.note.clone(),
+            ranges: row.ranges.iter().map(|&[lo, hi]| (lo, hi)).collect(),
+            quantity: row.quantity,
+        });
+    }
+    Ok(())
+}
+
+/// The rules of one parameter row: default within its bounds and ranges,
+/// ranges within the bounds, a note for a sibling's default, `each` only on
+/// a range.
+fn check_row(row: &ParameterRow) -> Result<(), ParameterProblem> {
+    let (min, max, default) = (row.min, row.max, row.default);
+    if !(min..=max).contains(&default) {
+        return Err(ParameterProblem::DefaultOutside { default, min, max });
+    }
+    if row.ranges.iter().any(|&[lo, hi]| lo > hi || lo < min || hi > max) {
+        return Err(ParameterProblem::RangesOutside { min, max });
+    }
+    if !row.ranges.is_empty() && !row.ranges.iter().any(|&[lo, hi]| (lo..=hi).contains(&default)) {
+        return Err(ParameterProblem::DefaultOutsideRanges { default });
+    }
+    if row.default_source == DefaultSource::Sibling && row.note.as_deref().is_none_or(|n| n.trim().is_empty()) {
+        return Err(ParameterProblem::SiblingWithoutNote);
+    }
+    if row.each.as_ref().is_some_and(|e| row.last.is_none() || !e.contains("{}")) {
+        return Err(ParameterProblem::EachWithoutRange);
+    }
+    Ok(())
+}
+
 /// Checks a profile's features against the rest of it: every global
 /// parameter they name exists, and the lists fit.
-fn check_features(profile: &Profile) -> Result<(), String> {
+fn check_features(profile: &Profile) -> Result<(), FeatureProblem> {
     let f = &profile.features;
     let named = [
         ("shutdown_pin", f.shutdown_pin),
@@ -563,31 +579,31 @@ fn check_features(profile: &Profile) -> Result<(), String> {
         if let Some(n) = n
             && profile.global_parameter(0, n).is_none()
         {
-            return Err(format!("features.{key} names global parameter {n}, which the profile does not have (bank 0)"));
+            return Err(FeatureProblem::MissingParameter { key, number: n });
         }
     }
     if f.baud_rates.is_empty() {
-        return Err("features.baud_rates is empty: it needs at least the rate of code 0".into());
+        return Err(FeatureProblem::NoBaudRates);
     }
     if let Some(p) = profile.global_parameter(0, BAUD_RATE)
         && p.max + 1 != f.baud_rates.len() as i64
     {
-        return Err(format!(
-            "features.baud_rates has {} rates, but GP {BAUD_RATE} ({}) takes codes {}…{}",
-            f.baud_rates.len(),
-            p.name,
-            p.min,
-            p.max
-        ));
+        return Err(FeatureProblem::BaudRates {
+            rates: f.baud_rates.len(),
+            parameter: BAUD_RATE,
+            name: p.name.clone(),
+            min: p.min,
+            max: p.max,
+        });
     }
     if f.full_scale_current_ma == 0 {
-        return Err("features.full_scale_current_ma is 0".into());
+        return Err(FeatureProblem::NoCurrent);
     }
     if f.motion_clock_hz == 0 {
-        return Err("features.motion_clock_hz is 0".into());
+        return Err(FeatureProblem::NoClock);
     }
     if f.encoder_deviation_stop && f.encoder == Encoder::None {
-        return Err("features.encoder_deviation_stop needs an encoder (features.encoder is \"none\")".into());
+        return Err(FeatureProblem::DeviationStopWithoutEncoder);
     }
     Ok(())
 }
@@ -612,7 +628,7 @@ mod tests {
         let no_number = t.replacen("each = \"User variable {}\"", "each = \"User variable\"", 1);
         let no_range = t.replacen("last = 55\n", "", 1);
         for broken in [no_number, no_range] {
-            assert!(Profile::from_toml(&broken).unwrap_err().contains("`each`"));
+            assert!(Profile::from_toml(&broken).unwrap_err().to_string().contains("`each`"));
         }
     }
 
@@ -638,7 +654,7 @@ mod tests {
             );
             Profile::built_in(name).unwrap_or_else(|e| panic!("{e}"));
         }
-        let e = Profile::built_in("tmcm-9999").unwrap_err();
+        let e = Profile::built_in("tmcm-9999").unwrap_err().to_string();
         assert!(e.contains("known: ") && e.contains(&Profile::names().join(", ")), "{e}");
     }
 
@@ -712,7 +728,7 @@ mod tests {
         let dup = format!(
             "{base}\n[[axis_parameter]]\nnumber = 4\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\ndefault_source = \"assumed\"\n"
         );
-        assert!(Profile::from_toml(&dup).unwrap_err().contains("twice"));
+        assert!(Profile::from_toml(&dup).unwrap_err().to_string().contains("twice"));
     }
 
     #[test]
@@ -724,12 +740,12 @@ mod tests {
         assert_eq!(p.axis_parameter(0).unwrap().default_source, DefaultSource::Assumed);
         let row = "[[axis_parameter]]\nnumber = 250\nname = \"x\"\naccess = \"RW\"\nmin = 0\nmax = 1\ndefault = 0\n";
         let base = text("tmcm-1141");
-        let unknown = Profile::from_toml(&format!("{base}\n{row}default_source = \"folklore\"\n")).unwrap_err();
+        let unknown = Profile::from_toml(&format!("{base}\n{row}default_source = \"folklore\"\n")).unwrap_err().to_string();
         assert!(
             unknown.contains("folklore") && unknown.contains("manual") && unknown.contains("sibling") && unknown.contains("assumed"),
             "{unknown}"
         );
-        let bare = Profile::from_toml(&format!("{base}\n{row}default_source = \"sibling\"\n")).unwrap_err();
+        let bare = Profile::from_toml(&format!("{base}\n{row}default_source = \"sibling\"\n")).unwrap_err().to_string();
         assert!(bare.contains("parameter 250 (x)") && bare.contains("needs a note"), "{bare}");
         Profile::from_toml(&format!("{base}\n{row}default_source = \"sibling\"\nnote = \"TMCM-1140 manual\"\n")).unwrap();
     }
@@ -758,7 +774,7 @@ mod tests {
             assert_eq!(mode.range_text(), "1…8, 65…68, 133…136");
         }
         let bad = text("tmcm-1141").replace("ranges = [[1, 8], [65, 68], [133, 136]]", "ranges = [[1, 8], [65, 200]]");
-        assert!(Profile::from_toml(&bad).unwrap_err().contains("ranges must lie within 1…136"));
+        assert!(Profile::from_toml(&bad).unwrap_err().to_string().contains("ranges must lie within 1…136"));
     }
 }
 
@@ -875,11 +891,15 @@ mod feature_tests {
 
     #[test]
     fn an_unknown_feature_is_rejected_by_name() {
-        let e = Profile::from_toml(&with_features("tmcm-1141", "teleport = true")).unwrap_err();
+        let e = Profile::from_toml(&with_features("tmcm-1141", "teleport = true")).unwrap_err().to_string();
         assert!(e.contains("unknown field") && e.contains("teleport"), "{e}");
-        let e = Profile::from_toml(&replacing("tmcm-351", "secondary_id = 83\n", "secondary_id = 83\nbroadcast_id = 1\n")).unwrap_err();
+        let e = Profile::from_toml(&replacing("tmcm-351", "secondary_id = 83\n", "secondary_id = 83\nbroadcast_id = 1\n"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("unknown field") && e.contains("broadcast_id"), "{e}");
-        let e = Profile::from_toml(&replacing("tmcm-1141", "reference_search = \"tmc429\"", "reference_search = \"tmc430\"")).unwrap_err();
+        let e = Profile::from_toml(&replacing("tmcm-1141", "reference_search = \"tmc429\"", "reference_search = \"tmc430\""))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("tmc430"), "{e}");
     }
 
@@ -888,26 +908,29 @@ mod feature_tests {
         let t = text("tmcm-1141");
         let start = t.find("\n[features]\n").unwrap();
         let end = start + t[start..].find("\n# ---").unwrap();
-        let e = Profile::from_toml(&format!("{}{}", &t[..start], &t[end..])).unwrap_err();
+        let e = Profile::from_toml(&format!("{}{}", &t[..start], &t[end..])).unwrap_err().to_string();
         assert!(e.contains("features"), "{e}");
         // So is every key that is not optional.
-        let e = Profile::from_toml(&replacing("tmcm-1141", "coolstep = true", "")).unwrap_err();
+        let e = Profile::from_toml(&replacing("tmcm-1141", "coolstep = true", "")).unwrap_err().to_string();
         assert!(e.contains("coolstep"), "{e}");
     }
 
     #[test]
     fn features_must_name_parameters_the_profile_has() {
         // The TMCM-1141 has no GP 73.
-        let e = Profile::from_toml(&with_features("tmcm-1141", "eeprom_lock = 73")).unwrap_err();
+        let e = Profile::from_toml(&with_features("tmcm-1141", "eeprom_lock = 73")).unwrap_err().to_string();
         assert!(e.contains("features.eeprom_lock") && e.contains("73"), "{e}");
-        let e = Profile::from_toml(&with_features("tmcm-1141", "can = { id = 71, reply_id = 70, secondary_id = 83 }")).unwrap_err();
+        let e =
+            Profile::from_toml(&with_features("tmcm-1141", "can = { id = 71, reply_id = 70, secondary_id = 83 }")).unwrap_err().to_string();
         assert!(e.contains("features.can.id"), "{e}");
         // One rate per GP 65 code.
-        let e = Profile::from_toml(&replacing("tmcm-1141", ", 230400]", "]")).unwrap_err();
+        let e = Profile::from_toml(&replacing("tmcm-1141", ", 230400]", "]")).unwrap_err().to_string();
         assert!(e.contains("baud_rates") && e.contains("0…8"), "{e}");
-        let e = Profile::from_toml(&replacing("tmcm-1310", "baud_rates = [9600]", "baud_rates = []")).unwrap_err();
+        let e = Profile::from_toml(&replacing("tmcm-1310", "baud_rates = [9600]", "baud_rates = []")).unwrap_err().to_string();
         assert!(e.contains("baud_rates"), "{e}");
-        let e = Profile::from_toml(&replacing("tmcm-1141", "encoder_deviation_stop = false", "encoder_deviation_stop = true")).unwrap_err();
+        let e = Profile::from_toml(&replacing("tmcm-1141", "encoder_deviation_stop = false", "encoder_deviation_stop = true"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("needs an encoder"), "{e}");
     }
 

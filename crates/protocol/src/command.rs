@@ -439,16 +439,22 @@ impl Command {
     /// Decodes an instruction. Fields the manual marks "don't care" are
     /// ignored.
     pub fn decode(i: Instruction) -> Result<Command, DecodeError> {
+        let decoded = match i.opcode {
+            op::ROR..=op::GIO => Self::decode_motion(i)?,
+            op::CALC..=op::AIV | op::CALL => Self::decode_program(i)?,
+            op::UF0..=op::UF7 => Some(Command::UserFunction { number: i.opcode - op::UF0, kind: i.kind, motor: i.motor, value: i.value }),
+            op::STOP_APPLICATION.. => Self::decode_control(i)?,
+            _ => None,
+        };
+        decoded.ok_or(DecodeError::UnknownOpcode(i.opcode))
+    }
+
+    /// Motors, parameters and ports (instructions 1…15); `None` for an
+    /// unknown number.
+    fn decode_motion(i: Instruction) -> Result<Option<Command>, DecodeError> {
         let Instruction { opcode, kind, motor, value } = i;
         let wrong = DecodeError::WrongType { opcode, kind };
-        // CALC allows 0…9, CALCX 0…10, the user-variable family 0…11
-        // (CALCV has no SWAP).
-        let calc = |max: u8| match CalcOp::from_code(kind) {
-            Some(c) if kind <= max => Ok(c),
-            _ => Err(wrong),
-        };
-        let condition = || Condition::from_code(kind).ok_or(wrong);
-        Ok(match opcode {
+        Ok(Some(match opcode {
             op::ROR => Command::Ror { motor, velocity: value },
             op::ROL => Command::Rol { motor, velocity: value },
             op::MST => Command::Mst { motor },
@@ -472,6 +478,23 @@ impl Command {
             }
             op::SIO => Command::Sio { port: kind, bank: motor, value },
             op::GIO => Command::Gio { port: kind, bank: motor },
+            _ => return Ok(None),
+        }))
+    }
+
+    /// The instructions of stand-alone programs (19…57, CALL); `None` for
+    /// an unknown number.
+    fn decode_program(i: Instruction) -> Result<Option<Command>, DecodeError> {
+        let Instruction { opcode, kind, motor, value } = i;
+        let wrong = DecodeError::WrongType { opcode, kind };
+        // CALC allows 0…9, CALCX 0…10, the user-variable family 0…11
+        // (CALCV has no SWAP).
+        let calc = |max: u8| match CalcOp::from_code(kind) {
+            Some(c) if kind <= max => Ok(c),
+            _ => Err(wrong),
+        };
+        let condition = || Condition::from_code(kind).ok_or(wrong);
+        Ok(Some(match opcode {
             op::CALC => Command::Calc { op: calc(9)?, value },
             op::COMP => Command::Comp { value },
             op::JC => Command::Jc { condition: condition()?, address: value },
@@ -513,37 +536,36 @@ impl Command {
             op::SIV => Command::Siv { value },
             op::GIV => Command::Giv,
             op::AIV => Command::Aiv,
-            op::UF0..=op::UF7 => Command::UserFunction { number: opcode - op::UF0, kind, motor, value },
             op::CALL => Command::Call { condition: condition()?, address: value },
-            op::STOP_APPLICATION => Command::StopApplication,
-            op::RUN_APPLICATION => match kind {
-                0 => Command::RunApplication { from: None },
-                1 => Command::RunApplication { from: Some(value) },
-                _ => return Err(wrong),
-            },
-            op::STEP_APPLICATION => Command::StepApplication,
-            op::RESET_APPLICATION => Command::ResetApplication,
-            op::ENTER_DOWNLOAD => Command::EnterDownload { address: value },
-            op::EXIT_DOWNLOAD => Command::ExitDownload,
-            op::READ_MEMORY => Command::ReadMemory { address: value },
-            op::APPLICATION_STATUS => match kind {
-                0..=3 => Command::ApplicationStatus { kind },
-                _ => return Err(wrong),
-            },
-            op::FIRMWARE_VERSION => match kind {
-                0 => Command::FirmwareVersion { binary: false },
-                1 => Command::FirmwareVersion { binary: true },
-                _ => return Err(wrong),
-            },
-            op::FACTORY_DEFAULTS => Command::FactoryDefaults { key: value },
-            op::TARGET_REACHED_EVENT => match kind {
-                0 | 1 => Command::TargetReachedEvent { every_move: kind == 1, mask: value },
-                _ => return Err(wrong),
-            },
-            op::ASCII_MODE => Command::AsciiMode,
-            op::RESET => Command::Reset { key: value },
-            _ => return Err(DecodeError::UnknownOpcode(opcode)),
-        })
+            _ => return Ok(None),
+        }))
+    }
+
+    /// The host's control of the application and the module (128…);
+    /// `None` for an unknown number.
+    fn decode_control(i: Instruction) -> Result<Option<Command>, DecodeError> {
+        let Instruction { opcode, kind, value, .. } = i;
+        let command = match (opcode, kind) {
+            (op::STOP_APPLICATION, _) => Command::StopApplication,
+            (op::RUN_APPLICATION, 0) => Command::RunApplication { from: None },
+            (op::RUN_APPLICATION, 1) => Command::RunApplication { from: Some(value) },
+            (op::STEP_APPLICATION, _) => Command::StepApplication,
+            (op::RESET_APPLICATION, _) => Command::ResetApplication,
+            (op::ENTER_DOWNLOAD, _) => Command::EnterDownload { address: value },
+            (op::EXIT_DOWNLOAD, _) => Command::ExitDownload,
+            (op::READ_MEMORY, _) => Command::ReadMemory { address: value },
+            (op::APPLICATION_STATUS, 0..=3) => Command::ApplicationStatus { kind },
+            (op::FIRMWARE_VERSION, 0 | 1) => Command::FirmwareVersion { binary: kind == 1 },
+            (op::FACTORY_DEFAULTS, _) => Command::FactoryDefaults { key: value },
+            (op::TARGET_REACHED_EVENT, 0 | 1) => Command::TargetReachedEvent { every_move: kind == 1, mask: value },
+            (op::ASCII_MODE, _) => Command::AsciiMode,
+            (op::RESET, _) => Command::Reset { key: value },
+            (op::RUN_APPLICATION | op::APPLICATION_STATUS | op::FIRMWARE_VERSION | op::TARGET_REACHED_EVENT, _) => {
+                return Err(DecodeError::WrongType { opcode, kind });
+            }
+            _ => return Ok(None),
+        };
+        Ok(Some(command))
     }
 
     /// The instruction number of this command.
@@ -617,9 +639,9 @@ impl Command {
             ExitDownload => i(op::EXIT_DOWNLOAD, 0, 0, 0),
             ReadMemory { address } => i(op::READ_MEMORY, 0, 0, address),
             ApplicationStatus { kind } => i(op::APPLICATION_STATUS, kind, 0, 0),
-            FirmwareVersion { binary } => i(op::FIRMWARE_VERSION, binary as u8, 0, 0),
+            FirmwareVersion { binary } => i(op::FIRMWARE_VERSION, u8::from(binary), 0, 0),
             FactoryDefaults { key } => i(op::FACTORY_DEFAULTS, 0, 0, key),
-            TargetReachedEvent { every_move, mask } => i(op::TARGET_REACHED_EVENT, every_move as u8, 0, mask),
+            TargetReachedEvent { every_move, mask } => i(op::TARGET_REACHED_EVENT, u8::from(every_move), 0, mask),
             AsciiMode => i(op::ASCII_MODE, 0, 0, 0),
             Reset { key } => i(op::RESET, 0, 0, key),
         }

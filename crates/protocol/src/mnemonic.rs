@@ -180,7 +180,7 @@ pub fn parse_line(line: &str) -> Result<Instruction, ParseError> {
             }
             Operand::Motor => ins.motor = byte(number()?)?,
             Operand::Value | Operand::Address => {
-                ins.value = to_i32(number()?).ok_or_else(|| err(col, format!("'{text}' is out of 32-bit range")))?
+                ins.value = to_i32(number()?).ok_or_else(|| err(col, format!("'{text}' is out of 32-bit range")))?;
             }
         }
     }
@@ -190,7 +190,7 @@ pub fn parse_line(line: &str) -> Result<Instruction, ParseError> {
 /// Values from −2^31 to 2^32−1 are accepted; the upper half wraps to the
 /// negative numbers the wire carries.
 fn to_i32(v: i64) -> Option<i32> {
-    if (i32::MIN as i64..=u32::MAX as i64).contains(&v) { Some(v as u32 as i32) } else { None }
+    if (i64::from(i32::MIN)..=i64::from(u32::MAX)).contains(&v) { Some(v as u32 as i32) } else { None }
 }
 
 /// Whether the operands of the instruction's mnemonic cover every non-zero
@@ -218,7 +218,7 @@ pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
         .iter()
         .map(|k| match k {
             Operand::Type => ins.kind.to_string(),
-            Operand::TypeSymbol(table) => table.get(ins.kind as usize).map_or(ins.kind.to_string(), |s| s.to_string()),
+            Operand::TypeSymbol(table) => table.get(ins.kind as usize).map_or(ins.kind.to_string(), ToString::to_string),
             Operand::Motor => ins.motor.to_string(),
             Operand::Value => ins.value.to_string(),
             Operand::Address => label(ins.value),

@@ -166,11 +166,11 @@ async fn read_line(r: &mut (impl AsyncBufRead + Unpin), max: usize, line: &mut V
             None => (available.len(), false),
         };
         if line.len() + taken > max {
-            r.consume(taken + ended as usize);
+            r.consume(taken + usize::from(ended));
             return Ok(Line::TooLong { ended });
         }
         line.extend_from_slice(&available[..taken]);
-        r.consume(taken + ended as usize);
+        r.consume(taken + usize::from(ended));
         if ended {
             if line.last() == Some(&b'\r') {
                 line.pop();

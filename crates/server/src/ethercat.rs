@@ -22,12 +22,14 @@ pub struct EthercatHandle {
     /// Saves EEPROM writes; ends once the frame thread has ended and
     /// every write it handed over is saved.
     saver: Option<std::thread::JoinHandle<()>>,
+    /// The slaves, shared with the frame thread.
     pub segment: Arc<Mutex<Segment>>,
     /// Frames processed and frames ignored (not EtherCAT or malformed).
     pub counters: Arc<Mutex<(u64, u64)>>,
 }
 
 impl EthercatHandle {
+    /// Stops the frame thread and waits until every EEPROM write is saved.
     pub fn stop(mut self) {
         self.shutdown();
     }
@@ -37,6 +39,8 @@ impl EthercatHandle {
         self.join();
     }
 
+    /// Waits, without asking it to stop, until the frame thread ends and
+    /// every EEPROM write is saved.
     pub fn wait(mut self) {
         self.join();
     }
@@ -68,7 +72,7 @@ fn open(iface: &str) -> io::Result<(libc::c_int, libc::c_int)> {
         if index == 0 {
             return Err(io::Error::new(io::ErrorKind::NotFound, format!("no network interface '{iface}'")));
         }
-        let fd = check(libc::socket(libc::AF_PACKET, libc::SOCK_RAW, (ETH_P_ALL).to_be() as i32))?;
+        let fd = check(libc::socket(libc::AF_PACKET, libc::SOCK_RAW, i32::from((ETH_P_ALL).to_be())))?;
         let mut sll: libc::sockaddr_ll = std::mem::zeroed();
         sll.sll_family = libc::AF_PACKET as u16;
         sll.sll_protocol = ETH_P_ALL.to_be();
@@ -130,7 +134,7 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>
                 continue;
             }
             let processed = {
-                let mut seg = t_segment.lock().unwrap_or_else(|p| p.into_inner());
+                let mut seg = t_segment.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
                 let processed = seg.process(frame);
                 // Effects: EEPROM writes go to the saver; events have no link.
                 for i in seg.bus.take_effects().eeprom_written {
@@ -139,7 +143,7 @@ pub fn serve(iface: &str, mut segment: Segment, eeproms: Vec<Option<EepromFile>>
                 processed
             };
             {
-                let mut c = t_counters.lock().unwrap_or_else(|p| p.into_inner());
+                let mut c = t_counters.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
                 if processed { c.0 += 1 } else { c.1 += 1 }
             }
             if !processed {
@@ -195,7 +199,7 @@ fn save_writes(written: mpsc::Receiver<(usize, Eeprom)>, mut files: EepromFiles,
         newest.extend(std::iter::once(first).chain(written.try_iter()));
         for (i, image) in newest {
             if !files.save(i, &image) {
-                let mut seg = segment.lock().unwrap_or_else(|p| p.into_inner());
+                let mut seg = segment.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
                 seg.bus.module_mut(i).restore_eeprom(files.held(i).clone());
             }
         }

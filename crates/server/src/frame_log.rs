@@ -14,9 +14,12 @@ use std::sync::OnceLock;
 use std::time::Instant;
 use tmclsim_protocol::{FRAME_LEN, Reply, Request, Status, mnemonic};
 
+/// Which way a logged frame goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Direction {
+    /// From the host to the modules.
     In,
+    /// From a module to the host.
     Out,
 }
 

@@ -38,6 +38,7 @@ use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_firmware::Module;
 use tokio::sync::watch;
+use tokio::task::JoinSet;
 
 /// What to serve and where.
 #[derive(Clone, Debug)]
@@ -114,6 +115,7 @@ impl Default for ServerConfig {
 /// The endpoints a running server listens on.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Endpoints {
+    /// The TCP listener's address (the port the system chose for port 0).
     pub tcp: Option<SocketAddr>,
     /// The symlink a host opens, and the pty device it points to.
     pub pty: Option<(PathBuf, PathBuf)>,
@@ -137,7 +139,9 @@ impl Endpoints {
 /// One served link: its endpoints and the bus of its module(s).
 #[derive(Clone)]
 pub struct LinkHandle {
+    /// Where the link is served.
     pub endpoints: Endpoints,
+    /// The bus of the link's modules, shared with its tasks.
     pub bus: Arc<SharedBus>,
 }
 
@@ -201,7 +205,9 @@ impl Drop for ServerHandle {
 
 /// What one link serves and how.
 pub struct LinkSpec {
+    /// The modules on the link, each with the file its EEPROM is saved in.
     pub modules: Vec<(Module, Option<Arc<EepromFile>>)>,
+    /// The link's endpoints and options.
     pub config: ServerConfig,
 }
 
@@ -231,6 +237,18 @@ struct Opened {
     pty: Option<pty::Pty>,
     control: Option<tokio::net::TcpListener>,
     slcan: Option<pty::Pty>,
+}
+
+impl Opened {
+    /// Where this link is served, as its handle reports it.
+    fn endpoints(&self) -> Endpoints {
+        Endpoints {
+            tcp: self.tcp.as_ref().and_then(|l| l.local_addr().ok()),
+            pty: self.pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
+            control: self.control.as_ref().and_then(|l| l.local_addr().ok()),
+            slcan: self.slcan.as_ref().map(|p| (p.link.clone(), p.device.clone())),
+        }
+    }
 }
 
 async fn open(config: &ServerConfig) -> std::io::Result<Opened> {
@@ -362,6 +380,10 @@ pub fn start_shared(bus: Arc<SharedBus>, config: ServerConfig) -> std::io::Resul
     serve_buses(vec![(bus, config)])
 }
 
+/// What the server thread hands back once its links are open: their
+/// endpoints and the pty links' claims, or why a link did not open.
+type Ready = std::io::Result<(Vec<Endpoints>, Vec<pty::LinkClaim>)>;
+
 fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<ServerHandle> {
     for (bus, config) in &specs {
         check(config)?;
@@ -373,7 +395,6 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
     let warn = specs.iter().any(|(_, c)| c.warn_exposure);
     let shared: Vec<Arc<SharedBus>> = specs.iter().map(|(m, _)| m.clone()).collect();
     let (stop_tx, stop_rx) = watch::channel(false);
-    type Ready = std::io::Result<(Vec<Endpoints>, Vec<pty::LinkClaim>)>;
     let (ready_tx, ready_rx) = std::sync::mpsc::channel::<Ready>();
     let thread = std::thread::Builder::new().name("tmclsim-server".into()).spawn(move || {
         let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
@@ -383,68 +404,7 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
                 return;
             }
         };
-        rt.block_on(async move {
-            // On an error, what was opened so far is dropped: listeners
-            // close, pty links and their locks are removed.
-            let mut opened = Vec::with_capacity(specs.len());
-            for (_, config) in &specs {
-                match open(config).await {
-                    Ok(o) => opened.push(o),
-                    Err(e) => {
-                        drop(opened);
-                        let _ = ready_tx.send(Err(e));
-                        return;
-                    }
-                }
-            }
-            let claims =
-                opened.iter_mut().flat_map(|o| [o.pty.as_mut(), o.slcan.as_mut()]).flatten().filter_map(|p| p.claim.take()).collect();
-            let endpoints = opened
-                .iter()
-                .map(|o| Endpoints {
-                    tcp: o.tcp.as_ref().and_then(|l| l.local_addr().ok()),
-                    pty: o.pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
-                    control: o.control.as_ref().and_then(|l| l.local_addr().ok()),
-                    slcan: o.slcan.as_ref().map(|p| (p.link.clone(), p.device.clone())),
-                })
-                .collect();
-            let _ = ready_tx.send(Ok((endpoints, claims)));
-            let mut tasks = tokio::task::JoinSet::new();
-            for ((bus, config), o) in specs.into_iter().zip(opened) {
-                tasks.spawn(clock::run(bus.clone(), stop_rx.clone()));
-                if let Some(listener) = o.tcp {
-                    tasks.spawn(tcp::run(listener, bus.clone(), config.clone(), stop_rx.clone()));
-                }
-                if let Some(p) = o.pty {
-                    tasks.spawn(pty::run(p, bus.clone(), config.clone(), stop_rx.clone()));
-                }
-                if let Some(listener) = o.control {
-                    tasks.spawn(control::run(listener, bus.clone(), config.clone(), stop_rx.clone()));
-                }
-                if let Some(p) = o.slcan {
-                    tasks.spawn(slcan::run(p, bus.clone(), stop_rx.clone()));
-                }
-            }
-            let mut stop = stop_rx.clone();
-            // The server stops when asked, or when one of its tasks panics:
-            // then every link closes rather than a listener staying open
-            // in front of a task that is gone.
-            let failed = async {
-                loop {
-                    match tasks.join_next().await {
-                        Some(Err(e)) if e.is_panic() => return e,
-                        Some(_) => {}
-                        None => std::future::pending::<()>().await,
-                    }
-                }
-            };
-            tokio::select! {
-                _ = stop.wait_for(|s| *s) => {}
-                e = failed => eprintln!("tmclsim: a server task failed ({e}); every link of this server is closed"),
-            }
-            tasks.abort_all();
-            while tasks.join_next().await.is_some() {}
-        });
+        rt.block_on(serve_opened(specs, &ready_tx, stop_rx));
     })?;
     let ready = ready_rx.recv().map_err(|_| std::io::Error::other("server thread ended early")).and_then(|r| r);
     let (endpoints, claims) = match ready {
@@ -461,4 +421,72 @@ fn serve_buses(specs: Vec<(Arc<SharedBus>, ServerConfig)>) -> std::io::Result<Se
     }
     let links = endpoints.into_iter().zip(shared).map(|(endpoints, bus)| LinkHandle { endpoints, bus }).collect();
     Ok(ServerHandle { links, claims, stop: stop_tx, thread: Some(thread) })
+}
+
+/// The server thread's work: opens every link, reports them ready, serves
+/// them until asked to stop. On an error, what was opened so far is
+/// dropped: listeners close, pty links and their locks are removed.
+async fn serve_opened(
+    specs: Vec<(Arc<SharedBus>, ServerConfig)>,
+    ready_tx: &std::sync::mpsc::Sender<Ready>,
+    stop_rx: watch::Receiver<bool>,
+) {
+    let mut opened = Vec::with_capacity(specs.len());
+    for (_, config) in &specs {
+        match open(config).await {
+            Ok(o) => opened.push(o),
+            Err(e) => {
+                drop(opened);
+                let _ = ready_tx.send(Err(e));
+                return;
+            }
+        }
+    }
+    let claims = opened.iter_mut().flat_map(|o| [o.pty.as_mut(), o.slcan.as_mut()]).flatten().filter_map(|p| p.claim.take()).collect();
+    let endpoints = opened.iter().map(Opened::endpoints).collect();
+    let _ = ready_tx.send(Ok((endpoints, claims)));
+    let mut tasks = tokio::task::JoinSet::new();
+    for ((bus, config), o) in specs.into_iter().zip(opened) {
+        spawn_link(&mut tasks, o, &bus, &config, &stop_rx);
+    }
+    until_stopped(tasks, stop_rx).await;
+}
+
+/// The tasks of one link: its clock and whichever of TCP, pty, control
+/// port and slcan it serves.
+fn spawn_link(tasks: &mut JoinSet<()>, o: Opened, bus: &Arc<SharedBus>, config: &ServerConfig, stop_rx: &watch::Receiver<bool>) {
+    tasks.spawn(clock::run(bus.clone(), stop_rx.clone()));
+    if let Some(listener) = o.tcp {
+        tasks.spawn(tcp::run(listener, bus.clone(), config.clone(), stop_rx.clone()));
+    }
+    if let Some(p) = o.pty {
+        tasks.spawn(pty::run(p, bus.clone(), config.clone(), stop_rx.clone()));
+    }
+    if let Some(listener) = o.control {
+        tasks.spawn(control::run(listener, bus.clone(), config.clone(), stop_rx.clone()));
+    }
+    if let Some(p) = o.slcan {
+        tasks.spawn(slcan::run(p, bus.clone(), stop_rx.clone()));
+    }
+}
+
+/// Runs the tasks until the server is asked to stop, or until one of them
+/// panics: then every link closes rather than a listener staying open in
+/// front of a task that is gone.
+async fn until_stopped(mut tasks: JoinSet<()>, mut stop: watch::Receiver<bool>) {
+    let failed = async {
+        loop {
+            match tasks.join_next().await {
+                Some(Err(e)) if e.is_panic() => return e,
+                Some(_) => {}
+                None => std::future::pending::<()>().await,
+            }
+        }
+    };
+    tokio::select! {
+        _ = stop.wait_for(|s| *s) => {}
+        e = failed => eprintln!("tmclsim: a server task failed ({e}); every link of this server is closed"),
+    }
+    tasks.abort_all();
+    while tasks.join_next().await.is_some() {}
 }

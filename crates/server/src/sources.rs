@@ -34,10 +34,12 @@ pub fn assemble_file(path: impl AsRef<Path>, profile: Option<&Profile>) -> Resul
 /// from extra search directories in order.
 #[derive(Clone, Debug, Default)]
 pub struct FileResolver {
+    /// Directories searched after the including file's own, in order.
     pub search_path: Vec<PathBuf>,
 }
 
 impl FileResolver {
+    /// A resolver with no extra search directories.
     pub fn new() -> FileResolver {
         FileResolver::default()
     }

@@ -8,6 +8,10 @@
 //! [`page::Page`] is the playground's side of the browser IDE: its API
 //! answered in the page, over `Sim`s (the class `Playground`).
 
+// A binding: its public items are the JavaScript API that wasm-bindgen
+// generates.
+#![allow(missing_docs)]
+
 mod bindings;
 pub mod page;
 pub mod sim;

@@ -35,7 +35,7 @@ impl PageTarget {
         let sim = self.sims.get(id).ok_or(TargetError::NoModule)?;
         // A panic cannot leave a module half changed here (wasm aborts on
         // one): a poisoned lock is taken as it is.
-        Ok(sim.lock().unwrap_or_else(|e| e.into_inner()))
+        Ok(sim.lock().unwrap_or_else(std::sync::PoisonError::into_inner))
     }
 }
 

@@ -48,6 +48,12 @@ impl From<&str> for Failure {
     }
 }
 
+impl From<tmclsim_profile::ProfileError> for Failure {
+    fn from(e: tmclsim_profile::ProfileError) -> Failure {
+        Failure::new(e.to_string())
+    }
+}
+
 /// The module's answer to a command line.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Answer {

@@ -43,7 +43,7 @@ struct Users {
 
 impl Gate {
     fn users(&self) -> MutexGuard<'_, Users> {
-        self.state.lock().unwrap_or_else(|p| p.into_inner())
+        self.state.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 }
 
@@ -69,7 +69,7 @@ impl Downloading {
         let gate = &self.0[self.1];
         let mut users = gate.users();
         while users.requests > 0 {
-            users = gate.free.wait(users).unwrap_or_else(|p| p.into_inner());
+            users = gate.free.wait(users).unwrap_or_else(std::sync::PoisonError::into_inner);
         }
     }
 }

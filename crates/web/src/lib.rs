@@ -28,6 +28,7 @@ pub const DEFAULT_ADDR: &str = "127.0.0.1:8141";
 /// Where and how the app is served.
 #[derive(Clone, Debug)]
 pub struct WebConfig {
+    /// The address to listen on (port 0: the system picks one).
     pub addr: SocketAddr,
     /// Allow a non-loopback address; every request then needs the token.
     pub public: bool,
@@ -44,6 +45,7 @@ pub struct WebHandle {
 }
 
 impl WebHandle {
+    /// The address the app listens on, with the port it got.
     pub fn addr(&self) -> SocketAddr {
         self.addr
     }

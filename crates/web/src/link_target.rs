@@ -22,6 +22,7 @@ struct Debug {
     halt: Option<(Arc<AtomicBool>, std::thread::JoinHandle<()>)>,
 }
 
+/// The modules on one TMCL link, as the app's target.
 pub struct LinkTarget {
     /// The target itself, for the stepping thread of a run with
     /// breakpoints.
@@ -101,7 +102,7 @@ impl LinkTarget {
     /// Asks every address 1…255 for its type and firmware (136 type 1,
     /// a short wait each, then 136 type 0 for those that answered).
     pub fn scan(&self) -> Vec<Found> {
-        let mut c = self.client.lock().unwrap_or_else(|p| p.into_inner());
+        let mut c = self.client.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let addresses = scan_addresses(&mut c, self.scan_timeout);
         addresses
             .into_iter()
@@ -114,13 +115,13 @@ impl LinkTarget {
 
     fn exchange(&self, id: usize, ins: Instruction) -> Result<[u8; FRAME_LEN], TargetError> {
         let address = self.entries.get(id).ok_or(TargetError::NoModule)?.address;
-        let mut c = self.client.lock().unwrap_or_else(|p| p.into_inner());
+        let mut c = self.client.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         c.address = address;
         c.exchange(ins).map_err(TargetError::Failed)
     }
 
     fn with_debug<R>(&self, id: usize, f: impl FnOnce(&mut Debug) -> R) -> R {
-        f(self.debug.lock().unwrap_or_else(|p| p.into_inner()).entry(id).or_default())
+        f(self.debug.lock().unwrap_or_else(std::sync::PoisonError::into_inner).entry(id).or_default())
     }
 
     /// The run mode and program counter (135 type 1).

@@ -24,14 +24,14 @@ pub const MAX_PENALTY: std::time::Duration = std::time::Duration::from_secs(2);
 impl Failures {
     /// Counts one more failure; the wait before it is answered.
     pub fn penalty(&self) -> std::time::Duration {
-        let mut n = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        let mut n = self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         *n = n.saturating_add(1);
         std::time::Duration::from_millis(10u64 << (*n).min(8)).min(MAX_PENALTY)
     }
 
     /// A request with the right token ends the run of failures.
     pub fn clear(&self) {
-        *self.0.lock().unwrap_or_else(|p| p.into_inner()) = 0;
+        *self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = 0;
     }
 }
 

@@ -16,6 +16,7 @@ struct Place {
     index: usize,
 }
 
+/// The virtual modules of the running server's links, as the app's target.
 pub struct VirtualTarget {
     entries: Vec<ModuleEntry>,
     places: Vec<Place>,

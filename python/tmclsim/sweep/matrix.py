@@ -429,7 +429,8 @@ def check_depth(doc: Any, what: str = "the matrix") -> None:
 
 
 def parse(doc: Dict[str, Any]) -> Matrix:
-    """A matrix from the parsed TOML document."""
+    """A matrix from the parsed TOML document. Its parts are read in a
+    fixed order, and the first mistake met is the one reported."""
     if not isinstance(doc, dict):
         raise MatrixError("the matrix is a table (a TOML document)")
     check_depth(doc)
@@ -438,6 +439,24 @@ def parse(doc: Dict[str, Any]) -> Matrix:
         if k not in known:
             raise MatrixError(f"{_show(k)}: unknown key (known: {', '.join(sorted(known))})")
     mx = Matrix()
+    _timing(mx, doc)
+    _world_and_setup(mx, doc)
+    for k in ("vary", "check"):
+        if not isinstance(doc.get(k, []), list):
+            raise MatrixError(f"{k}: a list of tables ([[{k}]] sections)")
+    if len(doc.get("vary", [])) > MAX_AXES:
+        raise MatrixError(f"vary: {len(doc['vary'])} [[vary]] sections; at most {MAX_AXES}")
+    draws, worlds = _vary(mx, doc)
+    _draw_values(mx, draws, worlds)
+    _stop(mx, doc)
+    _checks(mx, doc)
+    _metrics(mx, doc)
+    _columns(mx)
+    return mx
+
+
+def _timing(mx: Matrix, doc: Dict[str, Any]) -> None:
+    """The profile, duration, step (and so the looks per scenario), seed."""
     mx.profile = _profile(doc.get("profile", mx.profile), "profile")
     mx.duration = duration(doc.get("duration", "60s"), "duration")
     mx.step = duration(doc.get("step", "100ms"), "step")
@@ -450,6 +469,10 @@ def parse(doc: Dict[str, Any]) -> Matrix:
         raise MatrixError(f"step: {seconds_text(mx.duration)} s in steps of {seconds_text(mx.step)} s is {looks} looks per scenario; "
                           f"at most {MAX_LOOKS} (a longer step or a shorter duration)")
     mx.seed = _int(doc.get("seed", 0), "seed", -MAX_SEED, MAX_SEED)
+
+
+def _world_and_setup(mx: Matrix, doc: Dict[str, Any]) -> None:
+    """The world of every scenario and the direct-mode commands before it."""
     world = doc.get("world", {"base": "stage"})
     if not isinstance(world, dict):
         raise MatrixError("world: a table with the keys of a world file (docs/world.md)")
@@ -458,51 +481,21 @@ def parse(doc: Dict[str, Any]) -> Matrix:
     if not isinstance(setup, list) or not all(isinstance(x, str) for x in setup):
         raise MatrixError("setup: a list of direct-mode commands, e.g. [\"SAP 4, 0, 1000\"]")
     mx.setup = list(setup)
-    for k in ("vary", "check"):
-        if not isinstance(doc.get(k, []), list):
-            raise MatrixError(f"{k}: a list of tables ([[{k}]] sections)")
-    if len(doc.get("vary", [])) > MAX_AXES:
-        raise MatrixError(f"vary: {len(doc['vary'])} [[vary]] sections; at most {MAX_AXES}")
+
+
+def _vary(mx: Matrix, doc: Dict[str, Any]) -> Tuple[Dict[int, Tuple[Any, Any, bool]], List[Tuple[str, str]]]:
+    """The [[vary]] axes, with their values listed or counted: the random
+    ones (by axis index) are drawn once the sweep's size is known, the
+    world keys (key, dotted path) checked against its modules."""
     seen = set()
     draws: Dict[int, Tuple[Any, Any, bool]] = {}
     worlds: List[Tuple[str, str]] = []
     for i, entry in enumerate(doc.get("vary", [])):
         key = f"vary[{i}]"
-        if not isinstance(entry, dict):
-            raise MatrixError(f"{key}: a table ([[vary]])")
-        targets = [t for t in ("world", "ap", "gp", "profile") if t in entry]
-        if len(targets) != 1:
-            raise MatrixError(f"{key}: name what it varies with exactly one of world = \"axis.0.home_switch.from\", ap = N, gp = N, profile = true")
-        target = targets[0]
-        allowed = {"name", target, "values", "range", "random"} | ({"motor"} if target == "ap" else {"bank"} if target == "gp" else set())
-        for k in entry:
-            if k not in allowed:
-                raise MatrixError(f"{key}.{_show(k)}: unknown key")
-        if target == "world":
-            path = entry["world"]
-            if not isinstance(path, str) or not path:
-                raise MatrixError(f"{key}.world: a dotted key of the world file, e.g. \"axis.0.home_switch.from\"")
+        axis, path = _axis(entry, key, seen)
+        if path is not None:
             worlds.append((f"{key}.world", path))
-            name = entry.get("name", path)
-            axis = Axis(name, "world", path, 0, [])
-        elif target == "profile":
-            name = entry.get("name", "profile")
-            axis = Axis(name, "profile", None, 0, [])
-        else:
-            what = entry[target]
-            if isinstance(what, bool) or not isinstance(what, (int, str)):
-                raise MatrixError(f"{key}.{target}: a parameter number or name")
-            if isinstance(what, int):
-                _byte(what, f"{key}.{target}")
-            which = "motor" if target == "ap" else "bank"
-            index = _byte(entry.get(which, 0), f"{key}.{which}")
-            name = entry.get("name", f"{target} {what} {index}")
-            axis = Axis(name, target, what, index, [])
-        if not isinstance(name, str) or not name:
-            raise MatrixError(f"{key}.name: a column name (text)")
-        if name in seen:
-            raise MatrixError(f"{key}.name: '{_show(name)}' is used twice")
-        seen.add(name)
+        target = axis.target
         count, values = _values(entry, key)
         if isinstance(values, tuple):
             # Drawn below, once the sweep's size is known.
@@ -515,6 +508,52 @@ def parse(doc: Dict[str, Any]) -> Matrix:
                 _profile(v, f"{key}.values[{j}]")
         axis.values = values
         mx.axes.append(axis)
+    return draws, worlds
+
+
+def _axis(entry: Any, key: str, seen: set) -> Tuple[Axis, Optional[str]]:
+    """One [[vary]] table's axis, without values, and the dotted world key
+    it varies (None for another target); its name joins `seen`."""
+    if not isinstance(entry, dict):
+        raise MatrixError(f"{key}: a table ([[vary]])")
+    targets = [t for t in ("world", "ap", "gp", "profile") if t in entry]
+    if len(targets) != 1:
+        raise MatrixError(f"{key}: name what it varies with exactly one of world = \"axis.0.home_switch.from\", ap = N, gp = N, profile = true")
+    target = targets[0]
+    allowed = {"name", target, "values", "range", "random"} | ({"motor"} if target == "ap" else {"bank"} if target == "gp" else set())
+    for k in entry:
+        if k not in allowed:
+            raise MatrixError(f"{key}.{_show(k)}: unknown key")
+    if target == "world":
+        path = entry["world"]
+        if not isinstance(path, str) or not path:
+            raise MatrixError(f"{key}.world: a dotted key of the world file, e.g. \"axis.0.home_switch.from\"")
+        name = entry.get("name", path)
+        axis = Axis(name, "world", path, 0, [])
+    elif target == "profile":
+        name = entry.get("name", "profile")
+        axis = Axis(name, "profile", None, 0, [])
+    else:
+        what = entry[target]
+        if isinstance(what, bool) or not isinstance(what, (int, str)):
+            raise MatrixError(f"{key}.{target}: a parameter number or name")
+        if isinstance(what, int):
+            _byte(what, f"{key}.{target}")
+        which = "motor" if target == "ap" else "bank"
+        index = _byte(entry.get(which, 0), f"{key}.{which}")
+        name = entry.get("name", f"{target} {what} {index}")
+        axis = Axis(name, target, what, index, [])
+    if not isinstance(name, str) or not name:
+        raise MatrixError(f"{key}.name: a column name (text)")
+    if name in seen:
+        raise MatrixError(f"{key}.name: '{_show(name)}' is used twice")
+    seen.add(name)
+    return axis, (path if target == "world" else None)
+
+
+def _draw_values(mx: Matrix, draws: Dict[int, Tuple[Any, Any, bool]], worlds: List[Tuple[str, str]]) -> None:
+    """Counts the scenarios, then draws the random values and checks the
+    world keys on every module the sweep runs on."""
     # The scenarios are counted before any value is drawn or listed.
     total = mx.count()
     if total > MAX_SCENARIOS:
@@ -527,6 +566,10 @@ def parse(doc: Dict[str, Any]) -> Matrix:
     profiles = next((a.values for a in mx.axes if a.target == "profile"), [mx.profile])
     for key, path in worlds:
         world_key(path, key, sorted({p.lower() for p in profiles}))
+
+
+def _stop(mx: Matrix, doc: Dict[str, Any]) -> None:
+    """When a scenario ends before its duration."""
     stop = doc.get("stop", {})
     if not isinstance(stop, dict) or set(stop) - {"program_ended", "when"}:
         raise MatrixError("stop: a table with program_ended = true|false and when = [\"var 0 != 0\", …]")
@@ -538,6 +581,10 @@ def parse(doc: Dict[str, Any]) -> Matrix:
     if not isinstance(when, list):
         raise MatrixError("stop.when: a list of conditions, e.g. [\"var 0 != 0\"]")
     mx.stop_when = [Condition.parse(t, f"stop.when[{i}]") for i, t in enumerate(when)]
+
+
+def _checks(mx: Matrix, doc: Dict[str, Any]) -> None:
+    """The [[check]] tables: what makes a scenario pass."""
     for i, c in enumerate(doc.get("check", [])):
         key = f"check[{i}]"
         if not isinstance(c, dict):
@@ -563,6 +610,10 @@ def parse(doc: Dict[str, Any]) -> Matrix:
             if c[kind] is not True:
                 raise MatrixError(f"{key}.{kind}: write {kind} = true")
             mx.checks.append(Check(name, kind))
+
+
+def _metrics(mx: Matrix, doc: Dict[str, Any]) -> None:
+    """The values each scenario reports beside its axes."""
     metrics = doc.get("metrics", ["time"])
     if not isinstance(metrics, list):
         raise MatrixError("metrics: a list, e.g. [\"time\", \"max_load\", \"ap 1 0\"]")
@@ -585,7 +636,11 @@ def parse(doc: Dict[str, Any]) -> Matrix:
                 raise MatrixError(f"metrics[{i}]: '{_show(x)}' is listed twice")
             mx.metrics.append(read.label())
             mx.metric_reads.append(read)
-    # Every column of the table has one name.
+
+
+def _columns(mx: Matrix) -> None:
+    """Every column of the table has one name: the fixed ones, the axes',
+    the metrics'."""
     columns = {"scenario", "passed", "failed_check", "error"}
     for i, a in enumerate(mx.axes):
         if a.name in columns:
@@ -594,7 +649,6 @@ def parse(doc: Dict[str, Any]) -> Matrix:
     for i, name in enumerate(mx.metrics):
         if name in columns:
             raise MatrixError(f"metrics[{i}]: '{_show(name)}' is a column of the table already (a [[vary]] name?)")
-    return mx
 
 
 # Outside strings and comments: the characters that open, close or divide

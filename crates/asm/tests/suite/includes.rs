@@ -27,7 +27,7 @@ fn shipped_include_files_assemble_and_match_the_profile() {
     let profile = tmcm_1141();
     let interrupts = assemble_path(shipped("Interrupts.inc"), Some(&profile)).unwrap_or_else(|d| panic!("{}", render(&d)));
     assert!(interrupts.instructions.is_empty());
-    let expected: BTreeSet<(String, i64)> = profile.interrupts.iter().map(|i| (i.symbol.clone(), i.number as i64)).collect();
+    let expected: BTreeSet<(String, i64)> = profile.interrupts.iter().map(|i| (i.symbol.clone(), i64::from(i.number))).collect();
     let found: BTreeSet<(String, i64)> = interrupts.constants.clone().into_iter().collect();
     assert_eq!(found, expected);
 
@@ -38,9 +38,9 @@ fn shipped_include_files_assemble_and_match_the_profile() {
         v.sort_unstable();
         v
     };
-    let axis: Vec<i64> = profile.axis_parameters().map(|p| p.number as i64).collect();
+    let axis: Vec<i64> = profile.axis_parameters().map(|p| i64::from(p.number)).collect();
     assert_eq!(with_prefix("AP_"), axis, "one AP_ name for every axis parameter");
-    let mut global: Vec<i64> = profile.global_parameters(0).chain(profile.global_parameters(3)).map(|p| p.number as i64).collect();
+    let mut global: Vec<i64> = profile.global_parameters(0).chain(profile.global_parameters(3)).map(|p| i64::from(p.number)).collect();
     global.sort_unstable();
     assert_eq!(with_prefix("GP_"), global, "one GP_ name for every parameter of banks 0 and 3");
     assert_eq!(parameters.constants["Motor0"], 0);

@@ -61,7 +61,7 @@ fn timer_interrupt_toggles_out0_every_second_while_the_main_loop_blinks() {
     // OUT0 toggles at 1000, 2000, … ms (to the millisecond).
     assert_eq!(out0_changes.len(), 10, "{out0_changes:?}");
     for (k, t) in out0_changes.iter().enumerate() {
-        assert!((*t as i64 - 1000 * (k as i64 + 1)).abs() <= 1, "{out0_changes:?}");
+        assert!((i64::from(*t) - 1000 * (k as i64 + 1)).abs() <= 1, "{out0_changes:?}");
     }
     // OUT1 changes every 500 ms (WAIT TICKS 50), 20 times in 10 s.
     assert!((19..=21).contains(&out1_changes), "{out1_changes}");

@@ -30,14 +30,14 @@ impl Completion {
             None => {
                 let mnemonics = (0..=255u8).filter_map(opcode::mnemonic).map(str::to_string);
                 let upper = word.chars().next().is_none_or(|c| c.is_ascii_uppercase());
-                let commands = CONSOLE_COMMANDS.iter().map(|c| c.to_string());
+                let commands = CONSOLE_COMMANDS.iter().map(ToString::to_string);
                 mnemonics.map(|m| if upper { m } else { m.to_ascii_lowercase() }).chain(commands).collect()
             }
             Some((_, head)) if *head == "help" => self.parameter_names(None),
             Some((_, head)) => {
                 let Some(op) = opcode::from_mnemonic(head) else { return (start, Vec::new()) };
                 match mnemonic::layout(op).and_then(|l| l.get(words.len() - 1)) {
-                    Some(Operand::TypeSymbol(table)) => table.iter().map(|s| s.to_string()).collect(),
+                    Some(Operand::TypeSymbol(table)) => table.iter().map(ToString::to_string).collect(),
                     Some(Operand::Type) if table_of(op).is_some() => self.parameter_names(Some(op)),
                     _ => Vec::new(),
                 }

@@ -79,7 +79,7 @@ struct Proxy {
 /// A lock whose holder may have panicked: the data is still usable (a
 /// panic ends the process anyway, see `main`).
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 impl Proxy {
@@ -254,7 +254,7 @@ fn take_stop_signals() -> Result<impl FnOnce() + Send, String> {
                 _ = term.recv() => {}
                 _ = hup.recv() => {}
             }
-        })
+        });
     })
 }
 

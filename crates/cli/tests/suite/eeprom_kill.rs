@@ -80,7 +80,7 @@ fn killed_during_store_and_download_storms_leaves_old_or_new_values() {
     let dir = std::env::temp_dir().join(format!("tmclsim-kill-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("storm.eeprom");
-    let mut seed: u64 = 0x9E37_79B9_7F4A_7C15 ^ std::process::id() as u64;
+    let mut seed: u64 = 0x9E37_79B9_7F4A_7C15 ^ u64::from(std::process::id());
     let mut counter = 0i32;
     let mut cells = Cells::default();
     let rounds = 300;
@@ -125,7 +125,7 @@ fn killed_during_store_and_download_storms_leaves_old_or_new_values() {
         }
         // The file, its lock, and at most the temporary file of the save
         // the kill interrupted (the next start removes it).
-        let names: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+        let names: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(Result::ok).map(|e| e.file_name()).collect();
         let temporaries = names.iter().filter(|n| n.to_string_lossy().ends_with(".tmp")).count();
         assert!(names.len() <= 3 && temporaries <= 1, "stray temporary files: {names:?}");
     }

@@ -107,7 +107,7 @@ fn the_tmcm_6110_follows_what_its_own_manuals_state() {
     assert_eq!(p.global_parameter(0, 130).unwrap().max, 2047);
     // TMCM-6110 manual V1.19, 5.6.5: SAP 6, 2, 47 sets 200 mA (47/255 of the
     // 1.1 A RMS of its V1.31 title page).
-    let ma = 47.0 * p.features.full_scale_current_ma as f64 / 255.0;
+    let ma = 47.0 * f64::from(p.features.full_scale_current_ma) / 255.0;
     assert!((ma - 200.0).abs() < 5.0, "{ma} mA");
     // 5.6.5, 5.6.6, 5.6.8: SAP, GAP and RSAP take motor 0…5.
     assert_eq!(p.module.axes, 6);

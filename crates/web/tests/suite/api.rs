@@ -69,7 +69,7 @@ fn direct_mode_takes_names_and_answers_in_words() {
     assert_eq!(code, 400);
     assert!(r["error"].as_str().unwrap().contains("did you mean 'GAP'"), "{r}");
     let (_, r) = post(&s.url("/api/modules/0/command"), json!({"line": "SAP 4, 0, 99999"}));
-    assert_eq!(r["status"].as_u64(), Some(Status::InvalidValue.code() as u64));
+    assert_eq!(r["status"].as_u64(), Some(u64::from(Status::InvalidValue.code())));
     assert!(r["text"].as_str().unwrap().contains("1…2047"), "{r}");
 }
 
