@@ -11,7 +11,7 @@ use tmclsim_host::shared::execute;
 pub fn run(shared: &SharedBus, index: usize, line: &str, served: bool) -> Result<String, String> {
     match line.split_whitespace().next() {
         Some("link") if !served => Err("link faults need a link: serve the module and use the server's world() or link_faults()".into()),
-        Some("link" | "help") | None => execute(shared, line),
+        Some("link" | "help") | None => execute(shared, line).map_err(String::from),
         Some(_) => {
             let Addressed { address, command } = Addressed::parse(line)?;
             match address {

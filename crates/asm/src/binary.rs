@@ -19,29 +19,63 @@ pub fn encode(instructions: &[Instruction]) -> Vec<u8> {
     out
 }
 
+/// Why a binary image cannot be read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinaryError {
+    /// The length is no multiple of 8 bytes.
+    Length(usize),
+    /// A word's checksum byte is wrong.
+    Checksum {
+        /// The word's address.
+        address: usize,
+        /// The checksum byte stored.
+        stored: u8,
+        /// The checksum of the word's seven bytes.
+        expected: u8,
+    },
+}
+
+impl std::fmt::Display for BinaryError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            BinaryError::Length(len) => write!(
+                f,
+                "binary length {len} is not a multiple of {WORD_LEN} bytes ({} trailing byte(s) after address {})",
+                len % WORD_LEN,
+                len / WORD_LEN
+            ),
+            BinaryError::Checksum { address, stored, expected } => write!(
+                f,
+                "bad checksum at address {address} (byte offset {}): stored 0x{stored:02X}, expected 0x{expected:02X}",
+                address * WORD_LEN
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BinaryError {}
+
+impl From<BinaryError> for String {
+    fn from(e: BinaryError) -> String {
+        e.to_string()
+    }
+}
+
 /// Reads a binary image; the length must be a multiple of 8 and every
 /// checksum must match.
-pub fn decode(bytes: &[u8]) -> Result<Vec<Instruction>, String> {
-    let trailing = bytes.len() % WORD_LEN;
-    if trailing != 0 {
-        return Err(format!(
-            "binary length {} is not a multiple of {WORD_LEN} bytes ({trailing} trailing byte(s) after address {})",
-            bytes.len(),
-            bytes.len() / WORD_LEN
-        ));
+pub fn decode(bytes: &[u8]) -> Result<Vec<Instruction>, BinaryError> {
+    if !bytes.len().is_multiple_of(WORD_LEN) {
+        return Err(BinaryError::Length(bytes.len()));
     }
     let mut out = Vec::with_capacity(bytes.len() / WORD_LEN);
     for (address, word) in bytes.chunks_exact(WORD_LEN).enumerate() {
-        let seven: &[u8; 7] = word[..7].try_into().map_err(|_| "internal: short word".to_string())?;
-        let expected = checksum(seven);
+        let mut seven = [0u8; 7];
+        seven.copy_from_slice(&word[..7]);
+        let expected = checksum(&seven);
         if word[7] != expected {
-            return Err(format!(
-                "bad checksum at address {address} (byte offset {}): stored 0x{:02X}, expected 0x{expected:02X}",
-                address * WORD_LEN,
-                word[7]
-            ));
+            return Err(BinaryError::Checksum { address, stored: word[7], expected });
         }
-        out.push(Instruction::from_bytes(seven));
+        out.push(Instruction::from_bytes(&seven));
     }
     Ok(out)
 }
@@ -61,9 +95,9 @@ mod tests {
     fn errors_name_the_address() {
         let mut bytes = encode(&[Instruction::new(1, 0, 0, 1), Instruction::new(2, 0, 0, 2)]);
         bytes[15] ^= 0xFF;
-        let e = decode(&bytes).unwrap_err();
+        let e = decode(&bytes).unwrap_err().to_string();
         assert!(e.starts_with("bad checksum at address 1 (byte offset 8)"), "{e}");
-        assert!(decode(&bytes[..13]).unwrap_err().contains("not a multiple of 8"));
+        assert!(decode(&bytes[..13]).unwrap_err().to_string().contains("not a multiple of 8"));
         assert_eq!(decode(&[]).unwrap(), vec![]);
     }
 }

@@ -74,26 +74,40 @@ pub fn operand_summary(opcode: u8) -> String {
     layout(opcode).unwrap_or(&[]).iter().map(|&o| operand_name(opcode, o)).collect::<Vec<_>>().join(", ")
 }
 
-/// The instruction number of a mnemonic, or the reason there is none.
-#[cfg(test)]
-pub fn opcode_of(mnemonic: &str, nothing_follows: bool) -> Result<u8, String> {
-    let mut unlimited = u64::MAX;
-    op::from_mnemonic(mnemonic).ok_or_else(|| unknown_instruction(mnemonic, nothing_follows, &mut unlimited))
+/// A value that does not fit its field of the instruction word.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FieldError {
+    /// A byte field (type, motor, a raw word's opcode) outside 0…255.
+    Byte {
+        /// The field, as messages name it (`motor`, `type`).
+        what: String,
+        /// The value given.
+        value: i64,
+    },
+    /// A value outside −2^31…2^32−1.
+    Word(i64),
 }
 
+impl std::fmt::Display for FieldError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FieldError::Byte { what, value } => write!(f, "{what} {value} is out of range 0...255"),
+            FieldError::Word(value) => write!(f, "value {value} does not fit in 32 bits (-2147483648...4294967295)"),
+        }
+    }
+}
+
+impl std::error::Error for FieldError {}
+
 /// Fits a value into a byte field.
-fn byte(value: i64, what: &str) -> Result<u8, String> {
-    u8::try_from(value).map_err(|_| format!("{what} {value} is out of range 0...255"))
+fn byte(value: i64, what: &str) -> Result<u8, FieldError> {
+    u8::try_from(value).map_err(|_| FieldError::Byte { what: what.to_string(), value })
 }
 
 /// Fits a value into the 32-bit field: −2^31…2^32−1, the upper half wraps
 /// to the negative numbers the wire carries (as `protocol::mnemonic` does).
-pub fn word(value: i64) -> Result<i32, String> {
-    if (i64::from(i32::MIN)..=i64::from(u32::MAX)).contains(&value) {
-        Ok(value as u32 as i32)
-    } else {
-        Err(format!("value {value} does not fit in 32 bits (-2147483648...4294967295)"))
-    }
+pub fn word(value: i64) -> Result<i32, FieldError> {
+    if (i64::from(i32::MIN)..=i64::from(u32::MAX)).contains(&value) { Ok(value as u32 as i32) } else { Err(FieldError::Word(value)) }
 }
 
 /// Encodes an instruction line; reports every problem it finds.
@@ -202,8 +216,8 @@ fn operand(
         Operand::Type | Operand::TypeSymbol(_) | Operand::Motor => byte(value, what).map(i64::from),
         Operand::Value | Operand::Address => word(value).map(i64::from),
     };
-    fitted.map_err(|message| {
-        reporter.error(loc, expr.column, message);
+    fitted.map_err(|e| {
+        reporter.error(loc, expr.column, e.to_string());
         Reported
     })
 }
@@ -257,8 +271,8 @@ pub fn encode_raw(
     for (k, (expr, what)) in fields.iter().zip(["opcode", "type", "motor", "value"]).enumerate() {
         let fitted = evaluator.eval(expr, loc, Expect::Number, reporter).and_then(|v| {
             let r = if k < 3 { byte(v, what).map(i64::from) } else { word(v).map(i64::from) };
-            r.map_err(|message| {
-                reporter.error(loc, expr.column, message);
+            r.map_err(|e| {
+                reporter.error(loc, expr.column, e.to_string());
                 Reported
             })
         });
@@ -276,6 +290,13 @@ pub fn encode_raw(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The instruction number of a mnemonic, or the diagnostic the
+    /// assembler gives for it.
+    fn opcode_of(mnemonic: &str, nothing_follows: bool) -> Result<u8, String> {
+        let mut unlimited = u64::MAX;
+        op::from_mnemonic(mnemonic).ok_or_else(|| unknown_instruction(mnemonic, nothing_follows, &mut unlimited))
+    }
 
     #[test]
     fn names_of_operands() {

@@ -19,7 +19,7 @@ use std::collections::BTreeMap;
 use std::hash::{BuildHasher, RandomState};
 
 use crate::diagnostic::{Loc, Reporter, suggestion};
-use crate::expr::{BinaryOp, Expr, ExprKind, apply};
+use crate::expr::{ArithmeticError, BinaryOp, Expr, ExprKind, apply};
 use crate::limits::MAX_LINE_BYTES;
 
 /// An error that has already been reported.
@@ -450,14 +450,14 @@ impl Evaluator {
             Kind::Name(name) => self.name(constants, name, loc, node.column, expect, reporter),
             Kind::Negate => {
                 let v = self.node(constants, code, pos, loc, expect, reporter)?;
-                v.checked_neg().map_or_else(|| fail(reporter, node.column, "arithmetic overflow in expression".into()), Ok)
+                v.checked_neg().map_or_else(|| fail(reporter, node.column, ArithmeticError::Overflow.to_string()), Ok)
             }
             Kind::Complement => Ok(!self.node(constants, code, pos, loc, expect, reporter)?),
             Kind::Binary(op, operator_column) => {
                 let a = self.node(constants, code, pos, loc, expect, reporter);
                 let b = self.node(constants, code, pos, loc, expect, reporter);
                 let (a, b) = (a?, b?);
-                apply(op, a, b).or_else(|message| fail(reporter, operator_column, message))
+                apply(op, a, b).or_else(|e| fail(reporter, operator_column, e.to_string()))
             }
         }
     }

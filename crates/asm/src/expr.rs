@@ -229,16 +229,39 @@ pub fn punct_text(p: Punct) -> &'static str {
     }
 }
 
+/// Why a binary operator has no 64-bit result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArithmeticError {
+    /// The result does not fit in 64 bits.
+    Overflow,
+    /// A shift by this many bits (outside 0…63).
+    Shift(i64),
+    /// `/` or `%` by 0.
+    DivisionByZero,
+}
+
+impl std::fmt::Display for ArithmeticError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ArithmeticError::Overflow => write!(f, "arithmetic overflow in expression"),
+            ArithmeticError::Shift(b) => write!(f, "shift by {b} (must be 0...63)"),
+            ArithmeticError::DivisionByZero => write!(f, "division by zero"),
+        }
+    }
+}
+
+impl std::error::Error for ArithmeticError {}
+
 /// Applies a binary operator with 64-bit checks.
-pub fn apply(op: BinaryOp, a: i64, b: i64) -> Result<i64, String> {
-    let overflow = || "arithmetic overflow in expression".to_string();
+pub fn apply(op: BinaryOp, a: i64, b: i64) -> Result<i64, ArithmeticError> {
+    let overflow = || ArithmeticError::Overflow;
     match op {
         BinaryOp::Or => Ok(a | b),
         BinaryOp::Xor => Ok(a ^ b),
         BinaryOp::And => Ok(a & b),
         BinaryOp::ShiftLeft | BinaryOp::ShiftRight => {
             if !(0..64).contains(&b) {
-                return Err(format!("shift by {b} (must be 0...63)"));
+                return Err(ArithmeticError::Shift(b));
             }
             if op == BinaryOp::ShiftRight {
                 Ok(a >> b)
@@ -252,7 +275,7 @@ pub fn apply(op: BinaryOp, a: i64, b: i64) -> Result<i64, String> {
         BinaryOp::Mul => a.checked_mul(b).ok_or_else(overflow),
         BinaryOp::Div | BinaryOp::Rem => {
             if b == 0 {
-                return Err("division by zero".into());
+                return Err(ArithmeticError::DivisionByZero);
             }
             let r = if op == BinaryOp::Div { a.checked_div(b) } else { a.checked_rem(b) };
             r.ok_or_else(overflow)

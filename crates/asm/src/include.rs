@@ -28,13 +28,52 @@ pub struct IncludedFile {
 pub trait IncludeResolver {
     /// Resolves `name` as written in `#include` in the file `from` (the
     /// `name` of an earlier [`IncludedFile`], or the file name given to
-    /// `assemble`). The error is a message for the user.
-    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, String>;
+    /// `assemble`). The error's text is shown to the user.
+    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, IncludeError>;
 
     /// The key of the file given to `assemble` (so that a file including
     /// the main file is found to be a cycle).
     fn key(&self, file: &str) -> String {
         file.to_string()
+    }
+}
+
+/// Why an included file was not found.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum IncludeError {
+    /// No file has this name.
+    NotFound {
+        /// The name as written after `#include`.
+        name: String,
+        /// The paths looked at, in order (empty: not told).
+        looked: Vec<String>,
+    },
+    /// The file is there but cannot be read.
+    Unreadable {
+        /// The file's path.
+        path: String,
+        /// Why, in words.
+        reason: String,
+    },
+}
+
+impl std::fmt::Display for IncludeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            IncludeError::NotFound { name, looked } if looked.is_empty() => write!(f, "cannot find include file '{name}'"),
+            IncludeError::NotFound { name, looked } => {
+                write!(f, "cannot find include file '{name}' (looked for {})", looked.join(", "))
+            }
+            IncludeError::Unreadable { path, reason } => write!(f, "cannot read include file '{path}': {reason}"),
+        }
+    }
+}
+
+impl std::error::Error for IncludeError {}
+
+impl From<IncludeError> for String {
+    fn from(e: IncludeError) -> String {
+        e.to_string()
     }
 }
 
@@ -76,7 +115,7 @@ impl MemoryResolver {
 }
 
 impl IncludeResolver for MemoryResolver {
-    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, String> {
+    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, IncludeError> {
         let base = Path::new(from).parent().unwrap_or(Path::new(""));
         let relative = normalize(&base.join(name)).to_string_lossy().replace('\\', "/");
         for candidate in [relative.as_str(), name] {
@@ -84,7 +123,7 @@ impl IncludeResolver for MemoryResolver {
                 return Ok(IncludedFile { key: candidate.to_string(), name: candidate.to_string(), text: text.clone() });
             }
         }
-        Err(format!("cannot find include file '{name}'"))
+        Err(IncludeError::NotFound { name: name.to_string(), looked: Vec::new() })
     }
 }
 
@@ -93,8 +132,8 @@ impl IncludeResolver for MemoryResolver {
 pub struct NoIncludes;
 
 impl IncludeResolver for NoIncludes {
-    fn resolve(&self, _from: &str, name: &str) -> Result<IncludedFile, String> {
-        Err(format!("cannot find include file '{name}'"))
+    fn resolve(&self, _from: &str, name: &str) -> Result<IncludedFile, IncludeError> {
+        Err(IncludeError::NotFound { name: name.to_string(), looked: Vec::new() })
     }
 }
 

@@ -48,7 +48,7 @@ pub mod symbol_file;
 pub use assembler::assemble;
 pub use diagnostic::{Diagnostic, render};
 pub use disasm::disassemble;
-pub use include::{IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
+pub use include::{IncludeError, IncludeResolver, IncludedFile, MemoryResolver, NoIncludes};
 pub use program::Program;
 pub use source_map::{LinePlace, SourceLine};
 pub use tmclsim_profile::Profile;

@@ -1,9 +1,10 @@
 //! An assembled program: its words, labels, constants and source map, and
 //! the files it is written as.
 
+use crate::binary::{self, BinaryError};
 use crate::disasm::disassemble;
 use crate::source_map::SourceLine;
-use crate::{binary, symbol_file};
+use crate::symbol_file::{self, SymbolFileError};
 use std::collections::BTreeMap;
 use tmclsim_protocol::Instruction;
 
@@ -28,7 +29,7 @@ impl Program {
     }
 
     /// Reads a binary image (length a multiple of 8, checksums checked).
-    pub fn from_binary(bytes: &[u8]) -> Result<Vec<Instruction>, String> {
+    pub fn from_binary(bytes: &[u8]) -> Result<Vec<Instruction>, BinaryError> {
         binary::decode(bytes)
     }
 
@@ -44,7 +45,7 @@ impl Program {
     }
 
     /// Reads a symbol file written by [`Program::symbol_file`].
-    pub fn parse_symbol_file(text: &str) -> Result<BTreeMap<String, u32>, String> {
+    pub fn parse_symbol_file(text: &str) -> Result<BTreeMap<String, u32>, SymbolFileError> {
         symbol_file::parse(text)
     }
 

@@ -52,7 +52,7 @@ impl LinePlace {
 /// A file matches when it is the name in the map, or when the map's name
 /// ends with `/` + the name given. Without a file, the file of the first
 /// instruction (the main file) is meant.
-pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, String> {
+pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, PlaceError> {
     let file = match &place.file {
         Some(f) => {
             let names: BTreeMap<&str, ()> = map.iter().map(|s| (&*s.file, ())).collect();
@@ -60,15 +60,18 @@ pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, String> 
             match matching.as_slice() {
                 [one] => one.to_string(),
                 [] => {
-                    let all: Vec<&str> = names.keys().copied().collect();
-                    return Err(format!("no instruction comes from a file '{f}' (the program's files: {})", all.join(", ")));
+                    let files = names.keys().map(|n| (*n).to_string()).collect();
+                    return Err(PlaceError::NoSuchFile { file: f.clone(), files });
                 }
-                many => return Err(format!("'{f}' names several files: {}", many.join(", "))),
+                many => {
+                    let files = many.iter().map(|n| (*n).to_string()).collect();
+                    return Err(PlaceError::SeveralFiles { file: f.clone(), files });
+                }
             }
         }
         None => match map.first() {
             Some(s) => s.file.to_string(),
-            None => return Err("the program has no source map (it was not assembled from source)".into()),
+            None => return Err(PlaceError::NoSourceMap),
         },
     };
     map.iter()
@@ -76,7 +79,56 @@ pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, String> 
         .filter(|(_, s)| *s.file == *file && s.line >= place.line)
         .min_by_key(|(a, s)| (s.line, *a))
         .map(|(a, _)| a as u32)
-        .ok_or_else(|| format!("{file}: no instruction at or after line {}", place.line))
+        .ok_or(PlaceError::NoInstruction { file, line: place.line })
+}
+
+/// Why a source line has no instruction address.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PlaceError {
+    /// No instruction comes from a file of this name.
+    NoSuchFile {
+        /// The file as given.
+        file: String,
+        /// The program's files.
+        files: Vec<String>,
+    },
+    /// The name fits several of the program's files.
+    SeveralFiles {
+        /// The file as given.
+        file: String,
+        /// The files it fits.
+        files: Vec<String>,
+    },
+    /// The program was not assembled from source.
+    NoSourceMap,
+    /// The file holds no instruction at or after the line.
+    NoInstruction {
+        /// The file, as the source map names it.
+        file: String,
+        /// The line asked for.
+        line: u32,
+    },
+}
+
+impl std::fmt::Display for PlaceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlaceError::NoSuchFile { file, files } => {
+                write!(f, "no instruction comes from a file '{file}' (the program's files: {})", files.join(", "))
+            }
+            PlaceError::SeveralFiles { file, files } => write!(f, "'{file}' names several files: {}", files.join(", ")),
+            PlaceError::NoSourceMap => write!(f, "the program has no source map (it was not assembled from source)"),
+            PlaceError::NoInstruction { file, line } => write!(f, "{file}: no instruction at or after line {line}"),
+        }
+    }
+}
+
+impl std::error::Error for PlaceError {}
+
+impl From<PlaceError> for String {
+    fn from(e: PlaceError) -> String {
+        e.to_string()
+    }
 }
 
 #[cfg(test)]
@@ -104,8 +156,8 @@ mod tests {
         assert_eq!(at(None, 3), Ok(1));
         assert_eq!(at(Some("main.tmc"), 6), Ok(3));
         assert_eq!(at(Some("lib.tmc"), 1), Ok(2));
-        assert!(at(None, 10).unwrap_err().contains("no instruction at or after line 10"));
-        assert!(at(Some("other.tmc"), 1).unwrap_err().contains("the program's files: dir/main.tmc, lib.tmc"));
-        assert!(address_of(&[], &LinePlace { file: None, line: 1 }).unwrap_err().contains("no source map"));
+        assert!(at(None, 10).unwrap_err().to_string().contains("no instruction at or after line 10"));
+        assert!(at(Some("other.tmc"), 1).unwrap_err().to_string().contains("the program's files: dir/main.tmc, lib.tmc"));
+        assert!(address_of(&[], &LinePlace { file: None, line: 1 }).unwrap_err().to_string().contains("no source map"));
     }
 }

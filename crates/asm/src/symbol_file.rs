@@ -53,22 +53,86 @@ fn is_label(name: &str) -> bool {
     chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_') && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// What is wrong in a symbol file, and on which line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SymbolFileError {
+    /// The line, from 1.
+    pub line: usize,
+    /// What is wrong with it.
+    pub problem: SymbolProblem,
+}
+
+/// What is wrong with a line of a symbol file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SymbolProblem {
+    /// A source map line without its five fields.
+    SourceFields,
+    /// A source map line out of order.
+    SourceAddress {
+        /// The address whose line comes next.
+        expected: usize,
+        /// The `@address` field found.
+        found: String,
+    },
+    /// A source map field that should be a number.
+    NotANumber {
+        /// `line number` or `column`.
+        what: &'static str,
+        /// The field.
+        text: String,
+    },
+    /// A line that is not `label address` (the line, comment removed).
+    NotLabelAddress(String),
+    /// A label field that is no label name.
+    NotALabel(String),
+    /// An address field that is no address.
+    NotAnAddress(String),
+    /// A label that appears a second time.
+    Twice(String),
+}
+
+impl std::fmt::Display for SymbolFileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "line {}: ", self.line)?;
+        match &self.problem {
+            SymbolProblem::SourceFields => {
+                write!(f, "a source map line has five tab-separated fields (@address, file, line, column, text)")
+            }
+            SymbolProblem::SourceAddress { expected, found } => write!(f, "expected the source of address {expected}, found '{found}'"),
+            SymbolProblem::NotANumber { what, text } => write!(f, "'{text}' is not a {what}"),
+            SymbolProblem::NotLabelAddress(line) => write!(f, "expected 'label address', found '{line}'"),
+            SymbolProblem::NotALabel(name) => write!(f, "'{name}' is not a label name"),
+            SymbolProblem::NotAnAddress(address) => write!(f, "'{address}' is not an address"),
+            SymbolProblem::Twice(name) => write!(f, "label '{name}' appears twice"),
+        }
+    }
+}
+
+impl std::error::Error for SymbolFileError {}
+
+impl From<SymbolFileError> for String {
+    fn from(e: SymbolFileError) -> String {
+        e.to_string()
+    }
+}
+
 /// Reads the labels of a symbol file (its source map is checked, not kept).
-pub fn parse(text: &str) -> Result<BTreeMap<String, u32>, String> {
+pub fn parse(text: &str) -> Result<BTreeMap<String, u32>, SymbolFileError> {
     parse_all(text).map(|(labels, _)| labels)
 }
 
 /// Reads a source map line: `@address\tfile\tline\tcolumn\ttext`; its file
 /// shares the `previous` line's copy of the name when they are the same.
-fn parse_source_line(line: &str, number: usize, expected: usize, previous: Option<&SourceLine>) -> Result<SourceLine, String> {
+fn parse_source_line(line: &str, number: usize, expected: usize, previous: Option<&SourceLine>) -> Result<SourceLine, SymbolFileError> {
+    let error = |problem| SymbolFileError { line: number, problem };
     let fields: Vec<&str> = line.splitn(5, '\t').collect();
     let &[address, file, at, column, text] = fields.as_slice() else {
-        return Err(format!("line {number}: a source map line has five tab-separated fields (@address, file, line, column, text)"));
+        return Err(error(SymbolProblem::SourceFields));
     };
     if address[1..].parse::<usize>().ok() != Some(expected) {
-        return Err(format!("line {number}: expected the source of address {expected}, found '{address}'"));
+        return Err(error(SymbolProblem::SourceAddress { expected, found: address.to_string() }));
     }
-    let number_field = |what: &str, v: &str| v.parse::<u32>().map_err(|_| format!("line {number}: '{v}' is not a {what}"));
+    let number_field = |what, v: &str| v.parse::<u32>().map_err(|_| error(SymbolProblem::NotANumber { what, text: v.to_string() }));
     Ok(SourceLine {
         file: previous.filter(|p| *p.file == *file).map_or_else(|| Arc::from(file), |p| p.file.clone()),
         line: number_field("line number", at)?,
@@ -79,11 +143,12 @@ fn parse_source_line(line: &str, number: usize, expected: usize, previous: Optio
 
 /// Reads a symbol file: its labels and its source map (empty when it has
 /// none).
-pub fn parse_all(text: &str) -> Result<(BTreeMap<String, u32>, Vec<SourceLine>), String> {
+pub fn parse_all(text: &str) -> Result<(BTreeMap<String, u32>, Vec<SourceLine>), SymbolFileError> {
     let mut out = BTreeMap::new();
     let mut source_map = Vec::new();
     for (index, raw) in text.lines().enumerate() {
         let number = index + 1;
+        let error = |problem| SymbolFileError { line: number, problem };
         if raw.starts_with('@') {
             let line = parse_source_line(raw, number, source_map.len(), source_map.last())?;
             source_map.push(line);
@@ -95,16 +160,16 @@ pub fn parse_all(text: &str) -> Result<(BTreeMap<String, u32>, Vec<SourceLine>),
         }
         let fields: Vec<&str> = line.split_whitespace().collect();
         let &[name, address] = fields.as_slice() else {
-            return Err(format!("line {number}: expected 'label address', found '{line}'"));
+            return Err(error(SymbolProblem::NotLabelAddress(line.to_string())));
         };
         if !is_label(name) {
-            return Err(format!("line {number}: '{name}' is not a label name"));
+            return Err(error(SymbolProblem::NotALabel(name.to_string())));
         }
         let address = parse_number(address)
             .and_then(|a| u32::try_from(a).ok())
-            .ok_or_else(|| format!("line {number}: '{address}' is not an address"))?;
+            .ok_or_else(|| error(SymbolProblem::NotAnAddress(address.to_string())))?;
         if out.insert(name.to_string(), address).is_some() {
-            return Err(format!("line {number}: label '{name}' appears twice"));
+            return Err(error(SymbolProblem::Twice(name.to_string())));
         }
     }
     Ok((out, source_map))
@@ -140,18 +205,18 @@ mod tests {
 
     #[test]
     fn bad_source_map_lines() {
-        assert!(parse_all("@1\ta\t1\t1\tx").unwrap_err().contains("line 1: expected the source of address 0"));
-        assert!(parse_all("@0\ta\t1").unwrap_err().contains("five tab-separated fields"));
-        assert!(parse_all("@0\ta\tx\t1\tt").unwrap_err().contains("'x' is not a line number"));
-        assert!(parse_all("@\ta\t1\t1\tt").unwrap_err().contains("found '@'"));
+        assert!(parse_all("@1\ta\t1\t1\tx").unwrap_err().to_string().contains("line 1: expected the source of address 0"));
+        assert!(parse_all("@0\ta\t1").unwrap_err().to_string().contains("five tab-separated fields"));
+        assert!(parse_all("@0\ta\tx\t1\tt").unwrap_err().to_string().contains("'x' is not a line number"));
+        assert!(parse_all("@\ta\t1\t1\tt").unwrap_err().to_string().contains("found '@'"));
     }
 
     #[test]
     fn bad_lines() {
-        assert!(parse("Loop").unwrap_err().starts_with("line 1:"));
-        assert!(parse("\n// c\nLoop x").unwrap_err().starts_with("line 3:"));
+        assert!(parse("Loop").unwrap_err().to_string().starts_with("line 1:"));
+        assert!(parse("\n// c\nLoop x").unwrap_err().to_string().starts_with("line 3:"));
         assert!(parse("1abc 3").is_err());
-        assert!(parse("A 1\nA 2").unwrap_err().contains("twice"));
+        assert!(parse("A 1\nA 2").unwrap_err().to_string().contains("twice"));
         assert!(parse("A -1").is_err());
         assert_eq!(parse("  // nothing\n\nA $10 // hex\n").unwrap()["A"], 16);
     }

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 use tmclsim_firmware::Profile;
-pub use tmclsim_host::{Client, hex};
+pub use tmclsim_host::{Client, LinkError, hex};
 use tmclsim_protocol::{Instruction, opcode};
 
 /// A link to modules (a tmclsim server or real ones): TCP or a serial port.
@@ -32,17 +32,10 @@ pub struct LinkArgs {
 }
 
 impl LinkArgs {
-    pub fn open(&self, timeout: Duration) -> Result<Client, String> {
+    pub fn open(&self, timeout: Duration) -> Result<Client, LinkError> {
         let l = &self.link;
         Client::open(l.tcp.as_deref(), l.port.as_deref(), l.baud, self.address, timeout)
     }
-}
-
-/// Whether a link's error says the module did not answer (in time, in
-/// full, or with a right checksum): a command that failed, as a refused
-/// one did, not a link that failed.
-pub fn unanswered(error: &str) -> bool {
-    error.starts_with("no reply") || error.starts_with("only ") || error.ends_with("has a wrong checksum")
 }
 
 /// The profile named, or the one of the type the module reports.

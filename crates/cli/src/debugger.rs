@@ -237,7 +237,7 @@ pub fn resolve(at: &str, program: &Program) -> Result<u16, String> {
             .ok_or_else(|| format!("address {at} is outside the program (0…{})", program.instructions.len().saturating_sub(1)));
     }
     if let Some(line_place) = LinePlace::parse(at) {
-        return source_map::address_of(&program.source_map, &line_place).map(|a| a as u16);
+        return source_map::address_of(&program.source_map, &line_place).map(|a| a as u16).map_err(String::from);
     }
     let labels = program.symbols.keys().map(String::as_str);
     Err(format!("'{at}' is neither a label of the program, an address nor FILE:LINE{}", suggest::suggestion(at, labels)))

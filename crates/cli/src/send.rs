@@ -34,11 +34,11 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
     // answers an error does: exit status 1 (README.md, "Exit status").
     let reply = match client.exchange(ins) {
         Ok(reply) => reply,
-        Err(e) if crate::client::unanswered(&e) => {
+        Err(e) if e.is_unanswered() => {
             println!("{e}");
             return Ok(ExitCode::from(1));
         }
-        Err(e) => return Err(e),
+        Err(e) => return Err(e.into()),
     };
     println!("reply:   {}", hex(&reply));
     match tmclsim_host::reply::shape(ins, args.link.address, &reply) {

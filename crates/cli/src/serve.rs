@@ -120,7 +120,7 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
                 .map(|f| if args.slaves == 1 { f.clone() } else { std::path::PathBuf::from(format!("{}.{}", f.display(), i + 1)) })
         })
         .collect();
-    let eeproms = eeproms.iter().map(|p| p.as_deref().map(EepromFile::open).transpose()).collect::<Result<Vec<_>, String>>()?;
+    let eeproms = eeproms.iter().map(|p| p.as_deref().map(EepromFile::open).transpose()).collect::<Result<Vec<_>, _>>()?;
     let modules = eeproms
         .iter()
         .map(|file| {

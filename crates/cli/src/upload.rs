@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 use tmclsim_asm::Program;
+use tmclsim_host::LinkError;
 use tmclsim_host::download::{DownloadError, download_and_verify};
 use tmclsim_protocol::{Instruction, Status, opcode};
 
@@ -38,7 +39,13 @@ enum Stop {
 
 impl From<String> for Stop {
     fn from(e: String) -> Stop {
-        if crate::client::unanswered(&e) { Stop::Failed(e) } else { Stop::Error(e) }
+        Stop::Error(e)
+    }
+}
+
+impl From<LinkError> for Stop {
+    fn from(e: LinkError) -> Stop {
+        if e.is_unanswered() { Stop::Failed(e.to_string()) } else { Stop::Error(e.to_string()) }
     }
 }
 
@@ -56,8 +63,8 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
 fn upload(args: UploadArgs) -> Result<(), Stop> {
     let words: Vec<Instruction> = if args.program.extension().is_some_and(|e| e == "bin") {
         use tmclsim_server::files::{MAX_BINARY_BYTES, read_limited};
-        let bytes = read_limited(&args.program, MAX_BINARY_BYTES, "a program binary")?;
-        Program::from_binary(&bytes)?
+        let bytes = read_limited(&args.program, MAX_BINARY_BYTES, "a program binary").map_err(String::from)?;
+        Program::from_binary(&bytes).map_err(String::from)?
     } else {
         crate::asm::assemble(&args.program, &args.module)?.0.instructions
     };

@@ -43,6 +43,89 @@ impl Stream for Box<dyn serialport::SerialPort> {
     }
 }
 
+/// Why a link could not be opened, or a request not answered.
+#[derive(Debug)]
+pub enum LinkError {
+    /// Neither a TCP address nor a serial port was given.
+    NoLink,
+    /// The TCP connection failed.
+    Connect {
+        /// The address, `HOST:PORT`.
+        addr: String,
+        /// Why.
+        error: std::io::Error,
+    },
+    /// The serial port cannot be opened.
+    OpenPort {
+        /// The device.
+        device: String,
+        /// Why.
+        error: serialport::Error,
+    },
+    /// The serial port cannot be split into a reading and a writing half.
+    BothDirections(serialport::Error),
+    /// A setting of the link (timeouts) cannot be made.
+    Setup(std::io::Error),
+    /// Reading failed.
+    Read(std::io::Error),
+    /// Writing failed.
+    Write(std::io::Error),
+    /// The link closed in the middle of a reply.
+    Closed,
+    /// The timeout passed with this many of the reply's 9 bytes received.
+    NoReply {
+        /// Bytes received.
+        got: usize,
+    },
+    /// The reply's checksum is wrong.
+    Checksum([u8; FRAME_LEN]),
+}
+
+impl LinkError {
+    /// Whether the module did not answer (in time, in full, or with a
+    /// right checksum): a command that failed, as a refused one did, not a
+    /// link that failed.
+    pub fn is_unanswered(&self) -> bool {
+        matches!(self, LinkError::NoReply { .. } | LinkError::Checksum(_))
+    }
+}
+
+impl std::fmt::Display for LinkError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LinkError::NoLink => write!(f, "give --tcp HOST:PORT or --port DEVICE"),
+            LinkError::Connect { addr, error } => write!(f, "cannot connect to {addr}: {error}"),
+            LinkError::OpenPort { device, error } => write!(f, "cannot open {device}: {error}"),
+            LinkError::BothDirections(e) => write!(f, "cannot use the port in both directions: {e}"),
+            LinkError::Setup(e) => write!(f, "{e}"),
+            LinkError::Read(e) => write!(f, "read: {e}"),
+            LinkError::Write(e) => write!(f, "write: {e}"),
+            LinkError::Closed => write!(f, "the link closed before the reply was complete"),
+            LinkError::NoReply { got: 0 } => {
+                write!(f, "no reply within the timeout (wrong address, or replies suppressed by GP 255)")
+            }
+            LinkError::NoReply { got } => write!(f, "only {got} of 9 reply bytes arrived within the timeout"),
+            LinkError::Checksum(raw) => write!(f, "the reply {} has a wrong checksum", hex(raw)),
+        }
+    }
+}
+
+impl std::error::Error for LinkError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            LinkError::Connect { error, .. } | LinkError::Setup(error) | LinkError::Read(error) | LinkError::Write(error) => Some(error),
+            LinkError::OpenPort { error, .. } | LinkError::BothDirections(error) => Some(error),
+            LinkError::NoLink | LinkError::Closed | LinkError::NoReply { .. } | LinkError::Checksum(_) => None,
+        }
+    }
+}
+
+impl From<LinkError> for String {
+    fn from(e: LinkError) -> String {
+        e.to_string()
+    }
+}
+
 /// A link to one module address: TCP or a serial port.
 pub struct Client {
     stream: Box<dyn Stream + Send>,
@@ -54,7 +137,7 @@ pub struct Client {
 
 impl Client {
     /// Connects to `tcp` (HOST:PORT) or opens the serial port `port`.
-    pub fn open(tcp: Option<&str>, port: Option<&str>, baud: u32, address: u8, timeout: Duration) -> Result<Client, String> {
+    pub fn open(tcp: Option<&str>, port: Option<&str>, baud: u32, address: u8, timeout: Duration) -> Result<Client, LinkError> {
         let stream: Box<dyn Stream + Send> = match open_link(tcp, port, baud, timeout)? {
             Link::Tcp(s) => Box::new(s),
             Link::Serial(s) => Box::new(s),
@@ -71,10 +154,10 @@ impl Client {
     /// (a late reply that arrives meanwhile) is skipped. The version text
     /// of 136 type 0 and the stored word of 134 carry no instruction byte
     /// of the request (`reply::shape`): they are taken as they come.
-    pub fn exchange(&mut self, ins: Instruction) -> Result<[u8; FRAME_LEN], String> {
+    pub fn exchange(&mut self, ins: Instruction) -> Result<[u8; FRAME_LEN], LinkError> {
         let frame = Request::new(self.address, ins).encode();
-        self.stream.discard_input().map_err(|e| format!("read: {e}"))?;
-        self.stream.write_all(&frame).map_err(|e| format!("write: {e}"))?;
+        self.stream.discard_input().map_err(LinkError::Read)?;
+        self.stream.write_all(&frame).map_err(LinkError::Write)?;
         let start = Instant::now();
         loop {
             let left = self.timeout.saturating_sub(start.elapsed());
@@ -86,39 +169,39 @@ impl Client {
     }
 
     /// Sends one instruction and returns the decoded reply.
-    pub fn request(&mut self, ins: Instruction) -> Result<Reply, String> {
+    pub fn request(&mut self, ins: Instruction) -> Result<Reply, LinkError> {
         let raw = self.exchange(ins)?;
-        Reply::decode(&raw).ok_or_else(|| format!("the reply {} has a wrong checksum", hex(&raw)))
+        Reply::decode(&raw).ok_or(LinkError::Checksum(raw))
     }
 
     /// Sends without waiting for a reply (137).
-    pub fn send_only(&mut self, ins: Instruction) -> Result<(), String> {
+    pub fn send_only(&mut self, ins: Instruction) -> Result<(), LinkError> {
         let frame = Request::new(self.address, ins).encode();
-        self.stream.write_all(&frame).map_err(|e| format!("write: {e}"))
+        self.stream.write_all(&frame).map_err(LinkError::Write)
     }
 
     /// Reads one frame without sending anything (a late reply), within
     /// the timeout.
-    pub fn read_reply(&mut self) -> Result<[u8; FRAME_LEN], String> {
+    pub fn read_reply(&mut self) -> Result<[u8; FRAME_LEN], LinkError> {
         self.read_frame()
     }
 
-    fn read_frame(&mut self) -> Result<[u8; FRAME_LEN], String> {
+    fn read_frame(&mut self) -> Result<[u8; FRAME_LEN], LinkError> {
         self.read_frame_within(self.timeout)
     }
 
-    fn read_frame_within(&mut self, timeout: Duration) -> Result<[u8; FRAME_LEN], String> {
+    fn read_frame_within(&mut self, timeout: Duration) -> Result<[u8; FRAME_LEN], LinkError> {
         let start = Instant::now();
         let mut buf = [0u8; FRAME_LEN];
         let mut got = 0;
         while got < FRAME_LEN {
-            let left = timeout.checked_sub(start.elapsed()).ok_or_else(|| no_reply(got))?;
-            self.stream.set_deadline(left).map_err(|e| e.to_string())?;
+            let left = timeout.checked_sub(start.elapsed()).ok_or(LinkError::NoReply { got })?;
+            self.stream.set_deadline(left).map_err(LinkError::Setup)?;
             match self.stream.read(&mut buf[got..]) {
-                Ok(0) => return Err("the link closed before the reply was complete".into()),
+                Ok(0) => return Err(LinkError::Closed),
                 Ok(n) => got += n,
                 Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {}
-                Err(e) => return Err(format!("read: {e}")),
+                Err(e) => return Err(LinkError::Read(e)),
             }
         }
         Ok(buf)
@@ -130,17 +213,17 @@ enum Link {
     Serial(Box<dyn serialport::SerialPort>),
 }
 
-fn open_link(tcp: Option<&str>, port: Option<&str>, baud: u32, timeout: Duration) -> Result<Link, String> {
+fn open_link(tcp: Option<&str>, port: Option<&str>, baud: u32, timeout: Duration) -> Result<Link, LinkError> {
     match (tcp, port) {
         (Some(addr), _) => {
-            let s = std::net::TcpStream::connect(addr).map_err(|e| format!("cannot connect to {addr}: {e}"))?;
+            let s = std::net::TcpStream::connect(addr).map_err(|error| LinkError::Connect { addr: addr.to_string(), error })?;
             s.set_nodelay(true).ok();
             Ok(Link::Tcp(s))
         }
-        (None, Some(dev)) => {
-            Ok(Link::Serial(serialport::new(dev, baud).timeout(timeout).open().map_err(|e| format!("cannot open {dev}: {e}"))?))
-        }
-        _ => Err("give --tcp HOST:PORT or --port DEVICE".into()),
+        (None, Some(dev)) => Ok(Link::Serial(
+            serialport::new(dev, baud).timeout(timeout).open().map_err(|error| LinkError::OpenPort { device: dev.to_string(), error })?,
+        )),
+        _ => Err(LinkError::NoLink),
     }
 }
 
@@ -158,17 +241,17 @@ pub struct RawLink {
 
 impl RawLink {
     /// Connects to `tcp` (HOST:PORT) or opens the serial port `port`.
-    pub fn open(tcp: Option<&str>, port: Option<&str>, baud: u32, poll: Duration) -> Result<RawLink, String> {
+    pub fn open(tcp: Option<&str>, port: Option<&str>, baud: u32, poll: Duration) -> Result<RawLink, LinkError> {
         let poll = poll.max(Duration::from_millis(1));
         match open_link(tcp, port, baud, poll)? {
             Link::Tcp(s) => {
-                s.set_read_timeout(Some(poll)).map_err(|e| e.to_string())?;
-                s.set_write_timeout(Some(Duration::from_secs(5))).map_err(|e| e.to_string())?;
-                let writer = s.try_clone().map_err(|e| e.to_string())?;
+                s.set_read_timeout(Some(poll)).map_err(LinkError::Setup)?;
+                s.set_write_timeout(Some(Duration::from_secs(5))).map_err(LinkError::Setup)?;
+                let writer = s.try_clone().map_err(LinkError::Setup)?;
                 Ok(RawLink { reader: Box::new(s), writer: Box::new(writer) })
             }
             Link::Serial(s) => {
-                let writer = s.try_clone().map_err(|e| format!("cannot use the port in both directions: {e}"))?;
+                let writer = s.try_clone().map_err(LinkError::BothDirections)?;
                 Ok(RawLink { reader: Box::new(s), writer: Box::new(writer) })
             }
         }
@@ -180,14 +263,6 @@ impl RawLink {
 pub fn profile_of_version(value: i32) -> Option<std::sync::Arc<tmclsim_profile::Profile>> {
     let type_number = (value as u32) >> 16;
     tmclsim_profile::Profile::built_in(&format!("tmcm-{type_number}")).ok()
-}
-
-fn no_reply(got: usize) -> String {
-    if got == 0 {
-        "no reply within the timeout (wrong address, or replies suppressed by GP 255)".into()
-    } else {
-        format!("only {got} of 9 reply bytes arrived within the timeout")
-    }
 }
 
 /// Bytes as upper-case hex pairs separated by spaces (`01 06 …`).
@@ -234,7 +309,7 @@ mod tests {
             s.write_all(&[2, 5, 4, 0, 0, 0, 3, 232, 0]).unwrap();
         });
         let mut c = Client::open(Some(&addr), None, 9600, 1, Duration::from_millis(50)).unwrap();
-        assert!(c.exchange(Instruction::new(6, 1, 0, 0)).unwrap_err().starts_with("no reply"));
+        assert!(c.exchange(Instruction::new(6, 1, 0, 0)).unwrap_err().to_string().starts_with("no reply"));
         std::thread::sleep(Duration::from_millis(200));
         assert_eq!(c.exchange(Instruction::new(5, 4, 0, 222)).unwrap(), reply(5, 222), "the late GAP reply was dropped");
         c.timeout = Duration::from_secs(2);

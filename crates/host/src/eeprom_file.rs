@@ -73,6 +73,90 @@ impl From<LoadError> for String {
     }
 }
 
+/// Why an EEPROM file cannot be taken; the text starts with its path as
+/// named.
+#[derive(Debug)]
+pub struct OpenError {
+    /// The path as named.
+    pub path: PathBuf,
+    /// What went wrong.
+    pub problem: OpenProblem,
+}
+
+/// What went wrong taking an EEPROM file.
+#[derive(Debug)]
+pub enum OpenProblem {
+    /// The path cannot be followed to a file.
+    Path(std::io::Error),
+    /// The file is there and cannot be looked at.
+    Unreadable(std::io::Error),
+    /// The lock file cannot be opened or locked.
+    CannotLock {
+        /// The lock file.
+        lock: PathBuf,
+        /// Why.
+        error: std::io::Error,
+    },
+    /// There is no lock file and none may be made.
+    CannotCreateLock {
+        /// The lock file.
+        lock: PathBuf,
+        /// Why it cannot be made.
+        error: std::io::Error,
+    },
+    /// Another process holds the lock.
+    InUse {
+        /// The lock file.
+        lock: PathBuf,
+        /// The holder's process id, when the lock file tells it.
+        pid: Option<u32>,
+    },
+}
+
+impl std::fmt::Display for OpenError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let shown = self.path.display();
+        match &self.problem {
+            OpenProblem::Path(e) => write!(f, "{shown}: {e}"),
+            OpenProblem::Unreadable(e) => write!(f, "{shown}: cannot read the EEPROM file: {e}"),
+            OpenProblem::CannotLock { lock, error } => {
+                write!(f, "{shown}: cannot lock the EEPROM file ({}): {error}", lock.display())
+            }
+            OpenProblem::CannotCreateLock { lock, error } => write!(
+                f,
+                "{shown}: cannot lock the EEPROM file: cannot create {}: {error}; tmclsim needs to write in the EEPROM \
+                 file's directory (its lock file is there, and every save puts a new file there)",
+                lock.display()
+            ),
+            OpenProblem::InUse { lock, pid } => {
+                let pid = pid.map_or(String::new(), |p| format!(" (pid {p})"));
+                write!(
+                    f,
+                    "{shown}: the EEPROM file is in use by another tmclsim{pid}; one module at a time keeps an EEPROM file \
+                     (lock: {})",
+                    lock.display()
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for OpenError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.problem {
+            OpenProblem::Path(e) | OpenProblem::Unreadable(e) => Some(e),
+            OpenProblem::CannotLock { error, .. } | OpenProblem::CannotCreateLock { error, .. } => Some(error),
+            OpenProblem::InUse { .. } => None,
+        }
+    }
+}
+
+impl From<OpenError> for String {
+    fn from(e: OpenError) -> String {
+        e.to_string()
+    }
+}
+
 /// The text of an EEPROM file (`None`: there is none), within the limits.
 /// The errors name no file.
 fn read_limited(path: &Path) -> Result<Option<String>, LoadError> {
@@ -235,20 +319,20 @@ pub struct EepromFile {
 
 impl EepromFile {
     /// Takes the EEPROM file at `path` for this process.
-    pub fn open(path: &Path) -> Result<EepromFile, String> {
-        let shown = path.display();
-        let target = resolve(path).map_err(|e| format!("{shown}: {e}"))?;
+    pub fn open(path: &Path) -> Result<EepromFile, OpenError> {
+        let error = |problem| OpenError { path: path.to_path_buf(), problem };
+        let target = resolve(path).map_err(|e| error(OpenProblem::Path(e)))?;
         // The file first: when it cannot be looked at, that is the error
         // to report (the lock beside it would fail too, and say less).
         // Only a file that does not exist yet is fine (rule 89).
         if let Err(e) = std::fs::metadata(&target)
             && e.kind() != std::io::ErrorKind::NotFound
         {
-            return Err(format!("{shown}: cannot read the EEPROM file: {e}"));
+            return Err(error(OpenProblem::Unreadable(e)));
         }
-        let (dir, name) = dir_and_name(&target).map_err(|e| format!("{shown}: {e}"))?;
+        let (dir, name) = dir_and_name(&target).map_err(|e| error(OpenProblem::Path(e)))?;
         let lock_path = dir.join(format!(".{name}.lock"));
-        let cannot = |e: std::io::Error| format!("{shown}: cannot lock the EEPROM file ({}): {e}", lock_path.display());
+        let cannot = |e: std::io::Error| error(OpenProblem::CannotLock { lock: lock_path.clone(), error: e });
         let open = |write: bool| {
             OpenOptions::new()
                 .read(true)
@@ -266,11 +350,7 @@ impl EepromFile {
                 Ok(f) => (f, false),
                 // There is none, and none may be made here: say why.
                 Err(none) if none.kind() == std::io::ErrorKind::NotFound => {
-                    return Err(format!(
-                        "{shown}: cannot lock the EEPROM file: cannot create {}: {e}; tmclsim needs to write in the EEPROM \
-                         file's directory (its lock file is there, and every save puts a new file there)",
-                        lock_path.display()
-                    ));
+                    return Err(error(OpenProblem::CannotCreateLock { lock: lock_path.clone(), error: e }));
                 }
                 Err(other) => return Err(cannot(other)),
             },
@@ -284,12 +364,8 @@ impl EepromFile {
             Err(std::fs::TryLockError::WouldBlock) => {
                 let mut holder = String::new();
                 let _ = (&lock).take(32).read_to_string(&mut holder);
-                let pid = holder.trim().parse::<u32>().map_or(String::new(), |p| format!(" (pid {p})"));
-                return Err(format!(
-                    "{shown}: the EEPROM file is in use by another tmclsim{pid}; one module at a time keeps an EEPROM file \
-                     (lock: {})",
-                    lock_path.display()
-                ));
+                let pid = holder.trim().parse::<u32>().ok();
+                return Err(error(OpenProblem::InUse { lock: lock_path.clone(), pid }));
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(cannot(e)),
         }
@@ -413,7 +489,7 @@ mod tests {
         assert_eq!(load(&target).unwrap(), Some(image()));
         assert_eq!(file.load_for(&tmcm_1141()).unwrap(), (image(), true));
         // The lock is beside the target: the target named directly is taken.
-        let e = EepromFile::open(&target).unwrap_err();
+        let e = EepromFile::open(&target).unwrap_err().to_string();
         assert!(e.contains("in use by another tmclsim"), "{e}");
         assert!(dir.path().join("store/.real.eeprom.lock").exists());
         drop(file);
@@ -430,7 +506,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.eeprom");
         let first = EepromFile::open(&path).unwrap();
-        let e = EepromFile::open(&path).unwrap_err();
+        let e = EepromFile::open(&path).unwrap_err().to_string();
         assert!(e.starts_with(&format!("{}: ", path.display())), "{e}");
         assert!(e.contains(&format!("in use by another tmclsim (pid {})", std::process::id())), "{e}");
         drop(first);
@@ -445,7 +521,7 @@ mod tests {
         let victim = dir.path().join("victim");
         std::fs::write(&victim, "precious").unwrap();
         symlink(&victim, dir.path().join(".m.eeprom.lock")).unwrap();
-        let e = EepromFile::open(&dir.path().join("m.eeprom")).unwrap_err();
+        let e = EepromFile::open(&dir.path().join("m.eeprom")).unwrap_err().to_string();
         assert!(e.contains("cannot lock the EEPROM file"), "{e}");
         assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
     }

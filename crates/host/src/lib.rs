@@ -13,6 +13,6 @@ pub mod trace;
 // Without I/O, so that the playground has them too.
 pub use tmclsim_ide::{download, line, names, observe, reply};
 
-pub use client::{Client, hex};
+pub use client::{Client, LinkError, hex};
 pub use faults::LinkFaults;
 pub use shared::{SharedBus, Stats};

@@ -424,7 +424,7 @@ impl SharedBus {
 /// bus to the addressed module (the first one without `@ADDRESS`). The
 /// control socket of a served link and the Python package both run their
 /// lines here.
-pub fn execute(bus: &SharedBus, line: &str) -> Result<String, String> {
+pub fn execute(bus: &SharedBus, line: &str) -> Result<String, ControlError> {
     let mut w = line.split_whitespace();
     match w.next() {
         None => return Ok(String::new()),
@@ -435,22 +435,68 @@ pub fn execute(bus: &SharedBus, line: &str) -> Result<String, String> {
                 Some("drop") => f.drop = num(w.next(), "count")?,
                 Some("corrupt") => f.corrupt = num(w.next(), "count")?,
                 Some("delay") => f.delay = Duration::from_millis(num(w.next(), "delay in ms")?),
-                Some("mute") => f.mute = on_off(w.next())?,
+                Some("mute") => f.mute = on_off(w.next()).map_err(ControlError::world)?,
                 Some("clear") => f = LinkFaults::default(),
-                other => return Err(format!("link {}: use drop, corrupt, delay, mute or clear", other.unwrap_or(""))),
+                other => return Err(ControlError::LinkUsage(other.unwrap_or("").to_string())),
             }
             bus.set_link_faults(f);
             return Ok(String::new());
         }
         Some(_) => {}
     }
-    let Addressed { address, command } = Addressed::parse(line)?;
-    bus.apply_world(address, &command)
+    let Addressed { address, command } = Addressed::parse(line).map_err(ControlError::world)?;
+    bus.apply_world(address, &command).map_err(ControlError::world)
 }
 
-fn num<T: std::str::FromStr>(w: Option<&str>, what: &str) -> Result<T, String> {
-    let w = w.ok_or_else(|| format!("{what} is missing"))?;
-    w.parse().map_err(|_| format!("'{w}' is not a valid {what}"))
+/// Why a control line failed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ControlError {
+    /// A `link` fault lacks its number.
+    Missing {
+        /// What is missing (`count`, `delay in ms`).
+        what: &'static str,
+    },
+    /// A `link` fault's number is not one.
+    Invalid {
+        /// The word given.
+        word: String,
+        /// What it should be.
+        what: &'static str,
+    },
+    /// `link` with another word than drop, corrupt, delay, mute or clear.
+    LinkUsage(String),
+    /// The world command is wrong or failed (the firmware's words).
+    World(String),
+}
+
+impl ControlError {
+    fn world(e: impl std::fmt::Display) -> ControlError {
+        ControlError::World(e.to_string())
+    }
+}
+
+impl std::fmt::Display for ControlError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ControlError::Missing { what } => write!(f, "{what} is missing"),
+            ControlError::Invalid { word, what } => write!(f, "'{word}' is not a valid {what}"),
+            ControlError::LinkUsage(word) => write!(f, "link {word}: use drop, corrupt, delay, mute or clear"),
+            ControlError::World(message) => f.write_str(message),
+        }
+    }
+}
+
+impl std::error::Error for ControlError {}
+
+impl From<ControlError> for String {
+    fn from(e: ControlError) -> String {
+        e.to_string()
+    }
+}
+
+fn num<T: std::str::FromStr>(w: Option<&str>, what: &'static str) -> Result<T, ControlError> {
+    let w = w.ok_or(ControlError::Missing { what })?;
+    w.parse().map_err(|_| ControlError::Invalid { word: w.to_string(), what })
 }
 
 #[cfg(test)]
@@ -548,7 +594,7 @@ mod tests {
         assert!(execute(&bus, "help").unwrap().contains("link"));
         assert_eq!(execute(&bus, "link drop 2"), Ok(String::new()));
         assert_eq!(bus.link_faults().drop, 2);
-        assert!(execute(&bus, "link frob").unwrap_err().contains("use drop, corrupt"));
+        assert!(execute(&bus, "link frob").unwrap_err().to_string().contains("use drop, corrupt"));
         assert_eq!(execute(&bus, "input 1 1"), Ok(String::new()));
         assert_eq!(ask(&bus, opcode::GIO, 1, 0).0, 100);
         assert!(execute(&bus, "@9 input 1 1").is_err(), "no module at address 9");

@@ -81,9 +81,66 @@ pub fn format_line(t_ns: u64, dir: Dir, frame: &[u8; FRAME_LEN]) -> String {
     format!("{{\"t\": {}, \"dir\": \"{}\", \"frame\": \"{}\"}}", seconds(t_ns), dir.as_str(), hex(frame))
 }
 
+/// What is wrong with a line of a trace.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LineError {
+    /// The line is no JSON (the parser's message).
+    NotJson(String),
+    /// The line is JSON but no object.
+    NotObject,
+    /// No `t`.
+    NoTime,
+    /// `t` is no number (the value, as JSON).
+    TimeNotNumber(String),
+    /// `t` is outside 0…[`MAX_T_SECONDS`].
+    TimeOutside(f64),
+    /// No `dir`.
+    NoDir,
+    /// `dir` is neither `host` nor `module` (the value, as JSON, cut).
+    BadDir(String),
+    /// No `frame`.
+    NoFrame,
+    /// `frame` is no string (the value, as JSON, cut).
+    FrameNotString(String),
+    /// A piece of `frame` is no byte in hex (the piece, cut).
+    NotHexByte(String),
+    /// `frame` has this many bytes, not 9.
+    FrameLength(usize),
+}
+
+impl std::fmt::Display for LineError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LineError::NotJson(e) => write!(f, "not a JSON object: {e}"),
+            LineError::NotObject => {
+                write!(f, "not a JSON object: write {{\"t\": 0.0123, \"dir\": \"host\", \"frame\": \"01 06 01 00 00 00 00 00 08\"}}")
+            }
+            LineError::NoTime => write!(f, "no \"t\" (seconds since the start of the recording)"),
+            LineError::TimeNotNumber(t) => write!(f, "\"t\" is {t}, not a number of seconds"),
+            LineError::TimeOutside(t) => write!(f, "\"t\" is {t}: seconds since the start, 0…{MAX_T_SECONDS:.0}"),
+            LineError::NoDir => write!(f, "no \"dir\" (\"host\" or \"module\")"),
+            LineError::BadDir(d) => write!(f, "\"dir\" is {d}; write \"host\" or \"module\""),
+            LineError::NoFrame => write!(f, "no \"frame\" (9 bytes in hex)"),
+            LineError::FrameNotString(v) => write!(f, "\"frame\" is {v}, not a string of hex bytes"),
+            LineError::NotHexByte(p) => {
+                write!(f, "\"frame\": '{p}' is not a byte in hex (write 9 bytes as \"01 06 01 00 00 00 00 00 08\")")
+            }
+            LineError::FrameLength(n) => write!(f, "\"frame\" has {n} bytes; a TMCL frame has 9"),
+        }
+    }
+}
+
+impl std::error::Error for LineError {}
+
+impl From<LineError> for String {
+    fn from(e: LineError) -> String {
+        e.to_string()
+    }
+}
+
 /// A frame as a trace writes it: nine bytes in hex, separated by spaces
 /// (upper or lower case; one run of 18 digits is taken too).
-pub fn parse_frame(text: &str) -> Result<[u8; FRAME_LEN], String> {
+pub fn parse_frame(text: &str) -> Result<[u8; FRAME_LEN], LineError> {
     let words: Vec<&str> = text.split_whitespace().collect();
     let pairs: Vec<&str> = match words.as_slice() {
         [one] if one.len() > 2 && one.len().is_multiple_of(2) && one.is_ascii() => {
@@ -94,11 +151,11 @@ pub fn parse_frame(text: &str) -> Result<[u8; FRAME_LEN], String> {
     let mut bytes = Vec::with_capacity(FRAME_LEN);
     for p in &pairs {
         if p.len() != 2 || !p.chars().all(|c| c.is_ascii_hexdigit()) {
-            return Err(format!("\"frame\": '{}' is not a byte in hex (write 9 bytes as \"01 06 01 00 00 00 00 00 08\")", cut(p)));
+            return Err(LineError::NotHexByte(cut(p)));
         }
-        bytes.push(u8::from_str_radix(p, 16).map_err(|e| e.to_string())?);
+        bytes.push(u8::from_str_radix(p, 16).map_err(|_| LineError::NotHexByte(cut(p)))?);
     }
-    bytes.try_into().map_err(|b: Vec<u8>| format!("\"frame\" has {} bytes; a TMCL frame has 9", b.len()))
+    bytes.try_into().map_err(|b: Vec<u8>| LineError::FrameLength(b.len()))
 }
 
 /// At most 20 characters of a piece of text, for messages.
@@ -112,27 +169,27 @@ fn cut(text: &str) -> String {
 
 /// One line of a trace: its time in nanoseconds, who sent the frame, the
 /// frame. Keys other than `t`, `dir` and `frame` are ignored.
-pub fn parse_line(text: &str) -> Result<(u64, Dir, [u8; FRAME_LEN]), String> {
-    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| format!("not a JSON object: {e}"))?;
+pub fn parse_line(text: &str) -> Result<(u64, Dir, [u8; FRAME_LEN]), LineError> {
+    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| LineError::NotJson(e.to_string()))?;
     let Some(object) = value.as_object() else {
-        return Err("not a JSON object: write {\"t\": 0.0123, \"dir\": \"host\", \"frame\": \"01 06 01 00 00 00 00 00 08\"}".into());
+        return Err(LineError::NotObject);
     };
     let t = match object.get("t") {
-        None => return Err("no \"t\" (seconds since the start of the recording)".into()),
-        Some(t) => t.as_f64().ok_or_else(|| format!("\"t\" is {t}, not a number of seconds"))?,
+        None => return Err(LineError::NoTime),
+        Some(t) => t.as_f64().ok_or_else(|| LineError::TimeNotNumber(t.to_string()))?,
     };
     if !(0.0..=MAX_T_SECONDS).contains(&t) {
-        return Err(format!("\"t\" is {t}: seconds since the start, 0…{MAX_T_SECONDS:.0}"));
+        return Err(LineError::TimeOutside(t));
     }
     let dir = match object.get("dir").map(|d| (d, d.as_str())) {
-        None => return Err("no \"dir\" (\"host\" or \"module\")".into()),
+        None => return Err(LineError::NoDir),
         Some((_, Some("host"))) => Dir::Host,
         Some((_, Some("module"))) => Dir::Module,
-        Some((d, _)) => return Err(format!("\"dir\" is {}; write \"host\" or \"module\"", cut(&d.to_string()))),
+        Some((d, _)) => return Err(LineError::BadDir(cut(&d.to_string()))),
     };
     let frame = match object.get("frame") {
-        None => return Err("no \"frame\" (9 bytes in hex)".into()),
-        Some(f) => parse_frame(f.as_str().ok_or_else(|| format!("\"frame\" is {}, not a string of hex bytes", cut(&f.to_string())))?)?,
+        None => return Err(LineError::NoFrame),
+        Some(f) => parse_frame(f.as_str().ok_or_else(|| LineError::FrameNotString(cut(&f.to_string())))?)?,
     };
     Ok(((t * 1e9).round() as u64, dir, frame))
 }
@@ -361,7 +418,7 @@ mod tests {
 
     #[test]
     fn bad_lines_say_what_is_wrong() {
-        let e = |s: &str| parse_line(s).unwrap_err();
+        let e = |s: &str| parse_line(s).unwrap_err().to_string();
         assert!(e("hello").starts_with("not a JSON object"), "{}", e("hello"));
         assert!(e("[1]").starts_with("not a JSON object"));
         assert_eq!(e(r#"{"dir": "host", "frame": ""}"#), "no \"t\" (seconds since the start of the recording)");

@@ -54,6 +54,24 @@ pub(crate) struct Slots {
     tasks: JoinSet<()>,
 }
 
+/// Why a new client was refused: every slot is taken by a client that is
+/// not idle long enough to be closed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Full {
+    /// How many slots there are.
+    pub limit: usize,
+    /// What a slot holds (`connection`).
+    pub what: &'static str,
+}
+
+impl std::fmt::Display for Full {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {}s open (the limit)", self.limit, self.what)
+    }
+}
+
+impl std::error::Error for Full {}
+
 impl Slots {
     pub fn new(what: &'static str, limit: usize, idle_timeout: Duration) -> Slots {
         Slots { what, limit, idle_timeout, open: HashMap::new(), tasks: JoinSet::new() }
@@ -62,7 +80,7 @@ impl Slots {
     /// Makes room for a new client. At the limit, the connection that has
     /// gone longest without a request is closed if that is `idle_timeout`
     /// or more; otherwise the new client is refused (`Err`: why).
-    pub fn make_room(&mut self) -> Result<(), String> {
+    pub fn make_room(&mut self) -> Result<(), Full> {
         if self.open.len() < self.limit {
             return Ok(());
         }
@@ -81,7 +99,7 @@ impl Slots {
                 }
                 Ok(())
             }
-            _ => Err(format!("{} {}s open (the limit)", self.limit, self.what)),
+            _ => Err(Full { limit: self.limit, what: self.what }),
         }
     }
 

@@ -7,16 +7,49 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use tmclsim_asm::include::normalize;
 use tmclsim_asm::limits::MAX_SOURCE_BYTES;
-use tmclsim_asm::{Diagnostic, IncludeResolver, IncludedFile, Profile, Program, assemble};
+use tmclsim_asm::{Diagnostic, IncludeError, IncludeResolver, IncludedFile, Profile, Program, assemble};
 
-/// Reads a source file, at most [`MAX_SOURCE_BYTES`]; the error is a
-/// message for the user.
-pub fn read_source(path: &Path) -> Result<String, String> {
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+/// Why a source file was not read.
+#[derive(Debug)]
+pub enum SourceError {
+    /// The file cannot be opened or read.
+    Io(std::io::Error),
+    /// The file is larger than [`MAX_SOURCE_BYTES`].
+    TooLarge,
+}
+
+impl std::fmt::Display for SourceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SourceError::Io(e) => write!(f, "{e}"),
+            SourceError::TooLarge => write!(f, "larger than {} MiB, the limit for a source file", MAX_SOURCE_BYTES >> 20),
+        }
+    }
+}
+
+impl std::error::Error for SourceError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            SourceError::Io(e) => Some(e),
+            SourceError::TooLarge => None,
+        }
+    }
+}
+
+impl From<SourceError> for String {
+    fn from(e: SourceError) -> String {
+        e.to_string()
+    }
+}
+
+/// Reads a source file, at most [`MAX_SOURCE_BYTES`]; the error's text is
+/// shown to the user.
+pub fn read_source(path: &Path) -> Result<String, SourceError> {
+    let file = std::fs::File::open(path).map_err(SourceError::Io)?;
     let mut bytes = Vec::new();
-    file.take(MAX_SOURCE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
+    file.take(MAX_SOURCE_BYTES + 1).read_to_end(&mut bytes).map_err(SourceError::Io)?;
     if bytes.len() as u64 > MAX_SOURCE_BYTES {
-        return Err(format!("larger than {} MiB, the limit for a source file", MAX_SOURCE_BYTES >> 20));
+        return Err(SourceError::TooLarge);
     }
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
@@ -56,7 +89,7 @@ impl IncludeResolver for FileResolver {
         std::fs::canonicalize(file).map_or_else(|_| file.to_string(), |p| p.to_string_lossy().into_owned())
     }
 
-    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, String> {
+    fn resolve(&self, from: &str, name: &str) -> Result<IncludedFile, IncludeError> {
         let base = Path::new(from).parent().unwrap_or(Path::new(""));
         let written = Path::new(name);
         let mut candidates = vec![base.join(written)];
@@ -67,7 +100,8 @@ impl IncludeResolver for FileResolver {
             if !path.is_file() {
                 continue;
             }
-            let text = read_source(path).map_err(|e| format!("cannot read include file '{}': {e}", path.display()))?;
+            let text =
+                read_source(path).map_err(|e| IncludeError::Unreadable { path: path.display().to_string(), reason: e.to_string() })?;
             let key = std::fs::canonicalize(path).unwrap_or_else(|_| normalize(path));
             return Ok(IncludedFile {
                 key: key.to_string_lossy().into_owned(),
@@ -75,7 +109,7 @@ impl IncludeResolver for FileResolver {
                 text,
             });
         }
-        let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
-        Err(format!("cannot find include file '{name}' (looked for {})", looked.join(", ")))
+        let looked = candidates.iter().map(|p| p.display().to_string()).collect();
+        Err(IncludeError::NotFound { name: name.to_string(), looked })
     }
 }

@@ -117,7 +117,7 @@ impl LinkTarget {
         let address = self.entries.get(id).ok_or(TargetError::NoModule)?.address;
         let mut c = self.client.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         c.address = address;
-        c.exchange(ins).map_err(TargetError::Failed)
+        c.exchange(ins).map_err(|e| TargetError::Failed(e.to_string()))
     }
 
     fn with_debug<R>(&self, id: usize, f: impl FnOnce(&mut Debug) -> R) -> R {

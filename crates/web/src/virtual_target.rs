@@ -136,7 +136,7 @@ impl Target for VirtualTarget {
         } else {
             format!("@{} {line}", self.entries[id].address)
         };
-        tmclsim_server::control::execute(&p.bus, &line).map_err(TargetError::Failed)
+        tmclsim_server::control::execute(&p.bus, &line).map_err(|e| TargetError::Failed(e.to_string()))
     }
 
     fn set_breakpoints(&self, id: usize, addresses: &[u16]) -> Result<(), TargetError> {

@@ -113,8 +113,11 @@ fn binary_and_symbol_files_read_back() {
     assert_eq!(Program::parse_symbol_file(&program.symbol_file()).unwrap(), program.symbols);
     let mut bad = binary.clone();
     bad[8 * 3 + 7] = bad[8 * 3 + 7].wrapping_add(1);
-    assert_eq!(Program::from_binary(&bad).unwrap_err(), "bad checksum at address 3 (byte offset 24): stored 0x17, expected 0x16");
-    assert!(Program::from_binary(&binary[..31]).unwrap_err().starts_with("binary length 31 is not a multiple of 8 bytes"));
+    assert_eq!(
+        Program::from_binary(&bad).unwrap_err().to_string(),
+        "bad checksum at address 3 (byte offset 24): stored 0x17, expected 0x16"
+    );
+    assert!(Program::from_binary(&binary[..31]).unwrap_err().to_string().starts_with("binary length 31 is not a multiple of 8 bytes"));
     // The disassembly of the binary with the symbol file is the program.
     let symbols = Program::parse_symbol_file(&program.symbol_file()).unwrap();
     let again = reassemble(&Program::from_binary(&binary).unwrap(), Some(&symbols));

@@ -176,11 +176,11 @@ impl Session {
                 }
                 println!("{line}");
             }
-            Err(e) if crate::client::unanswered(&e) => {
+            Err(e) if e.is_unanswered() => {
                 self.failures += 1;
                 println!("{e}");
             }
-            Err(e) => return Err(e),
+            Err(e) => return Err(e.into()),
         }
         Ok(())
     }
