@@ -6,6 +6,7 @@ use serde::Deserialize;
 use serde_json::{Value, json};
 use tmclsim_firmware::snapshot::ModuleSnapshot;
 use tmclsim_profile::Profile;
+use tmclsim_protocol::mnemonic::ParseError;
 use tmclsim_protocol::{FRAME_LEN, Instruction, Request, opcode};
 
 /// Bytes as hex pairs: `01 06 01 …`.
@@ -20,9 +21,9 @@ pub fn entry(target: &dyn Target, id: usize) -> Result<&ModuleEntry, TargetError
 
 /// A direct-mode line for module `id` (parameter names from its profile),
 /// or what is wrong with it: `column N: …`.
-pub fn parse_line(target: &dyn Target, id: usize, line: &str) -> Result<Instruction, String> {
+pub fn parse_line(target: &dyn Target, id: usize, line: &str) -> Result<Instruction, ParseError> {
     let profile = target.modules().get(id).and_then(|m| m.profile.clone());
-    crate::line::parse(line, profile.as_deref()).map_err(|e| format!("column {}: {}", e.column, e.message))
+    crate::line::parse(line, profile.as_deref())
 }
 
 /// A request and its reply as the app shows them.
@@ -113,27 +114,59 @@ pub struct Write {
     pub op: Option<String>,
 }
 
+/// What is wrong with a parameter write.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum WriteError {
+    /// A kind other than `ap` or `gp`.
+    Kind,
+    /// The value does not fit 32 bits.
+    TooLarge(i64),
+    /// `set` without a value.
+    NoValue,
+    /// An op other than set, store or restore.
+    Op(String),
+}
+
+impl std::fmt::Display for WriteError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            WriteError::Kind => write!(f, "write takes kind 'ap' or 'gp'; outputs are set with SIO in a command"),
+            WriteError::TooLarge(v) => write!(f, "{v} does not fit a 32-bit value"),
+            WriteError::NoValue => write!(f, "give a value"),
+            WriteError::Op(op) => write!(f, "op '{op}': use set, store or restore"),
+        }
+    }
+}
+
+impl std::error::Error for WriteError {}
+
+impl From<WriteError> for String {
+    fn from(e: WriteError) -> String {
+        e.to_string()
+    }
+}
+
 impl Write {
     /// The instruction that does it (SAP/STAP/RSAP, SGP/STGP/RSGP), or what
     /// is wrong.
-    pub fn instruction(&self) -> Result<Instruction, String> {
+    pub fn instruction(&self) -> Result<Instruction, WriteError> {
         let axis = match self.kind {
             ReadKind::Ap => true,
             ReadKind::Gp => false,
-            _ => return Err("write takes kind 'ap' or 'gp'; outputs are set with SIO in a command".into()),
+            _ => return Err(WriteError::Kind),
         };
         let (set, store, restore) =
             if axis { (opcode::SAP, opcode::STAP, opcode::RSAP) } else { (opcode::SGP, opcode::STGP, opcode::RSGP) };
         let (number, index) = (self.number, self.index);
         match (self.op.as_deref(), self.value) {
             (None | Some("set"), Some(v)) => {
-                let v = i32::try_from(v).map_err(|_| format!("{v} does not fit a 32-bit value"))?;
+                let v = i32::try_from(v).map_err(|_| WriteError::TooLarge(v))?;
                 Ok(Instruction::new(set, number, index, v))
             }
-            (None | Some("set"), None) => Err("give a value".into()),
+            (None | Some("set"), None) => Err(WriteError::NoValue),
             (Some("store"), _) => Ok(Instruction::new(store, number, index, 0)),
             (Some("restore"), _) => Ok(Instruction::new(restore, number, index, 0)),
-            (Some(other), _) => Err(format!("op '{other}': use set, store or restore")),
+            (Some(other), _) => Err(WriteError::Op(other.to_string())),
         }
     }
 }

@@ -103,9 +103,9 @@ mod tests {
         let mut m = Module::built_in("tmcm-1141").unwrap();
         let program = words(&["MVP ABS, 0, 51200", "WAIT POS, 0, 0", "STOP"]);
         let mut sent = Vec::new();
-        let mut request = |ins: Instruction| -> Result<[u8; FRAME_LEN], String> {
+        let mut request = |ins: Instruction| -> Result<[u8; FRAME_LEN], &str> {
             sent.push(ins.opcode);
-            m.handle_frame(&Request::new(1, ins).encode()).ok_or_else(|| "no reply".to_string())
+            m.handle_frame(&Request::new(1, ins).encode()).ok_or("no reply")
         };
         let mut done = Vec::new();
         assert_eq!(download_and_verify(&mut request, 1, &program, &mut |n| done.push(n)), Ok(()));
@@ -117,9 +117,8 @@ mod tests {
     fn a_word_past_the_memory_and_code_protection_stop_the_download() {
         // Rule 14: a download that runs past the last word answers 4.
         let mut m = Module::built_in("tmcm-1141").unwrap();
-        let mut request = |ins: Instruction| -> Result<[u8; FRAME_LEN], String> {
-            m.handle_frame(&Request::new(1, ins).encode()).ok_or_else(String::new)
-        };
+        let mut request =
+            |ins: Instruction| -> Result<[u8; FRAME_LEN], &str> { m.handle_frame(&Request::new(1, ins).encode()).ok_or("no reply") };
         let too_long = vec![parse_line("MVP ABS, 0, 1").unwrap(); 1025];
         let e = download_and_verify(&mut request, 1, &too_long, &mut |_| ()).unwrap_err();
         assert_eq!(e, DownloadError::NotStored { address: 1024, word: too_long[0], status: 4 });
@@ -129,9 +128,8 @@ mod tests {
         // answers 5.
         let mut m = Module::built_in("tmcm-1141").unwrap();
         m.handle_frame(&Request::new(1, parse_line("SGP 81, 0, 1").unwrap()).encode());
-        let mut request = |ins: Instruction| -> Result<[u8; FRAME_LEN], String> {
-            m.handle_frame(&Request::new(1, ins).encode()).ok_or_else(String::new)
-        };
+        let mut request =
+            |ins: Instruction| -> Result<[u8; FRAME_LEN], &str> { m.handle_frame(&Request::new(1, ins).encode()).ok_or("no reply") };
         let e = download_and_verify(&mut request, 1, &words(&["STOP"]), &mut |_| ()).unwrap_err();
         assert_eq!(e, DownloadError::Unreadable { address: 0, status: 5 });
         assert_eq!(e.to_string(), "reading back word 0: status 5 (configuration EEPROM locked) (code protection?)");

@@ -3,7 +3,7 @@
 //! when asked.
 
 use crate::answers::{Read, read_all};
-use crate::target::Target;
+use crate::target::{Target, TargetError};
 use serde::Deserialize;
 use serde_json::{Value, json};
 
@@ -26,10 +26,10 @@ pub struct Subscription {
 
 impl Subscription {
     /// A subscription from the app's JSON, or what is wrong with it.
-    pub fn parse(text: &str) -> Result<Subscription, String> {
-        let s: Subscription = serde_json::from_str(text).map_err(|e| format!("subscription: {e}"))?;
+    pub fn parse(text: &str) -> Result<Subscription, SubscriptionError> {
+        let s: Subscription = serde_json::from_str(text).map_err(|e| SubscriptionError::Json(e.to_string()))?;
         if s.signals.len() > MAX_SIGNALS {
-            return Err(format!("at most {MAX_SIGNALS} signals"));
+            return Err(SubscriptionError::TooManySignals);
         }
         Ok(s)
     }
@@ -45,18 +45,44 @@ impl Subscription {
     }
 }
 
+/// What is wrong with a subscription.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SubscriptionError {
+    /// Its JSON is wrong (the parser's message).
+    Json(String),
+    /// More than [`MAX_SIGNALS`] signals.
+    TooManySignals,
+}
+
+impl std::fmt::Display for SubscriptionError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SubscriptionError::Json(e) => write!(f, "subscription: {e}"),
+            SubscriptionError::TooManySignals => write!(f, "at most {MAX_SIGNALS} signals"),
+        }
+    }
+}
+
+impl std::error::Error for SubscriptionError {}
+
+impl From<SubscriptionError> for String {
+    fn from(e: SubscriptionError) -> String {
+        e.to_string()
+    }
+}
+
 /// One sample: `{"t", "values", "program"?}`, or `{"error"}`.
 pub fn sample(target: &dyn Target, id: usize, sub: &Subscription) -> Value {
-    let take = || -> Result<Value, String> {
-        let (values, t) = read_all(target, id, &sub.signals).map_err(|e| e.to_string())?;
+    let take = || -> Result<Value, TargetError> {
+        let (values, t) = read_all(target, id, &sub.signals)?;
         let mut out = json!({"t": t, "values": values});
         if let Some(id) = sub.id {
             out["sub"] = json!(id);
         }
         if sub.program {
-            out["program"] = crate::program::state_of(target, id).map_err(|e| e.to_string())?;
+            out["program"] = crate::program::state_of(target, id)?;
         }
         Ok(out)
     };
-    take().unwrap_or_else(|e| json!({"error": e}))
+    take().unwrap_or_else(|e| json!({"error": e.to_string()}))
 }

@@ -107,39 +107,95 @@ impl Names {
     }
 
     /// The number of the axis parameter with this name.
-    pub fn axis(&self, name: &str) -> Result<u8, String> {
+    pub fn axis(&self, name: &str) -> Result<u8, NameError> {
         self.one(Table::Axis, name, None).map(|(_, n)| n)
     }
 
     /// The bank and number of the global parameter with this name; `bank`,
     /// when given, must agree.
-    pub fn global(&self, name: &str, bank: Option<u8>) -> Result<(u8, u8), String> {
+    pub fn global(&self, name: &str, bank: Option<u8>) -> Result<(u8, u8), NameError> {
         self.one(Table::Global, name, bank)
     }
 
-    fn one(&self, table: Table, name: &str, bank: Option<u8>) -> Result<(u8, u8), String> {
-        let what = if table == Table::Axis { "axis" } else { "global" };
+    fn one(&self, table: Table, name: &str, bank: Option<u8>) -> Result<(u8, u8), NameError> {
         let Some((full, places)) = self.table(table).get(&key(name)) else {
-            return Err(format!(
-                "the {} has no {what} parameter named '{name}'{}",
-                self.module,
-                suggest(name, self.table(table).values().map(|v| v.0.as_str()))
-            ));
+            return Err(NameError::Unknown {
+                module: self.module.clone(),
+                table,
+                name: name.to_string(),
+                suggestion: suggest(name, self.table(table).values().map(|v| v.0.as_str())),
+            });
         };
         let matching = self.places(table, name, bank);
         match matching.as_slice() {
             [one] => Ok(*one),
-            [] => Err(format!("'{full}' is a parameter of bank {}, not of bank {}", places[0].0, bank.unwrap_or(0))),
-            many if table == Table::Axis => {
-                Err(format!("'{full}' names axis parameters {}…{}: give the number", many[0].1, many[many.len() - 1].1))
-            }
-            many => Err(format!(
-                "'{full}' names global parameters {}…{} of bank {}: give the number",
-                many[0].1,
-                many[many.len() - 1].1,
-                many[0].0
-            )),
+            [] => Err(NameError::OtherBank { name: full.clone(), bank: places[0].0, asked: bank.unwrap_or(0) }),
+            many => Err(NameError::Several { name: full.clone(), table, bank: many[0].0, first: many[0].1, last: many[many.len() - 1].1 }),
         }
+    }
+}
+
+/// Why a name is no single parameter of the profile.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NameError {
+    /// No parameter of the table has this name.
+    Unknown {
+        /// The module's name.
+        module: String,
+        /// The table looked in.
+        table: Table,
+        /// The name as given.
+        name: String,
+        /// ` (did you mean …?)`, or empty.
+        suggestion: String,
+    },
+    /// The global parameter is in another bank than the one given.
+    OtherBank {
+        /// The parameter's name as the profile spells it.
+        name: String,
+        /// Its bank.
+        bank: u8,
+        /// The bank given (0 when none was).
+        asked: u8,
+    },
+    /// The name stands for a range of parameters (user variables).
+    Several {
+        /// The name as the profile spells it.
+        name: String,
+        /// The table.
+        table: Table,
+        /// Their bank.
+        bank: u8,
+        /// The first parameter number.
+        first: u8,
+        /// The last parameter number.
+        last: u8,
+    },
+}
+
+impl std::fmt::Display for NameError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NameError::Unknown { module, table, name, suggestion } => {
+                let what = if *table == Table::Axis { "axis" } else { "global" };
+                write!(f, "the {module} has no {what} parameter named '{name}'{suggestion}")
+            }
+            NameError::OtherBank { name, bank, asked } => write!(f, "'{name}' is a parameter of bank {bank}, not of bank {asked}"),
+            NameError::Several { name, table: Table::Axis, first, last, .. } => {
+                write!(f, "'{name}' names axis parameters {first}…{last}: give the number")
+            }
+            NameError::Several { name, table: Table::Global, bank, first, last } => {
+                write!(f, "'{name}' names global parameters {first}…{last} of bank {bank}: give the number")
+            }
+        }
+    }
+}
+
+impl std::error::Error for NameError {}
+
+impl From<NameError> for String {
+    fn from(e: NameError) -> String {
+        e.to_string()
     }
 }
 
@@ -205,11 +261,14 @@ mod tests {
         assert_eq!(n.axis("maximum_positioning_speed"), Ok(4));
         assert_eq!(n.axis("MAXIMUM POSITIONING SPEED"), Ok(4));
         assert_eq!(n.axis("MaximumPositioningSpeed"), Ok(4));
-        assert!(n.axis("positioning").unwrap_err().contains("Maximum positioning speed"));
+        assert!(n.axis("positioning").unwrap_err().to_string().contains("Maximum positioning speed"));
         assert_eq!(n.global("Serial address", None), Ok((0, 66)));
-        assert_eq!(n.global("Serial address", Some(2)).unwrap_err(), "'Serial address' is a parameter of bank 0, not of bank 2");
+        assert_eq!(
+            n.global("Serial address", Some(2)).unwrap_err().to_string(),
+            "'Serial address' is a parameter of bank 0, not of bank 2"
+        );
         assert_eq!(n.global("User variable 17", None), Ok((2, 17)));
-        assert!(n.global("User variables #0…#55", None).unwrap_err().ends_with("of bank 2: give the number"));
+        assert!(n.global("User variables #0…#55", None).unwrap_err().to_string().ends_with("of bank 2: give the number"));
         assert!(n.knows(Table::Global, "tmcl_tick_timer") && !n.knows(Table::Axis, "tmcl_tick_timer"));
     }
 }

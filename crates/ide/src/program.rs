@@ -16,9 +16,27 @@ pub const MAX_SOURCE: usize = 2 << 20;
 /// User variables shown in the state.
 const SHOWN_VARIABLES: u8 = 16;
 
+/// A source longer than [`MAX_SOURCE`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooLong;
+
+impl std::fmt::Display for TooLong {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "a program is at most 2 MiB of source")
+    }
+}
+
+impl std::error::Error for TooLong {}
+
+impl From<TooLong> for String {
+    fn from(e: TooLong) -> String {
+        e.to_string()
+    }
+}
+
 /// A source too long to assemble, in words.
-pub fn check_size(source: &str) -> Result<(), String> {
-    if source.len() > MAX_SOURCE { Err("a program is at most 2 MiB of source".into()) } else { Ok(()) }
+pub fn check_size(source: &str) -> Result<(), TooLong> {
+    if source.len() > MAX_SOURCE { Err(TooLong) } else { Ok(()) }
 }
 
 /// The program, or `{"ok": false, "diagnostics": […]}`.
@@ -165,17 +183,53 @@ pub fn state_of(target: &dyn Target, id: usize) -> Result<Value, TargetError> {
 }
 
 /// Checks breakpoint addresses against module `id`'s program memory.
-pub fn check_breakpoints(target: &dyn Target, id: usize, addresses: &[u16]) -> Result<(), String> {
+pub fn check_breakpoints(target: &dyn Target, id: usize, addresses: &[u16]) -> Result<(), BreakpointError> {
     let Some(p) = target.modules().get(id).and_then(|m| m.profile.clone()) else { return Ok(()) };
     // One breakpoint per word of program memory at most.
     let words = usize::from(p.module.program_memory);
     if let Some(a) = addresses.iter().find(|&&a| usize::from(a) >= words) {
-        return Err(format!("breakpoint at {a}: the program memory has addresses 0…{}", words - 1));
+        return Err(BreakpointError::Outside { address: *a, words });
     }
     if addresses.len() > words {
-        return Err(format!("at most {words} breakpoints (one per word of program memory)"));
+        return Err(BreakpointError::TooMany { words });
     }
     Ok(())
+}
+
+/// Why breakpoints were refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BreakpointError {
+    /// An address past the program memory.
+    Outside {
+        /// The address.
+        address: u16,
+        /// Words of program memory.
+        words: usize,
+    },
+    /// More breakpoints than words of program memory.
+    TooMany {
+        /// Words of program memory.
+        words: usize,
+    },
+}
+
+impl std::fmt::Display for BreakpointError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BreakpointError::Outside { address, words } => {
+                write!(f, "breakpoint at {address}: the program memory has addresses 0…{}", words - 1)
+            }
+            BreakpointError::TooMany { words } => write!(f, "at most {words} breakpoints (one per word of program memory)"),
+        }
+    }
+}
+
+impl std::error::Error for BreakpointError {}
+
+impl From<BreakpointError> for String {
+    fn from(e: BreakpointError) -> String {
+        e.to_string()
+    }
 }
 
 /// run, continue, stop, pause, step or reset; then the state.

@@ -82,6 +82,12 @@ impl std::fmt::Display for ParseError {
 
 impl std::error::Error for ParseError {}
 
+impl From<ParseError> for String {
+    fn from(e: ParseError) -> String {
+        e.to_string()
+    }
+}
+
 /// Parses a number as TMCL sources write it: decimal, negative, `$47`,
 /// `0x47`, `0b101`.
 pub fn parse_number(text: &str) -> Option<i64> {

@@ -140,9 +140,70 @@ struct Breakpoints {
     addresses: Vec<u16>,
 }
 
+/// Why a request of the API gets an error answer (`{"error": …}`).
+#[derive(Debug)]
+enum RouteError {
+    /// The body is not the JSON the request takes (the parser's words).
+    Body(String),
+    /// No request has this method and path.
+    NoSuchRequest {
+        /// `GET` or `POST`.
+        method: String,
+        /// The path, or its part after the module id.
+        path: String,
+    },
+    /// The path's module id is no number.
+    NotAModuleId(String),
+    /// The page has no module of this id.
+    NoSuchModule,
+    /// tmclsim has no profile of the module's type.
+    NoProfile,
+    /// The request is refused: its line, value, program or profile is
+    /// wrong (the answers' own words).
+    Refused(String),
+}
+
+impl std::fmt::Display for RouteError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RouteError::Body(e) => write!(f, "the request's JSON: {e}"),
+            RouteError::NoSuchRequest { method, path } => write!(f, "no such request: {method} {path}"),
+            RouteError::NotAModuleId(id) => write!(f, "'{id}' is not a module id"),
+            RouteError::NoSuchModule => write!(f, "no such module"),
+            RouteError::NoProfile => write!(f, "tmclsim has no profile of this module's type"),
+            RouteError::Refused(message) => f.write_str(message),
+        }
+    }
+}
+
+/// The errors of the answers, which the app shows as they are.
+macro_rules! refused_from {
+    ($($t:ty),*) => {$(
+        impl From<$t> for RouteError {
+            fn from(e: $t) -> RouteError {
+                RouteError::Refused(e.to_string())
+            }
+        }
+    )*};
+}
+
+refused_from!(
+    tmclsim_protocol::mnemonic::ParseError,
+    answers::WriteError,
+    program::TooLong,
+    program::BreakpointError,
+    tmclsim_profile::ProfileError
+);
+
+impl From<Failure> for RouteError {
+    fn from(f: Failure) -> RouteError {
+        RouteError::Refused(f.message)
+    }
+}
+
 /// The body of a request as `T`, or what is wrong with it.
-fn body<T: DeserializeOwned>(text: &str) -> Result<T, String> {
-    serde_json::from_str(if text.trim().is_empty() { "{}" } else { text }).map_err(|e| format!("the request's JSON: {e}"))
+fn body<T: DeserializeOwned>(text: &str) -> Result<T, RouteError> {
+    serde_json::from_str(if text.trim().is_empty() { "{}" } else { text }).map_err(|e| RouteError::Body(e.to_string()))
 }
 
 fn error(message: impl std::fmt::Display) -> Value {
@@ -210,7 +271,7 @@ impl Page {
         self.route(method, path, body_text).unwrap_or_else(error)
     }
 
-    fn route(&mut self, method: &str, path: &str, text: &str) -> Result<Value, String> {
+    fn route(&mut self, method: &str, path: &str, text: &str) -> Result<Value, RouteError> {
         let t = &self.target;
         let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
         let v = match (method, parts.as_slice()) {
@@ -221,7 +282,7 @@ impl Page {
             ("GET", ["api", "modules"]) => answers::modules_json(t),
             ("POST", ["api", "modules"]) => {
                 let b: NewModule = body(text)?;
-                let id = self.add(&b.profile, b.world.as_deref()).map_err(|f| f.message)?;
+                let id = self.add(&b.profile, b.world.as_deref())?;
                 json!({ "id": id })
             }
             ("POST", ["api", "scan"]) => answer(t.scan().map(|_| Value::Null)),
@@ -235,24 +296,24 @@ impl Page {
                 program::assemble_json(&b.source, profile.as_deref())
             }
             (method, ["api", "modules", id, rest @ ..]) => {
-                let id: usize = id.parse().map_err(|_| format!("'{id}' is not a module id"))?;
+                let id: usize = id.parse().map_err(|_| RouteError::NotAModuleId((*id).to_string()))?;
                 if id >= t.sims.len() {
-                    return Err("no such module".into());
+                    return Err(RouteError::NoSuchModule);
                 }
                 module_route(t, id, method, rest, text)?
             }
-            _ => return Err(format!("no such request: {method} {path}")),
+            _ => return Err(RouteError::NoSuchRequest { method: method.to_string(), path: path.to_string() }),
         };
         Ok(v)
     }
 }
 
 /// The requests of module `id` (`/api/modules/{id}/…`).
-fn module_route(t: &PageTarget, id: usize, method: &str, rest: &[&str], text: &str) -> Result<Value, String> {
+fn module_route(t: &PageTarget, id: usize, method: &str, rest: &[&str], text: &str) -> Result<Value, RouteError> {
     let v = match (method, rest) {
         ("GET", ["profile"]) => match &t.entries[id].profile {
             Some(p) => profile_json::of(p),
-            None => return Err("tmclsim has no profile of this module's type".into()),
+            None => return Err(RouteError::NoProfile),
         },
         ("POST", ["command"]) => {
             let b: Line = body(text)?;
@@ -264,7 +325,7 @@ fn module_route(t: &PageTarget, id: usize, method: &str, rest: &[&str], text: &s
             let ins = body::<Write>(text)?.instruction()?;
             answer(answers::exchange(t, id, ins))
         }
-        ("GET", ["world"]) => answers::world_state_json(&t.snapshot(id).ok_or("no such module")?),
+        ("GET", ["world"]) => answers::world_state_json(&t.snapshot(id).ok_or(RouteError::NoSuchModule)?),
         ("POST", ["world"]) => answer(answers::world_json(t, id, &body::<Line>(text)?.line)),
         ("POST", ["program", "download"]) => {
             let b: Source = body(text)?;
@@ -289,10 +350,10 @@ fn module_route(t: &PageTarget, id: usize, method: &str, rest: &[&str], text: &s
         }
         ("POST", ["program", action]) => match program::action(t, id, action) {
             Ok(v) => v,
-            Err(ActionError::Unknown(e)) => return Err(e),
+            Err(ActionError::Unknown(e)) => return Err(RouteError::Refused(e)),
             Err(ActionError::Target(e)) => error(e),
         },
-        _ => return Err(format!("no such request: {method} {}", rest.join("/"))),
+        _ => return Err(RouteError::NoSuchRequest { method: method.to_string(), path: rest.join("/") }),
     };
     Ok(v)
 }

@@ -57,7 +57,7 @@ async fn stream(mut socket: WebSocket, app: App, id: usize) {
                         sub = s;
                     }
                     Err(e) => {
-                        let _ = socket.send(Message::Text(json!({"error": e}).to_string().into())).await;
+                        let _ = socket.send(Message::Text(json!({"error": e.to_string()}).to_string().into())).await;
                     }
                 }
             }
