@@ -22,7 +22,6 @@ pub mod reg {
     pub const WD_DIVIDER: u16 = 0x0400;
     pub const WD_PROCESS_DATA: u16 = 0x0420;
     pub const WD_STATUS: u16 = 0x0440;
-    pub const EEPROM_CONFIG: u16 = 0x0500;
     pub const EEPROM_CONTROL: u16 = 0x0502;
     pub const EEPROM_ADDRESS: u16 = 0x0504;
     pub const EEPROM_DATA: u16 = 0x0508;
@@ -140,10 +139,6 @@ impl Esc {
 
     pub fn state(&self) -> u8 {
         self.mem[reg::AL_STATUS as usize] & 0x0F
-    }
-
-    pub fn al_status_code(&self) -> u16 {
-        rd16(&self.mem, reg::AL_STATUS_CODE)
     }
 
     /// Sets the AL status; `Some(code)` sets the error indication.

@@ -3,6 +3,7 @@
 //! index, address (4), length/more (2), interrupt (2), data, working
 //! counter (2); little endian.
 
+/// The EtherType of EtherCAT frames.
 pub const ETHERTYPE: u16 = 0x88A4;
 /// Ethernet header.
 pub const ETH_HEADER: usize = 14;
@@ -12,21 +13,26 @@ pub const DATAGRAM_HEADER: usize = 10;
 /// A datagram inside a frame, by offsets (the frame is edited in place).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Datagram {
+    /// The command (APRD, FPWR, LRW, …).
     pub command: u8,
     /// Offset of the datagram header in the frame.
     pub at: usize,
+    /// Length of the data in bytes.
     pub len: usize,
 }
 
 impl Datagram {
+    /// Offset of the 4-byte address in the frame.
     pub fn address_offset(&self) -> usize {
         self.at + 2
     }
 
+    /// Where the data lie in the frame.
     pub fn data(&self) -> std::ops::Range<usize> {
         self.at + DATAGRAM_HEADER..self.at + DATAGRAM_HEADER + self.len
     }
 
+    /// Offset of the 2-byte working counter in the frame.
     pub fn wkc_offset(&self) -> usize {
         self.at + DATAGRAM_HEADER + self.len
     }

@@ -3,15 +3,20 @@
 
 use tmclsim_firmware::Profile;
 
+/// How a slave names itself: SII EEPROM and objects 0x1008 and 0x1018.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Identity {
     /// The device name: the module's name.
     pub name: String,
+    /// The EtherCAT vendor id.
     pub vendor_id: u32,
+    /// The product code.
     pub product_code: u32,
     /// The firmware version: major in the high word, minor in the low.
     pub revision: u32,
+    /// The order code (`TMCM-1310`).
     pub order_code: String,
+    /// The device group the ESI file sorts the slave into.
     pub group: String,
 }
 

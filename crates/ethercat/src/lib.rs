@@ -16,17 +16,13 @@
 //! returns the frame as it leaves the last slave. The raw-socket link
 //! lives in the server crate.
 
-// Not yet: the ESC registers and SII layout still lack docs.
-#![allow(missing_docs)]
-
-pub mod esc;
+mod esc;
 pub mod frame;
 pub mod identity;
-pub mod mailbox;
+mod mailbox;
 pub mod segment;
-pub mod sii;
-pub mod slave;
+mod sii;
+mod slave;
 
 pub use identity::{Identity, NotASlave};
 pub use segment::Segment;
-pub use slave::Slave;

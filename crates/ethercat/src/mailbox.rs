@@ -20,7 +20,6 @@ pub mod abort {
     pub const READ_ONLY: u32 = 0x0601_0002;
     pub const LENGTH: u32 = 0x0607_0010;
     pub const COMMAND: u32 = 0x0504_0001;
-    pub const GENERAL: u32 = 0x0800_0000;
 }
 
 /// A decoded SDO request.
@@ -109,7 +108,8 @@ pub fn abort_response(counter: u8, index: u16, subindex: u8, code: u32) -> Vec<u
     m
 }
 
-/// An SDO request as a master sends it (tests and tools).
+/// An SDO request as a master sends it.
+#[cfg(test)]
 pub fn request(counter: u8, sdo: &Sdo) -> Vec<u8> {
     let mut body = Vec::new();
     match sdo {

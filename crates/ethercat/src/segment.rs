@@ -8,8 +8,10 @@ use crate::identity::{Identity, NotASlave};
 use crate::slave::Slave;
 use tmclsim_firmware::{Bus, Module};
 
+/// EtherCAT slaves in a line, each in front of a module.
 pub struct Segment {
-    pub slaves: Vec<Slave>,
+    /// The slaves, in the order a frame passes them.
+    pub(crate) slaves: Vec<Slave>,
     /// The modules, slave `i` in front of module `i`.
     pub bus: Bus,
 }

@@ -56,22 +56,31 @@ fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8
 /// output.
 #[derive(Deserialize, Clone, Copy)]
 pub struct Read {
+    /// What is read.
     pub kind: ReadKind,
+    /// The parameter or port number.
     pub number: u8,
+    /// The motor (`ap`) or bank (`gp`, `input`); unused for outputs.
     #[serde(default)]
     pub index: u8,
 }
 
+/// What a [`Read`] reads (its JSON `kind`).
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum ReadKind {
+    /// An axis parameter (GAP).
     Ap,
+    /// A global parameter (GGP).
     Gp,
+    /// An input (GIO).
     Input,
+    /// An output (GIO bank 2).
     Output,
 }
 
 impl Read {
+    /// The request that reads it.
     pub fn instruction(self) -> Instruction {
         match self.kind {
             ReadKind::Ap => Instruction::new(opcode::GAP, self.number, self.index, 0),
@@ -106,11 +115,16 @@ pub fn read_json(target: &dyn Target, id: usize, reads: &[Read]) -> Result<Value
 /// from the EEPROM.
 #[derive(Deserialize)]
 pub struct Write {
+    /// `ap` or `gp` (the others are refused).
     pub kind: ReadKind,
+    /// The parameter number.
     pub number: u8,
+    /// The motor (`ap`) or bank (`gp`).
     #[serde(default)]
     pub index: u8,
+    /// The value to set (`set` only).
     pub value: Option<i64>,
+    /// `set` (the default), `store` or `restore`.
     pub op: Option<String>,
 }
 

@@ -14,13 +14,37 @@ pub enum DownloadError<E> {
     Link(E),
     /// A control command (`what`: "stop", "enter download mode", "exit
     /// download mode") was answered with an error status.
-    Refused { what: &'static str, status: u8 },
+    Refused {
+        /// The command, in words.
+        what: &'static str,
+        /// The status answered.
+        status: u8,
+    },
     /// A word was answered with another status than 101.
-    NotStored { address: usize, word: Instruction, status: u8 },
+    NotStored {
+        /// The word's address.
+        address: usize,
+        /// The word.
+        word: Instruction,
+        /// The status answered.
+        status: u8,
+    },
     /// 134 of a word was answered with an error status (code protection).
-    Unreadable { address: usize, status: u8 },
+    Unreadable {
+        /// The word's address.
+        address: usize,
+        /// The status answered.
+        status: u8,
+    },
     /// A word reads back as another word.
-    Differs { address: usize, stored: Instruction, sent: Instruction },
+    Differs {
+        /// The word's address.
+        address: usize,
+        /// The word read back.
+        stored: Instruction,
+        /// The word sent.
+        sent: Instruction,
+    },
 }
 
 impl<E: std::fmt::Display> std::fmt::Display for DownloadError<E> {

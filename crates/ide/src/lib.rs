@@ -10,9 +10,6 @@
 //! verification ([`download`]), and what an observer reads off a virtual
 //! module ([`observe`]).
 
-// Not yet: the requests' and answers' fields still lack docs.
-#![allow(missing_docs)]
-
 pub mod answers;
 pub mod download;
 pub mod line;

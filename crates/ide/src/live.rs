@@ -10,12 +10,15 @@ use serde_json::{Value, json};
 /// Most signals per subscription.
 pub const MAX_SIGNALS: usize = 64;
 
+/// What the live stream samples: the app's JSON.
 #[derive(Deserialize, Default, Clone)]
 pub struct Subscription {
+    /// The values read in every sample.
     #[serde(default)]
     pub signals: Vec<Read>,
     /// Samples per second (1…100; 20 when not given).
     pub rate: Option<f64>,
+    /// Whether every sample holds the program's state too.
     #[serde(default)]
     pub program: bool,
     /// Echoed as `sub` in every sample of this subscription, so that the

@@ -32,7 +32,9 @@ pub fn key(name: &str) -> String {
 /// Which table a command's type operand names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Table {
+    /// Axis parameters (SAP, GAP, …).
     Axis,
+    /// Global parameters (SGP, GGP, …).
     Global,
 }
 
@@ -66,6 +68,7 @@ pub struct Names {
 }
 
 impl Names {
+    /// The names of every parameter of `profile`.
     pub fn new(profile: &Profile) -> Names {
         let mut names = Names { module: profile.module.name.clone(), ..Names::default() };
         for table in [Table::Axis, Table::Global] {

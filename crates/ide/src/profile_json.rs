@@ -102,6 +102,8 @@ fn tuning(profile: &Profile) -> Value {
     json!({ "stallguard2": stallguard2, "coolstep": coolstep, "reference_search": reference })
 }
 
+/// A profile as the app reads it: the module, its commands, parameters,
+/// inputs and outputs, and tuning hints.
 pub fn of(profile: &Profile) -> Value {
     let m = &profile.module;
     let commands: Vec<&str> = m.opcodes.iter().filter_map(|&o| tmclsim_protocol::opcode::mnemonic(o)).collect();

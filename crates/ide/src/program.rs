@@ -259,7 +259,9 @@ pub fn action(target: &dyn Target, id: usize, action: &str) -> Result<Value, Act
 /// Why a program action failed: an unknown action, or the target's error.
 #[derive(Debug)]
 pub enum ActionError {
+    /// No such action (the message says which there are).
     Unknown(String),
+    /// The target failed.
     Target(TargetError),
 }
 

@@ -11,6 +11,7 @@ use tmclsim_protocol::{FRAME_LEN, Instruction};
 /// One module of a target, as the module list shows it.
 #[derive(Clone)]
 pub struct ModuleEntry {
+    /// Its TMCL module address.
     pub address: u8,
     /// The profile of the type the module reports (136 type 1), if any.
     pub profile: Option<Arc<Profile>>,
@@ -23,7 +24,9 @@ pub struct ModuleEntry {
 /// A module that answered a scan.
 #[derive(Clone, Debug)]
 pub struct Found {
+    /// The address that answered.
     pub address: u8,
+    /// Its 136 type 0 answer, e.g. `1141V146`.
     pub firmware: String,
     /// The profile's name, if the module's type has one.
     pub profile: Option<String>,
@@ -49,11 +52,14 @@ impl std::fmt::Display for TargetError {
     }
 }
 
+/// Modules the app works with: those this process simulates, or real
+/// (or served) modules on a TMCL link.
 pub trait Target: Send + Sync + 'static {
     /// `virtual` or `link`.
     fn kind(&self) -> &'static str;
     /// Where the modules are, in words.
     fn describe(&self) -> String;
+    /// The modules, by id (their index).
     fn modules(&self) -> &[ModuleEntry];
     /// One TMCL request to module `id` through the same request path as a
     /// frame from a link; the raw reply.
@@ -92,6 +98,7 @@ pub trait Target: Send + Sync + 'static {
     /// Sets the program's breakpoints; the firmware stops on them (virtual)
     /// or the target emulates them by single steps (link).
     fn set_breakpoints(&self, id: usize, addresses: &[u16]) -> Result<(), TargetError>;
+    /// The program's breakpoints.
     fn breakpoints(&self, id: usize) -> Vec<u16>;
     /// The breakpoint the program stands on, if it stopped at one.
     fn breakpoint_hit(&self, id: usize) -> Option<u16>;

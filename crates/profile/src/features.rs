@@ -50,6 +50,7 @@ impl StallDetection {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Encoder {
+    /// No encoder input.
     None,
     /// An incremental encoder on a TMC423 interface: AP 209 position,
     /// AP 210 prescaler.
@@ -92,7 +93,9 @@ pub struct EthercatIdentity {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EepromMagic {
+    /// The global parameter number.
     pub parameter: u8,
+    /// The value that marks an initialised EEPROM.
     pub value: i32,
 }
 

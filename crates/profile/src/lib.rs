@@ -9,9 +9,6 @@
 //! search, stall detection, encoder, CAN identifiers, EEPROM lock, …). The
 //! firmware and the assembler read them; neither knows module names.
 
-// Not yet: the profile schema's fields still lack docs.
-#![allow(missing_docs)]
-
 mod error;
 mod features;
 
@@ -89,17 +86,26 @@ impl DefaultSource {
 /// One axis or global parameter (or a run of them, for user variables).
 #[derive(Clone, Debug)]
 pub struct Parameter {
+    /// The parameter number (the type byte of SAP/GAP, SGP/GGP).
     pub number: u8,
+    /// The name as the manual gives it (a range row's name for its run).
     pub name: String,
     /// Its own name when it is one of a range row's parameters ("User
     /// variable 17"); `name` is then the range's.
     pub own_name: Option<String>,
+    /// What may be done with it: read, write, store in the EEPROM, …
     pub access: Access,
+    /// The smallest value.
     pub min: i64,
+    /// The largest value.
     pub max: i64,
+    /// The value after a reset with a fresh EEPROM.
     pub default: i64,
+    /// Where the default comes from.
     pub default_source: DefaultSource,
+    /// The unit, when the manual names one.
     pub unit: Option<String>,
+    /// Where a value or rule comes from, or what is special about it.
     pub note: Option<String>,
     /// When the values within `min…max` are not all valid: the valid
     /// ones, as inclusive ranges (e.g. AP 193's modes 1–8, 65–68, 133–136).
@@ -115,7 +121,9 @@ pub struct Parameter {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Quantity {
+    /// A velocity (pulse divisor).
     Velocity,
+    /// An acceleration (pulse and ramp divisors).
     Acceleration,
 }
 
@@ -148,11 +156,15 @@ impl Parameter {
     }
 }
 
+/// What kind of I/O channel a port is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum PortDirection {
+    /// An input (GIO).
     Input,
+    /// An output (SIO, GIO bank 2).
     Output,
+    /// The switch inputs' pull-up resistors (SIO bank 0).
     Pullup,
 }
 
@@ -164,50 +176,78 @@ pub enum PortRole {
     Supply,
 }
 
+/// An I/O port of the module (SIO/GIO), from the profile's `[[port]]` rows.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Port {
+    /// Input, output or pull-up.
     pub direction: PortDirection,
+    /// The bank of SIO/GIO.
     pub bank: u8,
+    /// The port number within its bank.
     pub number: u8,
+    /// The name as the manual gives it (`OUT1`).
     pub name: String,
+    /// The smallest value.
     pub min: i64,
+    /// The largest value.
     pub max: i64,
+    /// The value after a reset.
     #[serde(default)]
     pub default: i64,
+    /// The unit, when the manual names one.
     #[serde(default)]
     pub unit: Option<String>,
     /// What the channel measures (`None`: a plain digital or analog input).
     #[serde(default)]
     pub role: Option<PortRole>,
+    /// Where a value or rule comes from, or what is special about it.
     #[serde(default)]
     pub note: Option<String>,
 }
 
+/// An interrupt of the module's TMCL interrupt table (EI, DI, VECT).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Interrupt {
+    /// The interrupt number.
     pub number: u8,
+    /// Its name in the manual.
     pub name: String,
+    /// Its symbol in `Interrupts.inc` (`TI_TIMER0`).
     pub symbol: String,
 }
 
+/// The `[module]` table of a profile: what the module is and has.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModuleInfo {
+    /// The module's name (`TMCM-1141`).
     pub name: String,
+    /// The type number 136 type 1 reports (1141).
     pub type_number: u16,
+    /// The firmware version, major and minor (1, 46 for V1.46).
     pub firmware: [u8; 2],
+    /// Number of motors.
     pub axes: u8,
+    /// Width of the position counters in bits.
     pub position_bits: u8,
+    /// The motion controller chip (`TMC429`).
     pub motion_controller: String,
+    /// Words of TMCL program memory.
     pub program_memory: u16,
+    /// Where `program_memory` comes from, when not from the manual.
     #[serde(default)]
     pub program_memory_source: Option<String>,
+    /// Number of user variables.
     pub user_variables: u16,
+    /// How many of them (from 0) can be stored in the EEPROM.
     pub user_variables_stored: u16,
+    /// Number of coordinates per motor (SCO, GCO, CCO).
     pub coordinates: u8,
+    /// The instruction numbers the module has.
     pub opcodes: Vec<u8>,
+    /// The instruction numbers it executes in ASCII mode.
     #[serde(default)]
     pub ascii_opcodes: Vec<u8>,
     /// The host interfaces the module has, as its manual lists them: a
@@ -219,10 +259,15 @@ pub struct ModuleInfo {
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum Interface {
+    /// USB (a virtual serial port).
     Usb,
+    /// RS-232.
     Rs232,
+    /// RS-485 (a multi-drop bus).
     Rs485,
+    /// CAN.
     Can,
+    /// EtherCAT.
     Ethercat,
 }
 
@@ -297,12 +342,19 @@ struct ProfileFile {
 /// table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InterruptSource {
+    /// Timer n (`TI_TIMERn`).
     Timer(u8),
+    /// Motor n reached its target (`TI_TARGETn`).
     TargetReached(u8),
+    /// Motor n stalled (`TI_STALLn`).
     Stall(u8),
+    /// Motor n's left stop switch (`TI_STOPLEFTn`).
     StopLeft(u8),
+    /// Motor n's right stop switch (`TI_STOPRIGHTn`).
     StopRight(u8),
+    /// Input n changed (`TI_INPUTCHANGEn`).
     InputChange(u8),
+    /// Motor n's encoder deviates (`TI_DEVIATIONn`).
     Deviation(u8),
 }
 
@@ -334,12 +386,15 @@ pub const BANKS: usize = 4;
 /// A loaded, indexed module profile.
 #[derive(Debug)]
 pub struct Profile {
+    /// What the module is and has.
     pub module: ModuleInfo,
     /// What this module can do, beyond its parameter tables.
     pub features: Features,
     axis: Vec<Option<Parameter>>,
     global: [Vec<Option<Parameter>>; BANKS],
+    /// The I/O ports.
     pub ports: Vec<Port>,
+    /// The interrupt table.
     pub interrupts: Vec<Interrupt>,
     /// The interrupts' sources, read from their symbols once.
     sources: Vec<(InterruptSource, u8)>,
@@ -417,18 +472,22 @@ impl Profile {
         BUILT_IN.iter().map(|(n, _)| *n).collect()
     }
 
+    /// The axis parameter of this number, if the module has it.
     pub fn axis_parameter(&self, number: u8) -> Option<&Parameter> {
         self.axis[number as usize].as_ref()
     }
 
+    /// The global parameter of this bank and number, if the module has it.
     pub fn global_parameter(&self, bank: u8, number: u8) -> Option<&Parameter> {
         self.global.get(bank as usize)?[number as usize].as_ref()
     }
 
+    /// Every axis parameter, by number.
     pub fn axis_parameters(&self) -> impl Iterator<Item = &Parameter> {
         self.axis.iter().flatten()
     }
 
+    /// Every global parameter of a bank, by number.
     pub fn global_parameters(&self, bank: u8) -> impl Iterator<Item = &Parameter> {
         self.global.get(bank as usize).into_iter().flatten().flatten()
     }
@@ -438,18 +497,22 @@ impl Profile {
         self.global_parameters(bank).next().is_some()
     }
 
+    /// Whether the module has this instruction.
     pub fn has_opcode(&self, opcode: u8) -> bool {
         self.opcode_set[opcode as usize]
     }
 
+    /// Whether ASCII mode executes this instruction.
     pub fn ascii_allows(&self, opcode: u8) -> bool {
         self.ascii_set[opcode as usize]
     }
 
+    /// The port of this kind, bank and number, if the module has it.
     pub fn port(&self, direction: PortDirection, bank: u8, number: u8) -> Option<&Port> {
         self.ports.iter().find(|p| p.direction == direction && p.bank == bank && p.number == number)
     }
 
+    /// The interrupt of this number, if the module has it.
     pub fn interrupt(&self, number: u8) -> Option<&Interrupt> {
         self.interrupts.iter().find(|i| i.number == number)
     }

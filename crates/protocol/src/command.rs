@@ -12,16 +12,22 @@ use crate::status::Status;
 /// MVP / MVPA addressing mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MoveMode {
+    /// ABS: to an absolute position.
     Absolute = 0,
+    /// REL: by a distance from the actual position.
     Relative = 1,
+    /// COORD: to a stored coordinate.
     Coordinate = 2,
 }
 
 /// RFS action.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RfsAction {
+    /// Start the reference search.
     Start = 0,
+    /// Stop the reference search.
     Stop = 1,
+    /// Whether a reference search is running.
     Status = 2,
 }
 
@@ -29,21 +35,34 @@ pub enum RfsAction {
 /// family (0…11, CALCV without SWAP).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CalcOp {
+    /// ADD: a + b.
     Add = 0,
+    /// SUB: a − b.
     Sub = 1,
+    /// MUL: a × b.
     Mul = 2,
+    /// DIV: a / b.
     Div = 3,
+    /// MOD: a mod b.
     Mod = 4,
+    /// AND: bitwise a and b.
     And = 5,
+    /// OR: bitwise a or b.
     Or = 6,
+    /// XOR: bitwise a xor b.
     Xor = 7,
+    /// NOT: bitwise not a (b unused).
     Not = 8,
+    /// LOAD: a ⟵ b.
     Load = 9,
+    /// SWAP: exchange a and b.
     Swap = 10,
+    /// COMP: compare a with b (sets the flags for JC).
     Comp = 11,
 }
 
 impl CalcOp {
+    /// Every operation, by code.
     pub const ALL: [CalcOp; 12] = [
         CalcOp::Add,
         CalcOp::Sub,
@@ -59,10 +78,12 @@ impl CalcOp {
         CalcOp::Comp,
     ];
 
+    /// The operation of a type byte.
     pub fn from_code(code: u8) -> Option<CalcOp> {
         CalcOp::ALL.get(code as usize).copied()
     }
 
+    /// The mnemonic (`ADD`).
     pub const fn name(self) -> &'static str {
         ["ADD", "SUB", "MUL", "DIV", "MOD", "AND", "OR", "XOR", "NOT", "LOAD", "SWAP", "COMP"][self as usize]
     }
@@ -71,21 +92,34 @@ impl CalcOp {
 /// JC / CALL conditions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Condition {
+    /// ZE: the last result is zero.
     Zero = 0,
+    /// NZ: the last result is not zero.
     NotZero = 1,
+    /// EQ: equal.
     Equal = 2,
+    /// NE: not equal.
     NotEqual = 3,
+    /// GT: greater.
     Greater = 4,
+    /// GE: greater or equal.
     GreaterEqual = 5,
+    /// LT: lower.
     Lower = 6,
+    /// LE: lower or equal.
     LowerEqual = 7,
+    /// ETO: a WAIT timed out.
     Timeout = 8,
+    /// EAL: an external alarm.
     Alarm = 9,
+    /// EDV: the encoder deviates.
     Deviation = 10,
+    /// EPO: position error.
     PositionError = 11,
 }
 
 impl Condition {
+    /// Every condition, by code.
     pub const ALL: [Condition; 12] = [
         Condition::Zero,
         Condition::NotZero,
@@ -101,10 +135,12 @@ impl Condition {
         Condition::PositionError,
     ];
 
+    /// The condition of a type byte.
     pub fn from_code(code: u8) -> Option<Condition> {
         Condition::ALL.get(code as usize).copied()
     }
 
+    /// The mnemonic (`ZE`).
     pub const fn name(self) -> &'static str {
         ["ZE", "NZ", "EQ", "NE", "GT", "GE", "LT", "LE", "ETO", "EAL", "EDV", "EPO"][self as usize]
     }
@@ -113,14 +149,20 @@ impl Condition {
 /// WAIT conditions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WaitCondition {
+    /// TICKS: a number of 10 ms ticks.
     Ticks = 0,
+    /// POS: the motor reaches its target.
     Position = 1,
+    /// REFSW: the reference switch.
     ReferenceSwitch = 2,
+    /// LIMSW: a limit switch.
     LimitSwitch = 3,
+    /// RFS: the reference search ends.
     ReferenceSearch = 4,
 }
 
 impl WaitCondition {
+    /// The condition of a type byte.
     pub fn from_code(code: u8) -> Option<WaitCondition> {
         Some(match code {
             0 => WaitCondition::Ticks,
@@ -132,6 +174,7 @@ impl WaitCondition {
         })
     }
 
+    /// The mnemonic (`TICKS`).
     pub const fn name(self) -> &'static str {
         ["TICKS", "POS", "REFSW", "LIMSW", "RFS"][self as usize]
     }
@@ -140,15 +183,22 @@ impl WaitCondition {
 /// CLE flags.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ErrorFlag {
+    /// ALL: every flag.
     All = 0,
+    /// ETO: the WAIT timeout flag.
     Timeout = 1,
+    /// EAL: the external alarm flag.
     Alarm = 2,
+    /// EDV: the deviation flag.
     Deviation = 3,
+    /// EPO: the position error flag.
     Position = 4,
+    /// ESD: the shutdown flag.
     Shutdown = 5,
 }
 
 impl ErrorFlag {
+    /// The flag of a type byte.
     pub fn from_code(code: u8) -> Option<ErrorFlag> {
         Some(match code {
             0 => ErrorFlag::All,
@@ -161,6 +211,7 @@ impl ErrorFlag {
         })
     }
 
+    /// The mnemonic (`ALL`).
     pub const fn name(self) -> &'static str {
         ["ALL", "ETO", "EAL", "EDV", "EPO", "ESD"][self as usize]
     }
@@ -169,228 +220,394 @@ impl ErrorFlag {
 /// Every TMCL command of the three modules, typed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Command {
+    /// ROR: rotate right (positive direction).
     Ror {
+        /// Motor number.
         motor: u8,
+        /// Velocity in internal units.
         velocity: i32,
     },
+    /// ROL: rotate left (negative direction).
     Rol {
+        /// Motor number.
         motor: u8,
+        /// Velocity in internal units.
         velocity: i32,
     },
+    /// MST: stop the motor.
     Mst {
+        /// Motor number.
         motor: u8,
     },
+    /// MVP: move to a position.
     Mvp {
+        /// ABS, REL or COORD.
         mode: MoveMode,
+        /// Motor number.
         motor: u8,
+        /// Target position, distance or coordinate number, by mode (microsteps).
         value: i32,
     },
+    /// SAP: set an axis parameter.
     Sap {
+        /// Axis parameter number.
         param: u8,
+        /// Motor number.
         motor: u8,
+        /// The new value.
         value: i32,
     },
+    /// GAP: get an axis parameter.
     Gap {
+        /// Axis parameter number.
         param: u8,
+        /// Motor number.
         motor: u8,
     },
+    /// STAP: store an axis parameter in the EEPROM.
     Stap {
+        /// Axis parameter number.
         param: u8,
+        /// Motor number.
         motor: u8,
     },
+    /// RSAP: restore an axis parameter from the EEPROM.
     Rsap {
+        /// Axis parameter number.
         param: u8,
+        /// Motor number.
         motor: u8,
     },
+    /// SGP: set a global parameter.
     Sgp {
+        /// Global parameter number.
         param: u8,
+        /// Bank of the parameter.
         bank: u8,
+        /// The new value.
         value: i32,
     },
+    /// GGP: get a global parameter.
     Ggp {
+        /// Global parameter number.
         param: u8,
+        /// Bank of the parameter.
         bank: u8,
     },
+    /// STGP: store a global parameter in the EEPROM.
     Stgp {
+        /// Global parameter number.
         param: u8,
+        /// Bank of the parameter.
         bank: u8,
     },
+    /// RSGP: restore a global parameter from the EEPROM.
     Rsgp {
+        /// Global parameter number.
         param: u8,
+        /// Bank of the parameter.
         bank: u8,
     },
+    /// RFS: reference search.
     Rfs {
+        /// Start, stop or status.
         action: RfsAction,
+        /// Motor number.
         motor: u8,
     },
+    /// SIO: set an output.
     Sio {
+        /// Output number.
         port: u8,
+        /// Bank (2: digital outputs).
         bank: u8,
+        /// 0 or 1.
         value: i32,
     },
+    /// GIO: get an input or output.
     Gio {
+        /// Input or output number.
         port: u8,
+        /// Bank (0: digital inputs, 1: analog inputs, 2: outputs).
         bank: u8,
     },
+    /// CALC: accumulator ⟵ accumulator `op` value.
     Calc {
+        /// The operation.
         op: CalcOp,
+        /// The second operand.
         value: i32,
     },
+    /// COMP: compare the accumulator with a value (sets the flags for JC).
     Comp {
+        /// The value compared with.
         value: i32,
     },
+    /// JC: jump if a condition holds.
     Jc {
+        /// The condition.
         condition: Condition,
+        /// Program address jumped to.
         address: i32,
     },
+    /// JA: jump.
     Ja {
+        /// Program address jumped to.
         address: i32,
     },
+    /// CSUB: call a subroutine.
     Csub {
+        /// Program address of the subroutine.
         address: i32,
     },
+    /// RSUB: return from a subroutine.
     Rsub,
+    /// EI: enable an interrupt (255: all).
     Ei {
+        /// Interrupt number.
         interrupt: u8,
     },
+    /// DI: disable an interrupt (255: all).
     Di {
+        /// Interrupt number.
         interrupt: u8,
     },
+    /// WAIT: wait for an event or a time.
     Wait {
+        /// What to wait for.
         condition: WaitCondition,
+        /// Motor of POS, REFSW, LIMSW and RFS.
         motor: u8,
+        /// Time (TICKS) or timeout (the others; 0: none), in 10 ms ticks.
         ticks: i32,
     },
+    /// STOP: end the program.
     Stop,
+    /// SAC: exchange bytes over an SPI bus.
     Sac {
+        /// SPI bus number (the type byte).
         bus: u8,
+        /// Number of bytes (the motor byte).
         count: u8,
+        /// The bytes to send.
         value: i32,
     },
+    /// SCO: set a coordinate.
     Sco {
+        /// Coordinate number.
         coordinate: u8,
+        /// Motor number.
         motor: u8,
+        /// Position in microsteps.
         value: i32,
     },
+    /// GCO: get a coordinate.
     Gco {
+        /// Coordinate number.
         coordinate: u8,
+        /// Motor number.
         motor: u8,
     },
+    /// CCO: capture the actual position as a coordinate.
     Cco {
+        /// Coordinate number.
         coordinate: u8,
+        /// Motor number.
         motor: u8,
     },
+    /// CALCX: calculate with the accumulator and the X register.
     CalcX {
+        /// The operation.
         op: CalcOp,
     },
+    /// AAP: set an axis parameter to the accumulator.
     Aap {
+        /// Axis parameter number.
         param: u8,
+        /// Motor number.
         motor: u8,
     },
+    /// AGP: set a global parameter to the accumulator.
     Agp {
+        /// Global parameter number.
         param: u8,
+        /// Bank of the parameter.
         bank: u8,
     },
+    /// CLE: clear error flags.
     Cle {
+        /// The flag to clear.
         flag: ErrorFlag,
     },
+    /// VECT: set the address of an interrupt handler.
     Vect {
+        /// Interrupt number.
         interrupt: u8,
+        /// Program address of the handler.
         address: i32,
     },
+    /// RETI: return from an interrupt handler.
     Reti,
+    /// ACO: set a coordinate to the accumulator.
     Aco {
+        /// Coordinate number.
         coordinate: u8,
+        /// Motor number.
         motor: u8,
     },
-    /// var1 in the motor/bank byte, var2 in the value.
+    /// CALCVV: user variable ⟵ variable `op` variable (var1 in the motor
+    /// byte, var2 in the value).
     CalcVV {
+        /// The operation.
         op: CalcOp,
+        /// User variable that holds the result.
         var1: u8,
+        /// User variable of the second operand.
         var2: i32,
     },
+    /// CALCVA: user variable ⟵ variable `op` accumulator.
     CalcVA {
+        /// The operation.
         op: CalcOp,
+        /// User variable number.
         var: u8,
     },
+    /// CALCAV: accumulator ⟵ accumulator `op` user variable.
     CalcAV {
+        /// The operation.
         op: CalcOp,
+        /// User variable number.
         var: u8,
     },
+    /// CALCVX: user variable ⟵ variable `op` X register.
     CalcVX {
+        /// The operation.
         op: CalcOp,
+        /// User variable number.
         var: u8,
     },
+    /// CALCXV: X register ⟵ X register `op` user variable.
     CalcXV {
+        /// The operation.
         op: CalcOp,
+        /// User variable number.
         var: u8,
     },
+    /// CALCV: user variable ⟵ variable `op` value.
     CalcV {
+        /// The operation.
         op: CalcOp,
+        /// User variable number.
         var: u8,
+        /// The second operand.
         value: i32,
     },
+    /// MVPA: move to the position in the accumulator.
     Mvpa {
+        /// ABS, REL or COORD, as for MVP.
         mode: MoveMode,
+        /// Motor number.
         motor: u8,
     },
+    /// RST: restart the program at an address.
     Rst {
+        /// Program address to restart at.
         address: i32,
     },
+    /// DJNZ: decrement a user variable and jump unless it is zero.
     Djnz {
+        /// User variable counted down.
         var: u8,
+        /// Program address jumped to.
         address: i32,
     },
+    /// ROLA: rotate left at the velocity in the accumulator.
     Rola {
+        /// Motor number.
         motor: u8,
     },
+    /// RORA: rotate right at the velocity in the accumulator.
     Rora {
+        /// Motor number.
         motor: u8,
     },
+    /// SIV: set the indexed variable (the user variable the X register points to).
     Siv {
+        /// The new value.
         value: i32,
     },
+    /// GIV: get the indexed variable into the accumulator.
     Giv,
+    /// AIV: set the indexed variable to the accumulator.
     Aiv,
+    /// UF0…UF7: a user function (the module defines what it does).
     UserFunction {
+        /// 0…7 (instruction 64…71).
         number: u8,
+        /// The type byte.
         kind: u8,
+        /// The motor byte.
         motor: u8,
+        /// The value.
         value: i32,
     },
+    /// CALL: call a subroutine if a condition holds.
     Call {
+        /// The condition.
         condition: Condition,
+        /// Program address of the subroutine.
         address: i32,
     },
+    /// 128: stop the program.
     StopApplication,
-    /// `None`: continue from the current address.
+    /// 129: run the program.
     RunApplication {
+        /// Address to start at; `None`: continue from the current address.
         from: Option<i32>,
     },
+    /// 130: execute one instruction of the program.
     StepApplication,
+    /// 131: stop the program and set it to address 0.
     ResetApplication,
+    /// 132: enter download mode.
     EnterDownload {
+        /// Program address of the first word stored.
         address: i32,
     },
+    /// 133: exit download mode.
     ExitDownload,
+    /// 134: read a word of program memory.
     ReadMemory {
+        /// Program address.
         address: i32,
     },
+    /// 135: get the application status.
     ApplicationStatus {
+        /// 0, 1: state and address; 2: accumulator; 3: X register.
         kind: u8,
     },
+    /// 136: get the firmware version.
     FirmwareVersion {
+        /// Type 1: the version as a number; type 0: as text.
         binary: bool,
     },
+    /// 137: restore the factory settings.
     FactoryDefaults {
+        /// Must be 1234 (the command is refused otherwise).
         key: i32,
     },
+    /// 138: ask for target reached events.
     TargetReachedEvent {
+        /// Type 1: an event after every move, not only the next.
         every_move: bool,
+        /// Motors as bits (bit 0: motor 0).
         mask: i32,
     },
+    /// 139: enter ASCII mode.
     AsciiMode,
+    /// 255: software reset.
     Reset {
+        /// Must be 1234 (the command is refused otherwise).
         key: i32,
     },
 }
@@ -401,10 +618,16 @@ pub enum DecodeError {
     /// No TMCL instruction has this number (status 2).
     UnknownOpcode(u8),
     /// The instruction has no such type (status 3).
-    WrongType { opcode: u8, kind: u8 },
+    WrongType {
+        /// The instruction number.
+        opcode: u8,
+        /// The type byte.
+        kind: u8,
+    },
 }
 
 impl DecodeError {
+    /// The status a module answers.
     pub const fn status(self) -> Status {
         match self {
             DecodeError::UnknownOpcode(_) => Status::InvalidCommand,

@@ -15,22 +15,29 @@ pub fn checksum(bytes: &[u8]) -> u8 {
 /// TMCL program memory.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Instruction {
+    /// Instruction number ([`crate::opcode`]).
     pub opcode: u8,
+    /// Type byte: a parameter number, a condition, an operation, …
     pub kind: u8,
+    /// Motor or bank number (a user variable for some instructions).
     pub motor: u8,
+    /// The value (big-endian on the wire).
     pub value: i32,
 }
 
 impl Instruction {
+    /// An instruction from its four fields.
     pub const fn new(opcode: u8, kind: u8, motor: u8, value: i32) -> Self {
         Instruction { opcode, kind, motor, value }
     }
 
+    /// The seven bytes: opcode, type, motor, value big-endian.
     pub fn to_bytes(self) -> [u8; 7] {
         let v = self.value.to_be_bytes();
         [self.opcode, self.kind, self.motor, v[0], v[1], v[2], v[3]]
     }
 
+    /// An instruction from its seven bytes (as [`Instruction::to_bytes`]).
     pub fn from_bytes(b: &[u8; 7]) -> Self {
         Instruction { opcode: b[0], kind: b[1], motor: b[2], value: i32::from_be_bytes([b[3], b[4], b[5], b[6]]) }
     }
@@ -39,15 +46,19 @@ impl Instruction {
 /// A request frame: `[address][opcode][type][motor][value BE][checksum]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Request {
+    /// The module address the request is for.
     pub address: u8,
+    /// What to do.
     pub instruction: Instruction,
 }
 
 impl Request {
+    /// A request to the module at `address`.
     pub const fn new(address: u8, instruction: Instruction) -> Self {
         Request { address, instruction }
     }
 
+    /// The nine bytes, checksum included.
     pub fn encode(&self) -> [u8; FRAME_LEN] {
         let i = self.instruction.to_bytes();
         let mut f = [self.address, i[0], i[1], i[2], i[3], i[4], i[5], i[6], 0];
@@ -66,22 +77,31 @@ impl Request {
 /// A normal reply: `[host][module][status][opcode][value BE][checksum]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Reply {
+    /// The host address the reply goes to.
     pub host: u8,
+    /// The address of the module that answers.
     pub module: u8,
+    /// The status code ([`Status`]); kept as a byte so that unknown codes
+    /// survive.
     pub status: u8,
+    /// The instruction number of the request answered.
     pub opcode: u8,
+    /// The value (big-endian on the wire).
     pub value: i32,
 }
 
 impl Reply {
+    /// A reply with a known status.
     pub fn new(host: u8, module: u8, status: Status, opcode: u8, value: i32) -> Self {
         Reply { host, module, status: status.code(), opcode, value }
     }
 
+    /// The status, when TMCL defines its code.
     pub fn status(&self) -> Option<Status> {
         Status::from_code(self.status)
     }
 
+    /// The nine bytes, checksum included.
     pub fn encode(&self) -> [u8; FRAME_LEN] {
         let v = self.value.to_be_bytes();
         let mut f = [self.host, self.module, self.status, self.opcode, v[0], v[1], v[2], v[3], 0];

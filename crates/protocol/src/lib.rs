@@ -6,9 +6,6 @@
 //! RS485/USB/TCP framing) live beside the frame types so that every link
 //! shares one definition of a TMCL instruction.
 
-// Not yet: the opcodes, commands and their fields still lack docs.
-#![allow(missing_docs)]
-
 pub mod command;
 pub mod frame;
 pub mod mnemonic;

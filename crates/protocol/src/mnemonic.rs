@@ -25,11 +25,17 @@ pub enum Operand {
     Address,
 }
 
+/// MVP and MVPA modes, by type number.
 pub const MOVE_MODES: &[&str] = &["ABS", "REL", "COORD"];
+/// RFS actions, by type number.
 pub const RFS_ACTIONS: &[&str] = &["START", "STOP", "STATUS"];
+/// CALC-family operations, by type number.
 pub const CALC_OPS: &[&str] = &["ADD", "SUB", "MUL", "DIV", "MOD", "AND", "OR", "XOR", "NOT", "LOAD", "SWAP", "COMP"];
+/// JC and CALL conditions, by type number.
 pub const CONDITIONS: &[&str] = &["ZE", "NZ", "EQ", "NE", "GT", "GE", "LT", "LE", "ETO", "EAL", "EDV", "EPO"];
+/// WAIT conditions, by type number.
 pub const WAIT_CONDITIONS: &[&str] = &["TICKS", "POS", "REFSW", "LIMSW", "RFS"];
+/// CLE flags, by type number.
 pub const ERROR_FLAGS: &[&str] = &["ALL", "ETO", "EAL", "EDV", "EPO", "ESD"];
 
 /// Operands of a mnemonic in source order; `None` for instruction numbers
@@ -70,7 +76,9 @@ pub fn layout(opcode: u8) -> Option<&'static [Operand]> {
 /// A parse error with the byte column (1-based) where it was found.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ParseError {
+    /// Where, from 1.
     pub column: usize,
+    /// What is wrong.
     pub message: String,
 }
 
@@ -233,6 +241,8 @@ pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
     if parts.is_empty() { name.to_string() } else { format!("{name} {}", parts.join(", ")) }
 }
 
+/// An instruction as a source line (`MVP ABS, 0, 51200`), addresses as
+/// numbers.
 pub fn format(ins: Instruction) -> String {
     format_with(ins, |a| a.to_string())
 }

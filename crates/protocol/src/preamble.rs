@@ -54,6 +54,7 @@ pub struct Preamble {
 }
 
 impl Preamble {
+    /// A preamble with no byte yet.
     pub fn new() -> Preamble {
         Preamble::default()
     }

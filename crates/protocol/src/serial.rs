@@ -10,6 +10,8 @@ use crate::frame::FRAME_LEN;
 /// Default inter-byte timeout: 5 ms.
 pub const DEFAULT_INTER_BYTE_TIMEOUT_NS: u64 = 5_000_000;
 
+/// Collects bytes into 9-byte frames; a pause longer than the inter-byte
+/// timeout starts a new frame.
 #[derive(Clone, Debug)]
 pub struct FrameAssembler {
     buf: [u8; FRAME_LEN],
@@ -25,6 +27,7 @@ impl Default for FrameAssembler {
 }
 
 impl FrameAssembler {
+    /// An assembler with this inter-byte timeout.
     pub fn new(timeout_ns: u64) -> Self {
         FrameAssembler { buf: [0; FRAME_LEN], len: 0, last_byte_ns: 0, timeout_ns }
     }

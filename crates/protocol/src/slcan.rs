@@ -14,20 +14,27 @@ pub enum SlcanCommand {
     BitTiming,
     /// `O` (or `L`, listen only).
     Open {
+        /// `L`: receive only.
         listen_only: bool,
     },
     /// `C`.
     Close,
     /// `t`/`T`: a data frame; `r`/`R`: a remote frame.
     Transmit {
+        /// The CAN identifier.
         id: u32,
+        /// A 29-bit identifier (`T`, `R`).
         extended: bool,
+        /// A remote frame (`r`, `R`).
         remote: bool,
+        /// The data bytes (none for a remote frame).
         data: Vec<u8>,
     },
-    /// `V`, `v`: version; `N`: serial number; `F`: status flags.
+    /// `V`, `v`: version.
     Version,
+    /// `N`: serial number.
     SerialNumber,
+    /// `F`: status flags.
     Status,
     /// `Z0`/`Z1` timestamps, `M`/`m` acceptance filters, `X`, `W`, `Q`:
     /// accepted and ignored.

@@ -25,10 +25,12 @@ pub enum Status {
 }
 
 impl Status {
+    /// The status byte.
     pub const fn code(self) -> u8 {
         self as u8
     }
 
+    /// The status of a byte, when TMCL defines it.
     pub fn from_code(code: u8) -> Option<Status> {
         Some(match code {
             1 => Status::WrongChecksum,
@@ -58,6 +60,7 @@ impl Status {
         }
     }
 
+    /// The status in words (`wrong checksum`).
     pub const fn describe(self) -> &'static str {
         match self {
             Status::WrongChecksum => "wrong checksum",
