@@ -74,84 +74,108 @@ impl Debugger {
         self.report_changes(m);
         println!("debugger: h for help");
         loop {
-            let m = bus.module_mut(0);
-            // While a WAIT waits, the counter stands on the WAIT (135 type 1).
-            let pc = m.program().counter();
-            let waiting = if m.program().wait.is_some() { " (waiting)" } else { "" };
-            print!("[{:.3} s] {}  {}{waiting} > ", m.now_ns() as f64 * 1e-9, place(program, pc), text_at(program, pc));
-            std::io::stdout().flush().ok();
+            prompt(bus.module(0), program);
             let Some(line) = lines.next() else { return Ok(Debug::Quit) };
             let line = line.map_err(|e| e.to_string())?;
             let words: Vec<&str> = line.split_whitespace().collect();
             let Some((command, args)) = words.split_first() else { continue };
-            match command.to_ascii_lowercase().as_str() {
-                "s" | "step" => match count(args) {
-                    Ok(n) => {
-                        for _ in 0..n {
-                            if !step_one(bus, end) {
-                                println!("the run's end (--for) is reached");
-                                break;
-                            }
-                        }
-                        self.report_changes(bus.module(0));
+            if let Some(end_of_session) = self.command(bus, program, command, args, end) {
+                return Ok(end_of_session);
+            }
+        }
+    }
+
+    /// Runs one command line; `Some` when it ends the session.
+    fn command(&mut self, bus: &mut Bus, program: &Program, command: &str, args: &[&str], end: u64) -> Option<Debug> {
+        let m = bus.module_mut(0);
+        match command.to_ascii_lowercase().as_str() {
+            "s" | "step" => self.step(bus, args, end),
+            "n" | "next" if args.is_empty() => {
+                next(bus, end);
+                self.report_changes(bus.module(0));
+            }
+            "c" | "continue" if args.is_empty() => {
+                m.start_program();
+                return Some(Debug::Continue);
+            }
+            "a" | "advance" => self.advance(bus, program, args, end),
+            "b" | "break" | "d" | "delete" => breakpoints(m, program, command.starts_with(['b', 'B']), args),
+            "p" | "print" => match Quantity::parse(args, m) {
+                Ok(q) => println!("{} = {}", q.describe(m), q.read(m)),
+                Err(e) => println!("{e}"),
+            },
+            "w" | "watch" if args.is_empty() => self.list(m),
+            "w" | "watch" => self.watch(m, args),
+            "u" | "unwatch" => self.unwatch(args),
+            "l" | "list" => list(m, program, args),
+            "i" | "inspect" if args.is_empty() => inspect(m),
+            "h" | "help" | "?" => println!("{HELP}"),
+            "q" | "quit" => return Some(Debug::Quit),
+            "n" | "next" | "c" | "continue" | "i" | "inspect" => println!("{command} takes no arguments"),
+            other => {
+                let known = [
+                    "step", "next", "continue", "advance", "break", "delete", "print", "watch", "unwatch", "list", "inspect", "help",
+                    "quit",
+                ];
+                println!("unknown command '{other}'{}; h lists the commands", suggest::suggestion(other, known));
+            }
+        }
+        None
+    }
+
+    /// `step [N]`: N instructions (1), not past the run's end.
+    fn step(&mut self, bus: &mut Bus, args: &[&str], end: u64) {
+        match count(args) {
+            Ok(n) => {
+                for _ in 0..n {
+                    if !step_one(bus, end) {
+                        println!("the run's end (--for) is reached");
+                        break;
                     }
-                    Err(e) => println!("{e}"),
-                },
-                "n" | "next" if args.is_empty() => {
-                    next(bus, end);
+                }
+                self.report_changes(bus.module(0));
+            }
+            Err(e) => println!("{e}"),
+        }
+    }
+
+    /// `advance TIME`: virtual time on, the program running.
+    fn advance(&mut self, bus: &mut Bus, program: &Program, args: &[&str], end: u64) {
+        match args {
+            [time] => match crate::duration::parse_duration(time) {
+                Ok(d) => {
+                    advance(bus, program, d, end);
                     self.report_changes(bus.module(0));
                 }
-                "c" | "continue" if args.is_empty() => {
-                    m.start_program();
-                    return Ok(Debug::Continue);
-                }
-                "a" | "advance" => match args {
-                    [time] => match crate::duration::parse_duration(time) {
-                        Ok(d) => {
-                            advance(bus, program, d, end);
-                            self.report_changes(bus.module(0));
-                        }
-                        Err(e) => println!("{e}"),
-                    },
-                    _ => println!("advance takes one time, e.g. advance 5s"),
-                },
-                "b" | "break" | "d" | "delete" => breakpoints(m, program, command.starts_with(['b', 'B']), args),
-                "p" | "print" => match Quantity::parse(args, m) {
-                    Ok(q) => println!("{} = {}", q.describe(m), q.read(m)),
-                    Err(e) => println!("{e}"),
-                },
-                "w" | "watch" if args.is_empty() => self.list(m),
-                "w" | "watch" => match Quantity::parse(args, m) {
-                    Ok(q) => {
-                        let value = q.read(m);
-                        println!("watch {}: {} = {value}", self.watches.len() + 1, q.describe(m));
-                        self.watches.push((q, Some(value)));
-                    }
-                    Err(e) => println!("{e}"),
-                },
-                "u" | "unwatch" => match args {
-                    ["all"] => self.watches.clear(),
-                    [n] => match n.parse::<usize>() {
-                        Ok(i) if (1..=self.watches.len()).contains(&i) => {
-                            self.watches.remove(i - 1);
-                        }
-                        _ => println!("no watch {n}; w lists them"),
-                    },
-                    _ => println!("unwatch takes a watch number (w lists them) or all"),
-                },
-                "l" | "list" => list(m, program, args),
-                "i" | "inspect" if args.is_empty() => inspect(m),
-                "h" | "help" | "?" => println!("{HELP}"),
-                "q" | "quit" => return Ok(Debug::Quit),
-                "n" | "next" | "c" | "continue" | "i" | "inspect" => println!("{command} takes no arguments"),
-                other => {
-                    let known = [
-                        "step", "next", "continue", "advance", "break", "delete", "print", "watch", "unwatch", "list", "inspect", "help",
-                        "quit",
-                    ];
-                    println!("unknown command '{other}'{}; h lists the commands", suggest::suggestion(other, known));
-                }
+                Err(e) => println!("{e}"),
+            },
+            _ => println!("advance takes one time, e.g. advance 5s"),
+        }
+    }
+
+    /// `watch WHAT`: a quantity shown whenever it changes.
+    fn watch(&mut self, m: &Module, args: &[&str]) {
+        match Quantity::parse(args, m) {
+            Ok(q) => {
+                let value = q.read(m);
+                println!("watch {}: {} = {value}", self.watches.len() + 1, q.describe(m));
+                self.watches.push((q, Some(value)));
             }
+            Err(e) => println!("{e}"),
+        }
+    }
+
+    /// `unwatch N` or `unwatch all`.
+    fn unwatch(&mut self, args: &[&str]) {
+        match args {
+            ["all"] => self.watches.clear(),
+            [n] => match n.parse::<usize>() {
+                Ok(i) if (1..=self.watches.len()).contains(&i) => {
+                    self.watches.remove(i - 1);
+                }
+                _ => println!("no watch {n}; w lists them"),
+            },
+            _ => println!("unwatch takes a watch number (w lists them) or all"),
         }
     }
 
@@ -186,6 +210,15 @@ pub fn place(program: &Program, address: u16) -> String {
         Some(s) => format!("{}:{} ({address}{label})", s.file, s.line),
         None => format!("address {address}{}", if labels.is_empty() { String::new() } else { format!(" ({})", labels.join(", ")) }),
     }
+}
+
+/// The prompt: virtual time, the program's place and instruction.
+fn prompt(m: &Module, program: &Program) {
+    // While a WAIT waits, the counter stands on the WAIT (135 type 1).
+    let pc = m.program().counter();
+    let waiting = if m.program().wait.is_some() { " (waiting)" } else { "" };
+    print!("[{:.3} s] {}  {}{waiting} > ", m.now_ns() as f64 * 1e-9, place(program, pc), text_at(program, pc));
+    std::io::stdout().flush().ok();
 }
 
 /// The source text of an instruction, or its mnemonic form.

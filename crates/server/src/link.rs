@@ -108,87 +108,155 @@ where
 {
     let link = next_link_id();
     let _closing = Closing { bus: &bus, link };
-    let mut preamble = options.network.map(|_| Preamble::new());
-    let mut bad_frames = 0u32;
     let (events_tx, mut events) = mpsc::unbounded_channel::<[u8; FRAME_LEN]>();
-    let sink: EventSink = Arc::new(move |event| {
-        let _ = events_tx.send(event);
-    });
-    let start = Instant::now();
-    let mut assembler = FrameAssembler::new(options.inter_byte_timeout.as_nanos() as u64);
-    let log = |direction: crate::frame_log::Direction, frame: &[u8; FRAME_LEN]| {
-        if options.log_frames {
-            crate::frame_log::print(&options.name, link, direction, frame);
-        }
-    };
+    let mut session = Session::new(&bus, options, link, events_tx);
     let mut buf = [0u8; 512];
     loop {
         tokio::select! {
             read = reader.read(&mut buf) => {
-                let n = match read {
-                    Ok(0) => return Ok(()),
-                    Ok(n) => n,
-                    Err(e) => return Err(e),
-                };
-                let now = start.elapsed().as_nanos() as u64;
-                let bytes = match screen(&mut preamble, &buf[..n]) {
-                    Screened::Hold => continue,
-                    Screened::Foreign(what) => {
-                        eprintln!("tmclsim: closing connection {}: it opened with {}, not TMCL; nothing was executed", options.name, what.describe());
-                        return Ok(());
-                    }
-                    Screened::Pass(bytes) => bytes,
-                };
-                let mut text = Vec::new();
-                for &byte in bytes.iter() {
-                    if bus.ascii_active() {
-                        // ASCII mode: text in, text out; the frame
-                        // assembler starts afresh afterwards.
-                        bus.ascii_byte(lines, byte, &mut text);
-                        if byte == b'\r' {
-                            activity.touch();
-                        }
-                        assembler.reset();
-                        continue;
-                    }
-                    if !text.is_empty() {
-                        writer.write_all(&std::mem::take(&mut text)).await?;
-                    }
-                    let Some(frame) = assembler.push(byte, now) else { continue };
-                    let checksum_ok = tmclsim_protocol::checksum(&frame[..FRAME_LEN - 1]) == frame[FRAME_LEN - 1];
-                    bad_frames = if checksum_ok { 0 } else { bad_frames + 1 };
-                    activity.touch();
-                    log(crate::frame_log::Direction::In, &frame);
-                    let (replies, pause) = bus.handle(link, &sink, &frame);
-                    for reply in replies {
-                        let (reply, fault_delay) = bus.outgoing(reply);
-                        let delay = pause + fault_delay;
-                        if !delay.is_zero() {
-                            tokio::time::sleep(delay).await;
-                        }
-                        if let Some(reply) = reply {
-                            log(crate::frame_log::Direction::Out, &reply);
-                            writer.write_all(&reply).await?;
-                        }
-                    }
-                    if options.network.is_some_and(|limit| limit > 0 && bad_frames >= limit) {
-                        writer.flush().await?;
-                        eprintln!("tmclsim: closing connection {}: {bad_frames} frames in a row with a wrong checksum", options.name);
-                        return Ok(());
-                    }
+                let n = read?;
+                if n == 0 || session.bytes_in(&mut writer, &buf[..n], lines, activity).await? == Flow::Close {
+                    return Ok(());
                 }
-                if !text.is_empty() {
-                    writer.write_all(&text).await?;
-                }
-                writer.flush().await?;
             }
-            Some(event) = events.recv() => {
-                if let (Some(event), _) = bus.outgoing(event) {
-                    log(crate::frame_log::Direction::Out, &event);
-                    writer.write_all(&event).await?;
-                    writer.flush().await?;
+            Some(event) = events.recv() => session.event_out(&mut writer, event).await?,
+        }
+    }
+}
+
+/// Whether a link stays open after what it sent.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Flow {
+    Open,
+    Close,
+}
+
+/// What one served link keeps between reads.
+struct Session<'a> {
+    bus: &'a SharedBus,
+    options: &'a Options,
+    link: u64,
+    /// Where the bus sends the link's events (to the serving task).
+    sink: EventSink,
+    /// A network link's first bytes, until they are known to be TMCL.
+    preamble: Option<Preamble>,
+    /// Frames with a wrong checksum in a row.
+    bad_frames: u32,
+    assembler: FrameAssembler,
+    start: Instant,
+}
+
+impl<'a> Session<'a> {
+    fn new(bus: &'a SharedBus, options: &'a Options, link: u64, events: mpsc::UnboundedSender<[u8; FRAME_LEN]>) -> Session<'a> {
+        let sink: EventSink = Arc::new(move |event| {
+            let _ = events.send(event);
+        });
+        Session {
+            bus,
+            options,
+            link,
+            sink,
+            preamble: options.network.map(|_| Preamble::new()),
+            bad_frames: 0,
+            assembler: FrameAssembler::new(options.inter_byte_timeout.as_nanos() as u64),
+            start: Instant::now(),
+        }
+    }
+
+    fn log(&self, direction: crate::frame_log::Direction, frame: &[u8; FRAME_LEN]) {
+        if self.options.log_frames {
+            crate::frame_log::print(&self.options.name, self.link, direction, frame);
+        }
+    }
+
+    /// Bytes read from the link: screened, then taken as ASCII text or
+    /// frames, and answered.
+    async fn bytes_in<W: AsyncWrite + Unpin>(
+        &mut self,
+        writer: &mut W,
+        read: &[u8],
+        lines: &mut LineState,
+        activity: &Activity,
+    ) -> std::io::Result<Flow> {
+        let now = self.start.elapsed().as_nanos() as u64;
+        let bytes = match screen(&mut self.preamble, read) {
+            Screened::Hold => return Ok(Flow::Open),
+            Screened::Foreign(what) => {
+                eprintln!(
+                    "tmclsim: closing connection {}: it opened with {}, not TMCL; nothing was executed",
+                    self.options.name,
+                    what.describe()
+                );
+                return Ok(Flow::Close);
+            }
+            Screened::Pass(bytes) => bytes,
+        };
+        let mut text = Vec::new();
+        for &byte in bytes.iter() {
+            if self.bus.ascii_active() {
+                // ASCII mode: text in, text out; the frame
+                // assembler starts afresh afterwards.
+                self.bus.ascii_byte(lines, byte, &mut text);
+                if byte == b'\r' {
+                    activity.touch();
                 }
+                self.assembler.reset();
+                continue;
+            }
+            if !text.is_empty() {
+                writer.write_all(&std::mem::take(&mut text)).await?;
+            }
+            let Some(frame) = self.assembler.push(byte, now) else { continue };
+            if self.frame_in(writer, &frame, activity).await? == Flow::Close {
+                return Ok(Flow::Close);
             }
         }
+        if !text.is_empty() {
+            writer.write_all(&text).await?;
+        }
+        writer.flush().await?;
+        Ok(Flow::Open)
+    }
+
+    /// A complete frame: the module's replies, each after its delay.
+    /// `Close` when a network link sent too many bad frames in a row.
+    async fn frame_in<W: AsyncWrite + Unpin>(
+        &mut self,
+        writer: &mut W,
+        frame: &[u8; FRAME_LEN],
+        activity: &Activity,
+    ) -> std::io::Result<Flow> {
+        let checksum_ok = tmclsim_protocol::checksum(&frame[..FRAME_LEN - 1]) == frame[FRAME_LEN - 1];
+        self.bad_frames = if checksum_ok { 0 } else { self.bad_frames + 1 };
+        activity.touch();
+        self.log(crate::frame_log::Direction::In, frame);
+        let (replies, pause) = self.bus.handle(self.link, &self.sink, frame);
+        for reply in replies {
+            let (reply, fault_delay) = self.bus.outgoing(reply);
+            let delay = pause + fault_delay;
+            if !delay.is_zero() {
+                tokio::time::sleep(delay).await;
+            }
+            if let Some(reply) = reply {
+                self.log(crate::frame_log::Direction::Out, &reply);
+                writer.write_all(&reply).await?;
+            }
+        }
+        if self.options.network.is_some_and(|limit| limit > 0 && self.bad_frames >= limit) {
+            writer.flush().await?;
+            eprintln!("tmclsim: closing connection {}: {} frames in a row with a wrong checksum", self.options.name, self.bad_frames);
+            return Ok(Flow::Close);
+        }
+        Ok(Flow::Open)
+    }
+
+    /// An event of the link's modules, written as it comes.
+    async fn event_out<W: AsyncWrite + Unpin>(&self, writer: &mut W, event: [u8; FRAME_LEN]) -> std::io::Result<()> {
+        if let (Some(event), _) = self.bus.outgoing(event) {
+            self.log(crate::frame_log::Direction::Out, &event);
+            writer.write_all(&event).await?;
+            writer.flush().await?;
+        }
+        Ok(())
     }
 }
