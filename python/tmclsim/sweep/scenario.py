@@ -179,109 +179,158 @@ def profile_of(mx: Matrix, values: Dict[str, Any]) -> str:
 def run(mx: Matrix, programs: Dict[str, bytes], index: int, values: Dict[str, Any]) -> Tuple[Dict[str, Any], Optional[Dict[str, str]]]:
     """Runs one scenario: its row, and for a failure the files that
     reproduce it (world TOML and setup lines)."""
-    import tmclsim
-
     row: Dict[str, Any] = {"scenario": index, **values}
     profile = profile_of(mx, values)
-    # Every value a stop condition, a check or a metric reads; those with
-    # max/min are kept over the run.
-    reads = list(mx.metric_reads) + [c.read for c in mx.stop_when] + [c.condition.read for c in mx.checks if c.condition]
-    kept: Dict[Read, Optional[int]] = {r: None for r in reads if r.aggregate}
-    plain = {r: replace(r, aggregate="") for r in kept}
-    text, lines = "", []
+    reads = _reads(mx)
+    made = _Made()
     try:
-        # (As `files` makes them: the world, the module, the setup lines.)
-        text = world_text(mx, values)
-        m = tmclsim.Module(profile, world=text)
-        lines = setup_lines(m, mx, values)
-        m.load_program(tmclsim.Program.from_binary(programs[profile]))
-        for line in lines:
-            r = m.send(line)
-            if r is None or not r.ok:
-                raise ScenarioError(f"'{line}' answered {'nothing' if r is None else f'status {r.status} ({r.description})'}")
-        for r in reads:
-            # A value the module does not have is the scenario's error,
-            # found before the program runs.
-            read(m, plain.get(r, r))
+        m = _set_up(mx, programs, profile, values, reads, made)
     except _setup_errors() as e:
         row.update(passed=False, failed_check="setup", error=str(e))
         for name in mx.metrics:
             row[name] = None
-        return row, _files(text, lines)
+        return row, _files(made.text, made.lines)
     m.run()
-    axes = m.axes
-    stalled = end_stop = limit_switch = False
-    max_load = max_speed = 0
+    seen = _Seen(mx, m, reads)
+    ended_at = _run_until_stop(mx, m, seen)
+    failed = _first_failed(mx, seen, ended_at)
+    row.update(passed=not failed, failed_check=failed, error="")
+    _metrics(row, mx, m, seen)
+    return row, _files(made.text, made.lines) if failed else None
+
+
+def _reads(mx: Matrix) -> List[Read]:
+    """Every value a stop condition, a check or a metric reads; those with
+    max/min are kept over the run."""
+    return list(mx.metric_reads) + [c.read for c in mx.stop_when] + [c.condition.read for c in mx.checks if c.condition]
+
+
+class _Made:
+    """What the set-up has made so far (the files of a failure)."""
+
+    def __init__(self) -> None:
+        self.text = ""
+        self.lines: List[str] = []
+
+
+def _set_up(mx: Matrix, programs: Dict[str, bytes], profile: str, values: Dict[str, Any], reads: List[Read], made: _Made):
+    """The module in its world, its program loaded and its setup lines
+    sent, as `files` makes them; every value read is tried once."""
+    import tmclsim
+
+    made.text = world_text(mx, values)
+    m = tmclsim.Module(profile, world=made.text)
+    made.lines = setup_lines(m, mx, values)
+    m.load_program(tmclsim.Program.from_binary(programs[profile]))
+    for line in made.lines:
+        r = m.send(line)
+        if r is None or not r.ok:
+            raise ScenarioError(f"'{line}' answered {'nothing' if r is None else f'status {r.status} ({r.description})'}")
+    for r in reads:
+        # A value the module does not have is the scenario's error,
+        # found before the program runs.
+        read(m, replace(r, aggregate="") if r.aggregate else r)
+    return m
+
+
+class _Seen:
+    """What the run showed: the kept maxima and minima of the reads, and
+    what the checks and metrics look at after each step (only that)."""
+
+    def __init__(self, mx: Matrix, m, reads: List[Read]) -> None:
+        self.m = m
+        self.axes = m.axes
+        self.kept: Dict[Read, Optional[int]] = {r: None for r in reads if r.aggregate}
+        self.plain = {r: replace(r, aggregate="") for r in self.kept}
+        self.stalled = self.end_stop = self.limit_switch = False
+        self.max_load = self.max_speed = 0
+        kinds = {c.kind for c in mx.checks}
+        self.watch_speed = "max_speed" in mx.metrics
+        self.watch_end_stop = "no_end_stop" in kinds or "end_stop" in mx.metrics
+        self.watch_switches = "no_limit_switch" in kinds or "limit_switch" in mx.metrics
+        self.watch_stall = "no_stall" in kinds or "stalled" in mx.metrics
+        self.stallguard = m.stall_detection == "stallguard2"
+        self.watch_load = "max_load" in mx.metrics
+        self.watch_any = self.watch_speed or self.watch_end_stop or self.watch_switches or self.watch_stall or self.watch_load
+
+    def value(self, r: Read) -> int:
+        return self.kept[r] if r.aggregate else read(self.m, r)
+
+    def keep(self) -> None:
+        for r, v in self.kept.items():
+            now = read(self.m, self.plain[r])
+            self.kept[r] = now if v is None else max(v, now) if r.aggregate == "max" else min(v, now)
+
+    def look(self) -> None:
+        """After a step: every axis's speed, stops, switches, stall and load
+        that are watched."""
+        m = self.m
+        for a in range(self.axes) if self.watch_any else ():
+            if self.watch_speed:
+                self.max_speed = max(self.max_speed, abs(m.actual_speed(a)))
+            if self.watch_end_stop:
+                self.end_stop = self.end_stop or m.at_end_stop(a)
+            if self.watch_switches:
+                left, right, _home = m.switches(a)
+                self.limit_switch = self.limit_switch or left or right
+            if self.watch_stall:
+                # A stall stop (AP 207 bit 0, looked at without clearing
+                # it), or stallGuard2's flag (AP 208 bit 0: the motor turns
+                # with a load reading of 0, losing steps).
+                self.stalled = (
+                    self.stalled or bool(m.error_flags(a) & 1) or (self.stallguard and bool(m.get_axis_parameter(208, a) & 1))
+                )
+            if self.watch_load:
+                self.max_load = max(self.max_load, m.get_axis_parameter(206, a))
+
+
+def _run_until_stop(mx: Matrix, m, seen: _Seen) -> Optional[float]:
+    """Virtual time in steps until the duration is over, the program ends
+    (when that stops the run) or a stop condition holds; when the program
+    ended, if it did."""
     ended_at: Optional[float] = None
-    # Only what a check or a metric needs is looked at after each step.
-    kinds = {c.kind for c in mx.checks}
-    watch_speed = "max_speed" in mx.metrics
-    watch_end_stop = "no_end_stop" in kinds or "end_stop" in mx.metrics
-    watch_switches = "no_limit_switch" in kinds or "limit_switch" in mx.metrics
-    watch_stall = "no_stall" in kinds or "stalled" in mx.metrics
-    stallguard = m.stall_detection == "stallguard2"
-    watch_load = "max_load" in mx.metrics
-    watch_any = watch_speed or watch_end_stop or watch_switches or watch_stall or watch_load
-
-    def value(r: Read) -> int:
-        return kept[r] if r.aggregate else read(m, r)
-
-    def keep():
-        for r, v in kept.items():
-            now = read(m, plain[r])
-            kept[r] = now if v is None else max(v, now) if r.aggregate == "max" else min(v, now)
-
-    keep()  # the state the scenario starts from counts
+    seen.keep()  # the state the scenario starts from counts
     t = 0.0
     while t < mx.duration - 1e-12:
         m.advance(min(mx.step, mx.duration - t))
         if m.time <= t:
             break  # a step below the clock's nanosecond (a Matrix made by hand): time stands
         t = m.time
-        for a in range(axes) if watch_any else ():
-            if watch_speed:
-                max_speed = max(max_speed, abs(m.actual_speed(a)))
-            if watch_end_stop:
-                end_stop = end_stop or m.at_end_stop(a)
-            if watch_switches:
-                left, right, _home = m.switches(a)
-                limit_switch = limit_switch or left or right
-            if watch_stall:
-                # A stall stop (AP 207 bit 0, looked at without clearing
-                # it), or stallGuard2's flag (AP 208 bit 0: the motor turns
-                # with a load reading of 0, losing steps).
-                stalled = stalled or bool(m.error_flags(a) & 1) or (stallguard and bool(m.get_axis_parameter(208, a) & 1))
-            if watch_load:
-                max_load = max(max_load, m.get_axis_parameter(206, a))
-        keep()
+        seen.look()
+        seen.keep()
         if mx.stop_program_ended and m.program_mode == "stop":
             ended_at = t
             break
         if ended_at is None and not mx.stop_program_ended and m.program_mode == "stop":
             ended_at = t
-        if mx.stop_when and any(c.holds(value(c.read)) for c in mx.stop_when):
+        if mx.stop_when and any(c.holds(seen.value(c.read)) for c in mx.stop_when):
             break
-    failed = ""
+    return ended_at
+
+
+def _first_failed(mx: Matrix, seen: _Seen, ended_at: Optional[float]) -> str:
+    """The name of the first check that fails, or ""."""
     for c in mx.checks:
-        ok = _check(c, value, ended_at, stalled, end_stop, limit_switch)
-        if not ok:
-            failed = c.name
-            break
-    row.update(passed=not failed, failed_check=failed, error="")
+        if not _check(c, seen.value, ended_at, seen.stalled, seen.end_stop, seen.limit_switch):
+            return c.name
+    return ""
+
+
+def _metrics(row: Dict[str, Any], mx: Matrix, m, seen: _Seen) -> None:
+    """The metrics' columns of the row."""
     for name in mx.metrics:
         row[name] = {
             "time": lambda: round(m.time, 9),
             "position": lambda: m.actual_position(0),
             "carriage": lambda: m.mechanical_position(0),
-            "max_load": lambda: max_load,
-            "max_speed": lambda: max_speed,
-            "stalled": lambda: stalled,
-            "end_stop": lambda: end_stop,
-            "limit_switch": lambda: limit_switch,
+            "max_load": lambda: seen.max_load,
+            "max_speed": lambda: seen.max_speed,
+            "stalled": lambda: seen.stalled,
+            "end_stop": lambda: seen.end_stop,
+            "limit_switch": lambda: seen.limit_switch,
         }.get(name, lambda: None)()
     for r in mx.metric_reads:
-        row[r.label()] = value(r)
-    return row, _files(text, lines) if failed else None
+        row[r.label()] = seen.value(r)
 
 
 def _check(c: Check, value, ended_at, stalled, end_stop, limit_switch) -> bool:
