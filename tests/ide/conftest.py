@@ -97,6 +97,13 @@ def page(browser, start):
     pg = context.new_page()
     errors = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
+    # The page's requests without an answer yet, and those that failed:
+    # what open_app reports when the app does not get ready.
+    pg.unanswered = {}
+    pg.failed = []
+    pg.on("request", lambda r: pg.unanswered.__setitem__(id(r), f"{r.method} {r.url}"))
+    pg.on("requestfinished", lambda r: pg.unanswered.pop(id(r), None))
+    pg.on("requestfailed", lambda r: pg.failed.append(f"{r.method} {r.url}: {r.failure}") or pg.unanswered.pop(id(r), None))
     yield pg
     context.close()
     assert not errors, f"errors in the page: {errors}"
@@ -104,7 +111,13 @@ def page(browser, start):
 
 def open_app(page, url):
     page.goto(url)
-    page.wait_for_function("window.tmclsimReady === true")
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    try:
+        page.wait_for_function("window.tmclsimReady === true")
+    except PlaywrightTimeout:
+        unanswered = list(getattr(page, "unanswered", {}).values())
+        raise AssertionError(f"the app did not get ready: unanswered {unanswered}, failed {getattr(page, 'failed', [])}") from None
     return page
 
 
