@@ -14,6 +14,7 @@ use crate::clock::Clock;
 use crate::module::Module;
 use crate::snapshot::ModuleSnapshot;
 use crate::world_command::WorldCommand;
+use crate::world_error::WorldError;
 use tmclsim_protocol::FRAME_LEN;
 
 /// The replies to one frame and when they may go out.
@@ -301,10 +302,10 @@ impl Bus {
 
     /// Applies a world command to the module at `address` (`None`: the
     /// first module), at the clock's now.
-    pub fn apply_world(&mut self, address: Option<u8>, command: &WorldCommand) -> Result<String, String> {
+    pub fn apply_world(&mut self, address: Option<u8>, command: &WorldCommand) -> Result<String, WorldError> {
         let index = match address {
             None => 0,
-            Some(a) => self.index_of(a).ok_or_else(|| format!("no module on the bus answers to address {a}"))?,
+            Some(a) => self.index_of(a).ok_or(WorldError::NoModule { address: a })?,
         };
         self.catch_up();
         command.apply(&mut self.modules[index])
@@ -397,7 +398,10 @@ mod tests {
         assert!(!bus.module(0).world().digital(0));
         assert!(bus.module(1).world().digital(0));
         assert_eq!(bus.snapshot()[1].io.inputs & 1, 1);
-        assert_eq!(bus.apply_world(Some(9), &WorldCommand::Show { axis: None }).unwrap_err(), "no module on the bus answers to address 9");
+        assert_eq!(
+            bus.apply_world(Some(9), &WorldCommand::Show { axis: None }).unwrap_err().to_string(),
+            "no module on the bus answers to address 9"
+        );
     }
 
     #[test]

@@ -14,7 +14,7 @@ use crate::state::link::Link;
 use crate::state::persistence::Persistence;
 use crate::world::World;
 use std::sync::Arc;
-use tmclsim_profile::Profile;
+use tmclsim_profile::{Profile, ProfileError};
 
 pub use crate::outcome::{Origin, Outcome, Special};
 pub use crate::parameter_numbers::{ap, gp};
@@ -85,7 +85,7 @@ impl Module {
     }
 
     /// A module by built-in profile name.
-    pub fn built_in(name: &str) -> Result<Module, String> {
+    pub fn built_in(name: &str) -> Result<Module, ProfileError> {
         Ok(Module::new(Profile::built_in(name)?))
     }
 

@@ -6,6 +6,11 @@
 //! when the host overwrites the actual position or the module restarts
 //! (the carriage does not move when the counter is reset).
 
+/// Digital inputs a world holds (bit n of a 32-bit word).
+pub const WORLD_DIGITAL_INPUTS: usize = 32;
+/// Analog inputs a world holds.
+pub const WORLD_ANALOG_INPUTS: usize = 8;
+
 /// Switches along one axis.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AxisWorld {
