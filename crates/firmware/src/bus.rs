@@ -20,6 +20,8 @@ use tmclsim_protocol::FRAME_LEN;
 /// The replies to one frame and when they may go out.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Answer {
+    /// The reply frames, in order (none when the module keeps silent: GP 255,
+    /// 137).
     pub replies: Vec<[u8; FRAME_LEN]>,
     /// Delay before the replies: GP 75 of the module that answered and,
     /// with wire timing, the time request and reply take on the wire.
@@ -37,6 +39,7 @@ pub struct Effects {
 }
 
 impl Effects {
+    /// Nothing to carry out: no EEPROM written, no event frame.
     pub fn is_empty(&self) -> bool {
         self.eeprom_written.is_empty() && self.events.is_empty()
     }
@@ -79,6 +82,7 @@ impl Bus {
         self.wire_timing = on;
     }
 
+    /// The bus's source of "now".
     pub fn clock(&self) -> Clock {
         self.clock
     }
@@ -176,7 +180,7 @@ impl Bus {
             answer.delay_ns = answer.delay_ns.max(m.reply_delay_ns());
             if wire_timing {
                 // Request and reply, 10 bits a byte.
-                answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / m.profile().baud_rate(m.baud_rate_code()) as u64;
+                answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / u64::from(m.profile().baud_rate(m.baud_rate_code()));
             }
         };
         if let [m] = self.modules.as_mut_slice() {
@@ -268,18 +272,22 @@ impl Bus {
         effects
     }
 
+    /// How many modules are on the bus.
     pub fn len(&self) -> usize {
         self.modules.len()
     }
 
+    /// True when the bus holds no module.
     pub fn is_empty(&self) -> bool {
         self.modules.is_empty()
     }
 
+    /// The modules, in bus order.
     pub fn modules(&self) -> &[Module] {
         &self.modules
     }
 
+    /// The module at `index` in bus order (panics when there is none).
     pub fn module(&self, index: usize) -> &Module {
         &self.modules[index]
     }

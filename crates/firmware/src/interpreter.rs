@@ -32,6 +32,7 @@ impl Module {
         self.program.executed != before
     }
 
+    /// The TMCL program: its memory, counter, stack, timers and run mode.
     pub fn program(&self) -> &crate::program::Program {
         &self.program
     }
@@ -115,7 +116,7 @@ impl Module {
         if !self.profile.has_opcode(ins.opcode) || opcode::is_control(ins.opcode) {
             return Err(Status::InvalidCommand);
         }
-        let cmd = Command::decode(ins).map_err(|e| e.status())?;
+        let cmd = Command::decode(ins).map_err(tmclsim_protocol::DecodeError::status)?;
         self.dispatch(cmd, ins, Origin::Program, at).map(|_| ())
     }
 

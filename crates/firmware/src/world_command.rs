@@ -15,17 +15,24 @@ pub use crate::world_help::{HELP, help_items};
 /// One of the three switches of an axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SwitchKind {
+    /// The left stop switch.
     Left,
+    /// The right stop switch.
     Right,
+    /// The home switch.
     Home,
 }
 
 /// One of the driver's coil faults.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CoilFault {
+    /// Coil A shorted.
     ShortA,
+    /// Coil B shorted.
     ShortB,
+    /// Coil A open.
     OpenA,
+    /// Coil B open.
     OpenB,
 }
 
@@ -36,67 +43,98 @@ pub enum WorldCommand {
     Reset,
     /// Puts the carriage of an axis at a position (the motor does not move).
     PlaceCarriage {
+        /// The axis.
         axis: usize,
+        /// The carriage's mechanical position, in µsteps.
         position: f64,
     },
     /// Drives a digital input high or low.
     Input {
+        /// The input's number.
         number: u8,
+        /// True: high.
         high: bool,
     },
     /// Sets an ADC reading (0…4095).
     Analog {
+        /// The analog input's number.
         number: u8,
+        /// The ADC reading.
         value: u16,
     },
     /// Supply voltage in volts.
     Supply {
+        /// The voltage.
         volts: f64,
     },
+    /// Driver temperature.
     Temperature {
+        /// The temperature, in °C.
         celsius: f64,
     },
     /// Forces a switch pressed (`Some(true)`), released, or back to what
     /// the carriage position says (`None`).
     Switch {
+        /// The axis.
         axis: usize,
+        /// Which switch.
         which: SwitchKind,
+        /// Pressed, released, or `None`: by position.
         pressed: Option<bool>,
     },
     /// Places a stop switch at a position (with an optional width).
     PlaceStop {
+        /// The axis.
         axis: usize,
+        /// Left or right.
         which: SwitchKind,
+        /// The switch's position, in µsteps.
         position: f64,
+        /// How far the switch reaches beyond it (`None`: all the way).
         width: Option<f64>,
     },
     /// Places the home switch between two positions.
     PlaceHome {
+        /// The axis.
         axis: usize,
+        /// Lower end, in µsteps.
         from: f64,
+        /// Upper end, in µsteps.
         to: f64,
     },
     /// Mechanical end stops of the axis.
     Travel {
+        /// The axis.
         axis: usize,
+        /// Lower end stop, in µsteps.
         from: f64,
+        /// Upper end stop, in µsteps.
         to: f64,
     },
     /// A load torque (% of rated) everywhere or between two positions; 0
     /// removes the loads.
     Load {
+        /// The axis.
         axis: usize,
+        /// Torque demand in % of the rated torque.
         torque: f64,
+        /// Start of the position range, in µsteps.
         from: Option<f64>,
+        /// End of the position range, in µsteps.
         to: Option<f64>,
     },
+    /// Injects or clears a driver coil fault (AP 208 flags).
     Fault {
+        /// The axis.
         axis: usize,
+        /// Which fault.
         which: CoilFault,
+        /// True: the fault is present.
         on: bool,
     },
     /// Positions and switches of one axis or all.
     Show {
+        /// The axis (`None`: all axes).
         axis: Option<usize>,
     },
 }
@@ -105,7 +143,9 @@ pub enum WorldCommand {
 /// first one) and what to do.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Addressed {
+    /// The module's address (`None`: the first module on the bus).
     pub address: Option<u8>,
+    /// What to do.
     pub command: WorldCommand,
 }
 
@@ -118,10 +158,11 @@ fn optional(w: Option<&str>) -> Result<Option<f64>, WorldError> {
     w.map(|x| x.parse().map_err(|_| WorldError::NotANumber { word: x.to_string() })).transpose()
 }
 
+/// `on`/`1` or `off`/`0`, as a world or link command takes it.
 pub fn on_off(w: Option<&str>) -> Result<bool, WorldError> {
     match w {
-        Some("on") | Some("1") => Ok(true),
-        Some("off") | Some("0") => Ok(false),
+        Some("on" | "1") => Ok(true),
+        Some("off" | "0") => Ok(false),
         other => Err(expected("on or off", other)),
     }
 }
@@ -300,9 +341,9 @@ impl WorldCommand {
                         m.actual_position(a),
                         m.mechanical_position(a),
                         m.actual_speed(a),
-                        l as u8,
-                        r as u8,
-                        h as u8
+                        u8::from(l),
+                        u8::from(r),
+                        u8::from(h)
                     ));
                 }
                 return Ok(out);
@@ -327,7 +368,7 @@ impl WorldCommand {
             WorldCommand::Input { number, .. } => check_input(profile, 0, number),
             WorldCommand::Analog { number, value } => {
                 check_input(profile, 1, number)?;
-                check("analog value", value as f64, ANALOG).map(drop)
+                check("analog value", f64::from(value), ANALOG).map(drop)
             }
             WorldCommand::Supply { volts } => check("supply", volts, SUPPLY).map(drop),
             WorldCommand::Temperature { celsius } => check("temperature", celsius, TEMPERATURE).map(drop),

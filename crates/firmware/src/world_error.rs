@@ -12,8 +12,11 @@ use std::fmt;
 /// An allowed range of a world value, with its unit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Allowed {
+    /// Lowest allowed value.
     pub min: f64,
+    /// Highest allowed value.
     pub max: f64,
+    /// The unit messages show after the range (may be empty).
     pub unit: &'static str,
 }
 

@@ -115,7 +115,7 @@ impl World {
             return Err(WorldError::TooManyAnalogValues { count: f.analog.len() });
         }
         for (n, v) in f.analog.iter().enumerate() {
-            check(&format!("analog[{n}]"), *v as f64, ANALOG)?;
+            check(&format!("analog[{n}]"), f64::from(*v), ANALOG)?;
             w.set_analog(n as u8, *v);
         }
         for (a, af) in f.axis.into_iter().enumerate() {

@@ -1,6 +1,7 @@
 //! The commands of the world control protocol (docs/world.md) in words:
 //! what `help` answers and what an unknown command's error lists.
 
+/// The `help` answer of the control protocol: every world and link command.
 pub const HELP: &str = "commands: [@ADDRESS] input N 0|1 | analog N VALUE | supply VOLTS | temperature CELSIUS | \
 switch AXIS left|right|home press|release|auto | place AXIS left|right POSITION [WIDTH] | place AXIS home FROM TO | \
 place AXIS carriage POSITION | reset | travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \

@@ -144,13 +144,13 @@ impl AxisWorld {
 impl World {
     /// Checks every value of the world against the rule set.
     pub fn validate(&self) -> Result<(), WorldError> {
-        check("supply", self.supply_decivolts as f64 / 10.0, SUPPLY)?;
+        check("supply", f64::from(self.supply_decivolts) / 10.0, SUPPLY)?;
         check("temperature", self.temperature, TEMPERATURE)?;
         if self.analog_inputs.len() > WORLD_ANALOG_INPUTS {
             return Err(WorldError::TooManyAnalogInputs { count: self.analog_inputs.len() });
         }
         for (n, v) in self.analog_inputs.iter().enumerate() {
-            check(&format!("analog[{n}]"), *v as f64, ANALOG)?;
+            check(&format!("analog[{n}]"), f64::from(*v), ANALOG)?;
         }
         for (a, axis) in self.axes.iter().enumerate() {
             axis.validate().map_err(|e| e.on_axis(a))?;

@@ -11,6 +11,7 @@ impl Module {
         std::mem::take(&mut self.interrupts.events)
     }
 
+    /// True when 138 event frames are waiting to be taken (`take_events`).
     pub fn has_events(&self) -> bool {
         !self.interrupts.events.is_empty()
     }

@@ -51,7 +51,7 @@ impl Interrupts {
         if interrupt == 255 || profile.interrupt(interrupt).is_none() {
             return Err(Status::WrongType);
         }
-        if address < 0 || address >= profile.module.program_memory as i32 {
+        if address < 0 || address >= i32::from(profile.module.program_memory) {
             return Err(Status::InvalidValue);
         }
         self.vectors[interrupt as usize] = Some(address as u16);
