@@ -34,7 +34,7 @@ pub struct Module {
     pub(crate) world: World,
     /// The world the module was created in (`reset` of the world control
     /// goes back to it).
-    pub(crate) initial_world: World,
+    initial_world: World,
     /// The EEPROM image and whether it was written.
     pub(crate) persistence: Persistence,
     pub(crate) registers: Registers,
@@ -43,7 +43,7 @@ pub struct Module {
     pub(crate) link: Link,
     pub(crate) program: Program,
     /// Resets (255) and reinitialisations (137) since the module was created.
-    pub(crate) resets: u32,
+    resets: u32,
 }
 
 impl Module {

@@ -81,12 +81,12 @@ pub struct ReferenceSearch {
     marks: Vec<f64>,
     result: Result_,
     /// The home switch's level is inverted (RFS mode with 128 added).
-    pub invert_home: bool,
+    invert_home: bool,
     /// Direction of the current seek (flipped by `reverse_on`).
     pub dir: f64,
     /// Once all seeks are done: the reference point (motor coordinates)
     /// the motor moves to, and the distance for AP 196.
-    pub finish: Option<(f64, Option<f64>)>,
+    finish: Option<(f64, Option<f64>)>,
 }
 
 fn seek(switch: Switch, active: bool, dir: f64, fast: bool) -> Seek {

@@ -13,9 +13,9 @@ pub struct Interrupts {
     pub global: bool,
     /// 138: arm for the next MVP (`Some(false)`) or every MVP (`Some(true)`),
     /// with the motor mask.
-    pub event_arm: Option<(bool, u32)>,
+    event_arm: Option<(bool, u32)>,
     /// Event frames not yet taken.
-    pub events: Vec<[u8; FRAME_LEN]>,
+    events: Vec<[u8; FRAME_LEN]>,
 }
 
 impl Default for Interrupts {
@@ -32,6 +32,28 @@ impl Interrupts {
         self.global = false;
         self.event_arm = None;
         self.events.clear();
+    }
+
+    /// The 138 arming: `Some((every_move, mask))`, or `None` when no
+    /// event is armed.
+    #[cfg(test)]
+    pub fn event_arm(&self) -> Option<(bool, u32)> {
+        self.event_arm
+    }
+
+    /// Queues an event frame (138) for the front end to send.
+    pub fn push_event(&mut self, frame: [u8; FRAME_LEN]) {
+        self.events.push(frame);
+    }
+
+    /// The event frames queued since the last call, oldest first.
+    pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
+        std::mem::take(&mut self.events)
+    }
+
+    /// True when event frames are queued.
+    pub fn has_events(&self) -> bool {
+        !self.events.is_empty()
     }
 
     /// EI, DI: interrupt 255 is the global enable; the others must be in
