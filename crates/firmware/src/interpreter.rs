@@ -42,11 +42,7 @@ impl Module {
     /// each once, in order (so at most one per word, and the interpreter
     /// finds one by a binary search).
     pub fn set_breakpoints(&mut self, addresses: &[u16]) {
-        let words = self.program.memory.len();
-        let mut kept: Vec<u16> = addresses.iter().copied().filter(|&a| usize::from(a) < words).collect();
-        kept.sort_unstable();
-        kept.dedup();
-        self.program.breakpoints = kept;
+        self.program.set_breakpoints(addresses);
     }
 
     /// Turns the instruction trace on or off.

@@ -76,6 +76,16 @@ pub struct TraceRecord {
     pub axes: Vec<(i32, i32)>,
 }
 
+/// What download mode means for a frame from one link.
+pub(crate) enum Download {
+    /// No download is going on.
+    Off,
+    /// This link downloads: its words are stored.
+    Owner,
+    /// Another link downloads: this one talks to the module in direct mode.
+    Other,
+}
+
 /// The interpreter's state.
 #[derive(Clone, Debug)]
 pub struct Program {
@@ -169,6 +179,47 @@ impl Program {
     /// True when interrupt `n` is pending.
     pub fn is_pending(&self, n: u8) -> bool {
         self.pending[n as usize / 64] & (1 << (n % 64)) != 0
+    }
+
+    /// Download mode as link `link` meets it; a download whose owner is
+    /// gone passes to the link that speaks next.
+    pub(crate) fn download_role(&mut self, link: LinkId) -> Download {
+        if self.download.is_none() {
+            return Download::Off;
+        }
+        match self.download_owner {
+            Some(owner) if owner != link => Download::Other,
+            _ => {
+                self.download_owner = Some(link);
+                Download::Owner
+            }
+        }
+    }
+
+    /// Link `link` is gone: a download it owned waits for the next link
+    /// that speaks (docs/behaviour.md rule 91).
+    pub fn release_download(&mut self, link: LinkId) {
+        if self.download_owner == Some(link) {
+            self.download_owner = None;
+        }
+    }
+
+    /// Sets the breakpoints: the addresses inside program memory, each
+    /// once, in order (so at most one per word, and the interpreter finds
+    /// one by a binary search).
+    pub fn set_breakpoints(&mut self, addresses: &[u16]) {
+        let words = self.memory.len();
+        let mut kept: Vec<u16> = addresses.iter().copied().filter(|&a| usize::from(a) < words).collect();
+        kept.sort_unstable();
+        kept.dedup();
+        self.breakpoints = kept;
+    }
+
+    /// Pauses a running program (step mode), as a debugger does.
+    pub fn pause(&mut self) {
+        if self.mode == RunMode::Run {
+            self.mode = RunMode::Step;
+        }
     }
 
     /// Lowest pending interrupt number for which `ready` holds.
