@@ -19,7 +19,7 @@ fuzz_target!(|data: &[u8]| {
         let applied = Addressed::parse(line).and_then(|a| bus.apply_world(a.address, &a.command));
         match applied {
             Ok(_) => assert_eq!(bus.module(0).world().validate(), Ok(()), "{line:?}"),
-            Err(e) => assert!(!e.is_empty(), "{line:?}"),
+            Err(e) => assert!(!e.to_string().is_empty(), "{line:?}"),
         }
         bus.advance(10_000_000);
     }

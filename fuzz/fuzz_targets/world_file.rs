@@ -11,7 +11,7 @@ fuzz_target!(|data: &[u8]| {
     let world = match World::from_toml(text, 1) {
         Ok(w) => w,
         Err(e) => {
-            assert!(!e.is_empty());
+            assert!(!e.to_string().is_empty());
             return;
         }
     };

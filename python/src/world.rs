@@ -16,7 +16,7 @@ pub fn run(shared: &SharedBus, index: usize, line: &str, served: bool) -> Result
             let Addressed { address, command } = Addressed::parse(line)?;
             match address {
                 Some(_) => shared.apply_world(address, &command),
-                None => shared.with_module(index, |m| command.apply(m)),
+                None => shared.with_module(index, |m| command.apply(m)).map_err(String::from),
             }
         }
     }

@@ -27,7 +27,7 @@ fn bench(c: &mut Criterion) {
                 let f = &fs[i % fs.len()];
                 i += 1;
                 black_box(m.handle_frame(black_box(f)))
-            })
+            });
         });
     }
     g.finish();
@@ -55,7 +55,7 @@ fn bench(c: &mut Criterion) {
     c.bench_function("advance 1 ms while moving", |b| {
         let mut bus = Bus::single(Module::built_in("tmcm-1141").unwrap());
         bus.handle_frame(&frames(&["ROR 0, 1000"])[0]);
-        b.iter(|| bus.advance(black_box(1_000_000)))
+        b.iter(|| bus.advance(black_box(1_000_000)));
     });
 }
 

@@ -14,11 +14,14 @@ use crate::clock::Clock;
 use crate::module::Module;
 use crate::snapshot::ModuleSnapshot;
 use crate::world_command::WorldCommand;
+use crate::world_error::WorldError;
 use tmclsim_protocol::FRAME_LEN;
 
 /// The replies to one frame and when they may go out.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Answer {
+    /// The reply frames, in order (none when the module keeps silent: GP 255,
+    /// 137).
     pub replies: Vec<[u8; FRAME_LEN]>,
     /// Delay before the replies: GP 75 of the module that answered and,
     /// with wire timing, the time request and reply take on the wire.
@@ -36,6 +39,7 @@ pub struct Effects {
 }
 
 impl Effects {
+    /// Nothing to carry out: no EEPROM written, no event frame.
     pub fn is_empty(&self) -> bool {
         self.eeprom_written.is_empty() && self.events.is_empty()
     }
@@ -78,6 +82,7 @@ impl Bus {
         self.wire_timing = on;
     }
 
+    /// The bus's source of "now".
     pub fn clock(&self) -> Clock {
         self.clock
     }
@@ -175,7 +180,7 @@ impl Bus {
             answer.delay_ns = answer.delay_ns.max(m.reply_delay_ns());
             if wire_timing {
                 // Request and reply, 10 bits a byte.
-                answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / m.profile().baud_rate(m.baud_rate_code()) as u64;
+                answer.delay_ns += 2 * FRAME_LEN as u64 * 10 * 1_000_000_000 / u64::from(m.profile().baud_rate(m.baud_rate_code()));
             }
         };
         if let [m] = self.modules.as_mut_slice() {
@@ -267,18 +272,22 @@ impl Bus {
         effects
     }
 
+    /// How many modules are on the bus.
     pub fn len(&self) -> usize {
         self.modules.len()
     }
 
+    /// True when the bus holds no module.
     pub fn is_empty(&self) -> bool {
         self.modules.is_empty()
     }
 
+    /// The modules, in bus order.
     pub fn modules(&self) -> &[Module] {
         &self.modules
     }
 
+    /// The module at `index` in bus order (panics when there is none).
     pub fn module(&self, index: usize) -> &Module {
         &self.modules[index]
     }
@@ -301,10 +310,10 @@ impl Bus {
 
     /// Applies a world command to the module at `address` (`None`: the
     /// first module), at the clock's now.
-    pub fn apply_world(&mut self, address: Option<u8>, command: &WorldCommand) -> Result<String, String> {
+    pub fn apply_world(&mut self, address: Option<u8>, command: &WorldCommand) -> Result<String, WorldError> {
         let index = match address {
             None => 0,
-            Some(a) => self.index_of(a).ok_or_else(|| format!("no module on the bus answers to address {a}"))?,
+            Some(a) => self.index_of(a).ok_or(WorldError::NoModule { address: a })?,
         };
         self.catch_up();
         command.apply(&mut self.modules[index])
@@ -397,7 +406,10 @@ mod tests {
         assert!(!bus.module(0).world().digital(0));
         assert!(bus.module(1).world().digital(0));
         assert_eq!(bus.snapshot()[1].io.inputs & 1, 1);
-        assert_eq!(bus.apply_world(Some(9), &WorldCommand::Show { axis: None }).unwrap_err(), "no module on the bus answers to address 9");
+        assert_eq!(
+            bus.apply_world(Some(9), &WorldCommand::Show { axis: None }).unwrap_err().to_string(),
+            "no module on the bus answers to address 9"
+        );
     }
 
     #[test]

@@ -18,12 +18,16 @@ use tmclsim_protocol::{Instruction, Status, opcode};
 /// A CAN frame: 11-bit identifier and up to 8 data bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CanFrame {
+    /// The 11-bit CAN identifier.
     pub id: u32,
+    /// How many of `data`'s bytes the frame carries (0…8).
     pub len: u8,
+    /// The data bytes; those past `len` are 0.
     pub data: [u8; 8],
 }
 
 impl CanFrame {
+    /// A frame with identifier `id` and the first 8 of `bytes`.
     pub fn new(id: u32, bytes: &[u8]) -> CanFrame {
         let mut data = [0u8; 8];
         let len = bytes.len().min(8);
@@ -31,6 +35,7 @@ impl CanFrame {
         CanFrame { id, len: len as u8, data }
     }
 
+    /// The frame's data bytes (the first `len`).
     pub fn bytes(&self) -> &[u8] {
         &self.data[..self.len as usize]
     }
@@ -43,8 +48,8 @@ impl Module {
             let secondary = self.globals[0][can.secondary_id as usize] as u32;
             (self.globals[0][can.id as usize] as u32, (secondary != 0).then_some(secondary))
         } else {
-            let secondary = self.secondary_address() as u32;
-            (self.address() as u32, (secondary != 0).then_some(secondary))
+            let secondary = u32::from(self.secondary_address());
+            (u32::from(self.address()), (secondary != 0).then_some(secondary))
         }
     }
 
@@ -52,7 +57,7 @@ impl Module {
     pub fn can_reply_id(&self) -> u32 {
         match self.profile.features.can {
             Some(can) => self.globals[0][can.reply_id as usize] as u32,
-            None => self.host_address() as u32,
+            None => u32::from(self.host_address()),
         }
     }
 

@@ -12,7 +12,12 @@ use std::time::{Duration, Instant};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Clock {
     /// Virtual time follows the wall clock: it was `origin_ns` at `origin`.
-    Wall { origin: Instant, origin_ns: u64 },
+    Wall {
+        /// The wall-clock instant taken as the origin.
+        origin: Instant,
+        /// Virtual time at `origin`, in ns.
+        origin_ns: u64,
+    },
     /// Virtual time moves only when the bus is told to advance.
     Stepped,
 }
@@ -41,6 +46,7 @@ impl Clock {
         }
     }
 
+    /// True when virtual time moves only when the bus is told to advance.
     pub fn is_stepped(&self) -> bool {
         matches!(self, Clock::Stepped)
     }

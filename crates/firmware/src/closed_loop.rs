@@ -29,7 +29,7 @@ use crate::state::registers::error_flag;
 /// Current scale reserve above what the load needs (%).
 pub const RESERVE_PERCENT: f64 = 20.0;
 
-pub mod cl {
+pub(crate) mod cl {
     pub const TORQUE_TARGET: u8 = 14;
     pub const MAX_POSSIBLE_CURRENT: u8 = 15;
     pub const VELOCITY_REACHED: u8 = 16;
@@ -66,7 +66,7 @@ impl Module {
     /// The module's current for 100 % (features `full_scale_current_ma`),
     /// mA RMS.
     fn full_scale_ma(&self) -> f64 {
-        self.profile.features.full_scale_current_ma as f64
+        f64::from(self.profile.features.full_scale_current_ma)
     }
 
     pub(crate) fn closed_loop_on(&self, m: usize) -> bool {
@@ -82,8 +82,8 @@ impl Module {
     /// Encoder counts of the rotor (raw, before SAP 209's offset).
     fn encoder_counts(&self, m: usize) -> f64 {
         let p = &self.axes[m].params;
-        let per_rev = p[cl::FULLSTEPS as usize].max(1) as f64 * self.microsteps(m);
-        self.mechanical_position(m) / per_rev * p[cl::ENCODER_RESOLUTION as usize].max(1) as f64
+        let per_rev = f64::from(p[cl::FULLSTEPS as usize].max(1)) * self.microsteps(m);
+        self.mechanical_position(m) / per_rev * f64::from(p[cl::ENCODER_RESOLUTION as usize].max(1))
     }
 
     /// What the encoder delivers now: the rotor's count, or the last one
@@ -104,11 +104,11 @@ impl Module {
     /// The rotor position the encoder reports, in µsteps of the counter.
     pub(crate) fn measured_position(&self, m: usize) -> f64 {
         let p = &self.axes[m].params;
-        let per_rev = p[cl::FULLSTEPS as usize].max(1) as f64 * self.microsteps(m);
+        let per_rev = f64::from(p[cl::FULLSTEPS as usize].max(1)) * self.microsteps(m);
         let counts = self.encoder_now(m);
         // The counter and the rotor agreed at `sync_offset`.
         let sign = self.shaft_sign();
-        let mech = counts / p[cl::ENCODER_RESOLUTION as usize].max(1) as f64 * per_rev;
+        let mech = counts / f64::from(p[cl::ENCODER_RESOLUTION as usize].max(1)) * per_rev;
         (mech - self.axes[m].closed_loop.sync_offset) * sign
     }
 
@@ -151,11 +151,11 @@ impl Module {
         let sign = self.shaft_sign();
         let before = self.mechanical_position(m) - moved * sign;
         if self.closed_loop_on(m) {
-            let (lo, hi) = (p[cl::SCALE_MIN as usize].clamp(0, 100) as f64, p[cl::SCALE_MAX as usize].clamp(0, 100) as f64);
+            let (lo, hi) = (f64::from(p[cl::SCALE_MIN as usize].clamp(0, 100)), f64::from(p[cl::SCALE_MAX as usize].clamp(0, 100)));
             let speed_factor = (1.0 - self.axes[m].motion.v.abs() / self.microsteps(m) / crate::driver::CORNER_FULLSTEPS).max(0.01);
             let needed = load / speed_factor + RESERVE_PERCENT;
             let scale = if self.axes[m].closed_loop.torque_mode {
-                (p[cl::TORQUE_TARGET as usize] as f64).abs() / self.full_scale_ma() * 100.0
+                f64::from(p[cl::TORQUE_TARGET as usize]).abs() / self.full_scale_ma() * 100.0
             } else if p[cl::SCALE_ENABLE as usize] == 1 {
                 needed.clamp(lo.min(hi), hi)
             } else {
@@ -171,7 +171,7 @@ impl Module {
                 // Correct the error at up to the correction velocity.
                 let lag = (axis.closed_loop.sync_offset - axis.mech_offset) * sign;
                 let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-                let v_corr = motion::velocity_pps(p[cl::MAX_CORRECTION_VELOCITY as usize].clamp(0, 2047) as f64, pd);
+                let v_corr = motion::velocity_pps(f64::from(p[cl::MAX_CORRECTION_VELOCITY as usize].clamp(0, 2047)), pd);
                 let step = (v_corr * dt).min(lag.abs());
                 if load <= torque {
                     axis.mech_offset += step * lag.signum() * sign;
@@ -179,7 +179,7 @@ impl Module {
             }
         } else {
             // Open loop: lost steps stay lost.
-            self.axes[m].closed_loop.scale = (self.motor_current(m) as f64 / 255.0 * 100.0).round();
+            self.axes[m].closed_loop.scale = (f64::from(self.motor_current(m)) / 255.0 * 100.0).round();
             let axis = &mut self.axes[m];
             if open_loop_slips {
                 axis.mech_offset -= moved * sign;
@@ -200,7 +200,7 @@ impl Module {
         if !self.world.axes[m].encoder_lost {
             let last = self.axes[m].closed_loop.encoder_last;
             let now = self.encoder_counts(m);
-            let per_rev = p[cl::ENCODER_RESOLUTION as usize].max(1) as f64;
+            let per_rev = f64::from(p[cl::ENCODER_RESOLUTION as usize].max(1));
             let (a, b) = ((last / per_rev).floor(), (now / per_rev).floor());
             let index = if now >= last { (a < b).then_some(b * per_rev) } else { (b < a).then_some(a * per_rev) };
             if let (Some(at), true) = (index, p[cl::ENCODER_MODE as usize] & 0b101 == 0b100) {
@@ -213,7 +213,7 @@ impl Module {
         // Deviation: measured rotor against the virtual position.
         let limit = p[cl::MAX_FOLLOWING_ERROR as usize];
         let error = (self.axes[m].motion.x - self.measured_position(m)).abs();
-        if limit > 0 && error > limit as f64 {
+        if limit > 0 && error > f64::from(limit) {
             if !self.axes[m].closed_loop.deviation_reported {
                 self.axes[m].closed_loop.deviation_reported = true;
                 self.registers.errors |= error_flag::DEVIATION;
@@ -232,7 +232,7 @@ impl Module {
     /// torque-mode current equals the load.
     pub(crate) fn torque_mode_velocity(&self, m: usize) -> f64 {
         let p = &self.axes[m].params;
-        let target = p[cl::TORQUE_TARGET as usize] as f64;
+        let target = f64::from(p[cl::TORQUE_TARGET as usize]);
         let percent = (target.abs() / self.full_scale_ma() * 100.0).min(100.0);
         let load = self.world.axes[m].load_at(self.mechanical_position(m), self.now_ns as f64 * 1e-9);
         if self.driver_off(m) || percent <= load {
@@ -253,15 +253,15 @@ impl Module {
         let p = &axis.params;
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let torque_ma = if axis.closed_loop.torque_mode {
-            (p[cl::TORQUE_TARGET as usize] as f64).clamp(-self.full_scale_ma(), self.full_scale_ma())
+            f64::from(p[cl::TORQUE_TARGET as usize]).clamp(-self.full_scale_ma(), self.full_scale_ma())
         } else {
             axis.closed_loop.scale / 100.0 * self.full_scale_ma()
         };
         Some(match param {
             ap::ACTUAL_POSITION if self.closed_loop_on(m) => self.measured_position(m).round() as i32,
-            ap::POSITION_REACHED => self.closed_loop_target_reached(m) as i32,
+            ap::POSITION_REACHED => i32::from(self.closed_loop_target_reached(m)),
             cl::MAX_POSSIBLE_CURRENT => self.full_scale_ma() as i32,
-            cl::VELOCITY_REACHED => self.velocity_reached(m) as i32,
+            cl::VELOCITY_REACHED => i32::from(self.velocity_reached(m)),
             cl::STATUS_WORD => self.status_word(m),
             cl::TORQUE_ACTUAL => torque_ma.round() as i32,
             cl::SCALE_ACTUAL | cl::TARGET_SCALE => {
@@ -272,7 +272,7 @@ impl Module {
                 }
             }
             cl::MEASURED_VELOCITY => motion::velocity_internal(axis.closed_loop.rotor_velocity, pd).round() as i32,
-            cl::INIT_FLAG => self.closed_loop_on(m) as i32,
+            cl::INIT_FLAG => i32::from(self.closed_loop_on(m)),
             ap::ENCODER_POSITION => self.closed_loop_encoder(m),
             cl::GAMMA => {
                 let load = self.world.axes[m].load_at(self.mechanical_position(m), self.now_ns as f64 * 1e-9);
@@ -287,13 +287,13 @@ impl Module {
 
     fn closed_loop_target_reached(&self, m: usize) -> bool {
         let axis = &self.axes[m];
-        let window = axis.params[cl::POSITION_WINDOW as usize].max(0) as f64;
+        let window = f64::from(axis.params[cl::POSITION_WINDOW as usize].max(0));
         if !self.closed_loop_on(m) {
             return self.actual_position(m) == axis.target_word;
         }
         axis.motion.mode != RampMode::Velocity
             && axis.motion.v == 0.0
-            && (axis.target_word as f64 - self.measured_position(m)).abs() <= window.max(0.5)
+            && (f64::from(axis.target_word) - self.measured_position(m)).abs() <= window.max(0.5)
     }
 
     fn velocity_reached(&self, m: usize) -> bool {
@@ -321,6 +321,6 @@ impl Module {
             self.world.supply_decivolts > 550,
             self.world.temperature >= crate::driver::SHUTDOWN_C,
         ];
-        bits.iter().enumerate().fold(0, |w, (i, b)| w | (*b as i32) << i)
+        bits.iter().enumerate().fold(0, |w, (i, b)| w | i32::from(*b) << i)
     }
 }

@@ -64,7 +64,7 @@ impl Module {
         let Some(counts_per_rev) = w.encoder_counts else { return self.axes[m].encoder_offset as i32 };
         let microsteps_per_rev = w.fullsteps_per_rev * self.microsteps(m);
         let counts = self.mechanical_position(m) / microsteps_per_rev * counts_per_rev;
-        let factor = self.axes[m].params[ap::ENCODER_PRESCALER as usize] as f64 / PRESCALER_UNIT;
+        let factor = f64::from(self.axes[m].params[ap::ENCODER_PRESCALER as usize]) / PRESCALER_UNIT;
         ((counts * factor).round() as i64 + self.axes[m].encoder_offset) as i32
     }
 
@@ -74,21 +74,21 @@ impl Module {
         let axis = &self.axes[m];
         let t = self.world.temperature;
         let still = axis.standstill_since.is_some_and(|s| self.now_ns.saturating_sub(s) >= STANDSTILL_NS);
-        (axis.motion.v != 0.0 && axis.driver.load_value == 0) as i32
-            | ((t >= SHUTDOWN_C) as i32) << 1
-            | ((t >= PREWARNING_C) as i32) << 2
-            | (f.short_a as i32) << 3
-            | (f.short_b as i32) << 4
-            | (f.open_a as i32) << 5
-            | (f.open_b as i32) << 6
-            | (still as i32) << 7
+        i32::from(axis.motion.v != 0.0 && axis.driver.load_value == 0)
+            | i32::from(t >= SHUTDOWN_C) << 1
+            | i32::from(t >= PREWARNING_C) << 2
+            | i32::from(f.short_a) << 3
+            | i32::from(f.short_b) << 4
+            | i32::from(f.open_a) << 5
+            | i32::from(f.open_b) << 6
+            | i32::from(still) << 7
     }
 
     /// Current scale in effect (0…31): coolStep's, or the current setting's.
     pub(crate) fn current_scale(&self, m: usize) -> f64 {
         match self.axes[m].driver.cool_scale {
             Some(cs) if self.axes[m].motion.v != 0.0 => cs,
-            _ => (self.motor_current(m) >> 3) as f64,
+            _ => f64::from(self.motor_current(m) >> 3),
         }
     }
 
@@ -122,7 +122,7 @@ impl Module {
 
     fn stallguard(&self, m: usize, margin: f64) -> i32 {
         let sgt = self.axes[m].params[ap::STALLGUARD_THRESHOLD as usize];
-        round_in(800.0 * margin + 8.0 * sgt as f64, 1023.0)
+        round_in(800.0 * margin + 8.0 * f64::from(sgt), 1023.0)
     }
 
     /// After the motion controller moved the axis from `x_before` during
@@ -182,8 +182,8 @@ impl Module {
         // Encoder deviation (AP 212): the motor stops when the position
         // counter and the encoder drift apart further than allowed.
         if limit > 0 && moving && self.profile.features.encoder_deviation_stop {
-            let deviation = (self.actual_position(m) as i64 - self.encoder_position(m) as i64).abs();
-            if deviation > limit as i64 {
+            let deviation = (i64::from(self.actual_position(m)) - i64::from(self.encoder_position(m))).abs();
+            if deviation > i64::from(limit) {
                 self.stop_now(m);
                 self.registers.errors |= error_flag::DEVIATION;
                 self.raise(Source::Deviation(m as u8));
@@ -196,7 +196,7 @@ impl Module {
     /// µsteps: the current scale goes up under load and down without.
     fn cool_step(&mut self, m: usize, moved: f64, off: bool, semin: i32) {
         let p = &self.axes[m].params;
-        let max = (p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3) as f64;
+        let max = f64::from(p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3);
         let min =
             if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
         let mut cs = self.axes[m].driver.cool_scale.unwrap_or(max);
@@ -267,7 +267,7 @@ impl Module {
 fn round_in(x: f64, max: f64) -> i32 {
     let x = x.clamp(0.0, max);
     let whole = x as i32;
-    whole + (x - whole as f64 >= 0.5) as i32
+    whole + i32::from(x - f64::from(whole) >= 0.5)
 }
 
 #[cfg(test)]
@@ -284,7 +284,7 @@ mod tests {
             }
         }
         for i in 0..100_000 {
-            let x = i as f64 * 0.012_345 - 50.0;
+            let x = f64::from(i) * 0.012_345 - 50.0;
             assert_eq!(round_in(x, 1023.0), x.round().clamp(0.0, 1023.0) as i32, "{x}");
         }
     }

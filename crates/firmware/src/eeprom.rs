@@ -13,6 +13,9 @@ use std::collections::BTreeMap;
 pub const FORMAT: u32 = 1;
 
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// The module's EEPROM image: what survives a power cycle (stored axis and
+/// global parameters, coordinates, the TMCL program). Front ends keep it as
+/// JSON (`to_json`, `from_json`).
 pub struct Eeprom {
     /// File format version.
     pub format: u32,
@@ -35,30 +38,37 @@ fn key(a: u8, b: u8) -> String {
 }
 
 impl Eeprom {
+    /// An empty image for the module named `module`.
     pub fn new(module: &str) -> Eeprom {
         Eeprom { format: FORMAT, module: module.to_string(), ..Eeprom::default() }
     }
 
+    /// The stored value of axis parameter `param` of `motor`, if any.
     pub fn axis(&self, motor: u8, param: u8) -> Option<i32> {
         self.axis.get(&key(motor, param)).copied()
     }
 
+    /// Stores a value of axis parameter `param` of `motor` (STAP).
     pub fn set_axis(&mut self, motor: u8, param: u8, value: i32) {
         self.axis.insert(key(motor, param), value);
     }
 
+    /// The stored value of global parameter `param` of `bank`, if any.
     pub fn global(&self, bank: u8, param: u8) -> Option<i32> {
         self.global.get(&key(bank, param)).copied()
     }
 
+    /// Stores a value of global parameter `param` of `bank` (STGP).
     pub fn set_global(&mut self, bank: u8, param: u8, value: i32) {
         self.global.insert(key(bank, param), value);
     }
 
+    /// Stored coordinate `n` of `motor`, if any.
     pub fn coordinate(&self, motor: u8, n: u8) -> Option<i32> {
         self.coordinates.get(&key(motor, n)).copied()
     }
 
+    /// Stores coordinate `n` of `motor`.
     pub fn set_coordinate(&mut self, motor: u8, n: u8, value: i32) {
         self.coordinates.insert(key(motor, n), value);
     }
@@ -72,10 +82,13 @@ impl Eeprom {
         self.program = program;
     }
 
+    /// The image as pretty-printed JSON, the form of an EEPROM file.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("EEPROM image serialises")
     }
 
+    /// Reads an image written by `to_json`; refuses text that is no image or
+    /// another format version.
     pub fn from_json(text: &str) -> Result<Eeprom, ImageTextError> {
         let e: Eeprom = serde_json::from_str(text).map_err(|e| ImageTextError::Unreadable(e.to_string()))?;
         if e.format != FORMAT {

@@ -163,9 +163,19 @@ impl Eeprom {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum ImageError {
     /// The image is another module's.
-    OtherModule { image: String, module: String },
+    OtherModule {
+        /// The module named in the image.
+        image: String,
+        /// The module it was to be loaded into.
+        module: String,
+    },
     /// Entries the module never stores (at least one).
-    Refused { module: String, entries: Vec<Refused> },
+    Refused {
+        /// The module that refuses them.
+        module: String,
+        /// The entries, each with why it is refused.
+        entries: Vec<Refused>,
+    },
 }
 
 impl std::fmt::Display for ImageError {
@@ -211,7 +221,7 @@ mod tests {
             for motor in 0..p.module.axes {
                 for a in p.axis_parameters().filter(|a| a.access.eeprom) {
                     e.set_axis(motor, a.number, a.default_word());
-                    e.set_axis(motor, a.number, a.max.min(i32::MAX as i64) as i32);
+                    e.set_axis(motor, a.number, a.max.min(i64::from(i32::MAX)) as i32);
                 }
                 for n in 1..=p.module.coordinates {
                     e.set_coordinate(motor, n, i32::MIN);

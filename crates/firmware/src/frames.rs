@@ -6,20 +6,11 @@
 use crate::module::Module;
 use crate::outcome::{Outcome, Special};
 use crate::parameter_numbers::gp;
+use crate::program::Download;
 use tmclsim_protocol::frame::version_string_reply;
 use tmclsim_protocol::{Command, FRAME_LEN, Instruction, Reply, Request, Status, opcode};
 
 use crate::link_id::{IN_PROCESS, LinkId};
-
-/// What download mode means for a frame from one link.
-enum Download {
-    /// No download is going on.
-    Off,
-    /// This link downloads: its words are stored.
-    Owner,
-    /// Another link downloads: this one talks to the module in direct mode.
-    Other,
-}
 
 impl Module {
     /// Handles one 9-byte frame from a serial-type link: address filter,
@@ -50,7 +41,7 @@ impl Module {
             return Some(Reply::new(host, request.address, Status::WrongChecksum, 0, 0).encode());
         }
         let ins = request.instruction;
-        let outcome = match self.download_role(link) {
+        let outcome = match self.program.download_role(link) {
             Download::Owner if !opcode::is_control(ins.opcode) => self.download_word(ins),
             // Another link's download is not started, ended or run over.
             Download::Other if Self::changes_program_state(ins.opcode) => Outcome::error(Status::NotAvailable, ins.value),
@@ -75,21 +66,6 @@ impl Module {
         Some(reply)
     }
 
-    /// Download mode as link `link` meets it; a download whose owner is
-    /// gone passes to the link that speaks next.
-    fn download_role(&mut self, link: LinkId) -> Download {
-        if self.program.download.is_none() {
-            return Download::Off;
-        }
-        match self.program.download_owner {
-            Some(owner) if owner != link => Download::Other,
-            _ => {
-                self.program.download_owner = Some(link);
-                Download::Owner
-            }
-        }
-    }
-
     /// Opcodes a link other than the download's owner may not send while
     /// it downloads: run, step, reset, and entering or leaving download
     /// mode.
@@ -103,9 +79,7 @@ impl Module {
     /// Link `link` is gone: a download it owned waits for the next link
     /// that speaks (docs/behaviour.md rule 91).
     pub fn link_closed(&mut self, link: LinkId) {
-        if self.program.download_owner == Some(link) {
-            self.program.download_owner = None;
-        }
+        self.program.release_download(link);
     }
 
     /// The reply a read would get, taken from the model without any of a

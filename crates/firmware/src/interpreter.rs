@@ -32,6 +32,7 @@ impl Module {
         self.program.executed != before
     }
 
+    /// The TMCL program: its memory, counter, stack, timers and run mode.
     pub fn program(&self) -> &crate::program::Program {
         &self.program
     }
@@ -41,11 +42,7 @@ impl Module {
     /// each once, in order (so at most one per word, and the interpreter
     /// finds one by a binary search).
     pub fn set_breakpoints(&mut self, addresses: &[u16]) {
-        let words = self.program.memory.len();
-        let mut kept: Vec<u16> = addresses.iter().copied().filter(|&a| usize::from(a) < words).collect();
-        kept.sort_unstable();
-        kept.dedup();
-        self.program.breakpoints = kept;
+        self.program.set_breakpoints(addresses);
     }
 
     /// Turns the instruction trace on or off.
@@ -115,7 +112,7 @@ impl Module {
         if !self.profile.has_opcode(ins.opcode) || opcode::is_control(ins.opcode) {
             return Err(Status::InvalidCommand);
         }
-        let cmd = Command::decode(ins).map_err(|e| e.status())?;
+        let cmd = Command::decode(ins).map_err(tmclsim_protocol::DecodeError::status)?;
         self.dispatch(cmd, ins, Origin::Program, at).map(|_| ())
     }
 

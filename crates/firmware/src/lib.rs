@@ -34,7 +34,9 @@ mod test_support;
 mod time;
 pub mod world;
 pub mod world_command;
+pub mod world_error;
 pub mod world_file;
+mod world_help;
 pub mod world_rules;
 
 pub use bus::Bus;
@@ -44,3 +46,4 @@ pub use link_id::{IN_PROCESS, LinkId};
 pub use module::{Module, Outcome, Special};
 pub use profile::Profile;
 pub use world::World;
+pub use world_error::WorldError;

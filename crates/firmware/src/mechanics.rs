@@ -90,16 +90,16 @@ impl Module {
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
         let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
-        let mut vmax = p[ap::MAX_SPEED as usize].clamp(0, 2047) as f64;
-        let mut target_velocity = p[ap::TARGET_SPEED as usize] as f64;
+        let mut vmax = f64::from(p[ap::MAX_SPEED as usize].clamp(0, 2047));
+        let mut target_velocity = f64::from(p[ap::TARGET_SPEED as usize]);
         if self.axes[motor].closed_loop.torque_mode {
             target_velocity = self.torque_mode_velocity(motor);
         }
         if let Some(rfs) = &self.axes[motor].rfs {
-            let slow = p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047) as f64;
+            let slow = f64::from(p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047));
             match rfs.current() {
                 Some(seek) => {
-                    let fast = p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047) as f64;
+                    let fast = f64::from(p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047));
                     target_velocity = seek.dir * if seek.fast { fast } else { slow };
                 }
                 None => vmax = slow.max(1.0),
@@ -107,9 +107,9 @@ impl Module {
         }
         motion::Ramp {
             vmax: motion::velocity_pps(vmax, pd),
-            vmin: motion::velocity_pps(p[ap::MIN_SPEED as usize].clamp(0, 2047) as f64, pd),
+            vmin: motion::velocity_pps(f64::from(p[ap::MIN_SPEED as usize].clamp(0, 2047)), pd),
             accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
-            accel_velocity: motion::accel_pps2(a.max(1) as f64, rd, pd),
+            accel_velocity: motion::accel_pps2(f64::from(a.max(1)), rd, pd),
             target_velocity: motion::velocity_pps(target_velocity, pd),
         }
     }
@@ -125,7 +125,7 @@ mod tests {
         assert_eq!(m.wrap_position(8_388_608), -8_388_608, "24 bits");
         assert_eq!(m.wrap_position(-8_388_609), 8_388_607);
         let m = module("tmcm-1141");
-        assert_eq!(m.wrap_position(i32::MAX as i64 + 1), i32::MIN, "32 bits");
+        assert_eq!(m.wrap_position(i64::from(i32::MAX) + 1), i32::MIN, "32 bits");
     }
 
     #[test]

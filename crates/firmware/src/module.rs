@@ -14,10 +14,10 @@ use crate::state::link::Link;
 use crate::state::persistence::Persistence;
 use crate::world::World;
 use std::sync::Arc;
-use tmclsim_profile::Profile;
+use tmclsim_profile::{Profile, ProfileError};
 
 pub use crate::outcome::{Origin, Outcome, Special};
-pub use crate::parameter_numbers::{ap, gp};
+pub use crate::parameter_numbers::gp;
 pub use crate::state::axis::Axis;
 pub use crate::state::registers::{Compare, Registers, error_flag};
 
@@ -34,7 +34,7 @@ pub struct Module {
     pub(crate) world: World,
     /// The world the module was created in (`reset` of the world control
     /// goes back to it).
-    pub(crate) initial_world: World,
+    initial_world: World,
     /// The EEPROM image and whether it was written.
     pub(crate) persistence: Persistence,
     pub(crate) registers: Registers,
@@ -43,7 +43,7 @@ pub struct Module {
     pub(crate) link: Link,
     pub(crate) program: Program,
     /// Resets (255) and reinitialisations (137) since the module was created.
-    pub(crate) resets: u32,
+    resets: u32,
 }
 
 impl Module {
@@ -85,18 +85,23 @@ impl Module {
     }
 
     /// A module by built-in profile name.
-    pub fn built_in(name: &str) -> Result<Module, String> {
+    pub fn built_in(name: &str) -> Result<Module, ProfileError> {
         Ok(Module::new(Profile::built_in(name)?))
     }
 
+    /// The module's profile: its parameter tables, ports, interrupts and
+    /// features.
     pub fn profile(&self) -> &Arc<Profile> {
         &self.profile
     }
 
+    /// The world around the module (switches, loads, inputs, supply).
     pub fn world(&self) -> &World {
         &self.world
     }
 
+    /// The world, to change it directly (world commands go through
+    /// `WorldCommand::apply`).
     pub fn world_mut(&mut self) -> &mut World {
         &mut self.world
     }
@@ -121,6 +126,7 @@ impl Module {
         a.mech_offset = position - a.motion.x * sign;
     }
 
+    /// The module's EEPROM image as it is stored now.
     pub fn eeprom(&self) -> &Eeprom {
         self.persistence.eeprom()
     }
@@ -148,14 +154,18 @@ impl Module {
         self.resets
     }
 
+    /// Accumulator, X register, comparison result and error flags of the
+    /// interpreter.
     pub fn registers(&self) -> Registers {
         self.registers
     }
 
+    /// The module's virtual time, in ns since it was created.
     pub fn now_ns(&self) -> u64 {
         self.now_ns
     }
 
+    /// Axis `motor` (panics when the module has no such axis).
     pub fn axis(&self, motor: usize) -> &Axis {
         &self.axes[motor]
     }
@@ -170,6 +180,7 @@ impl Module {
         self.globals[0][gp::SECONDARY_ADDRESS as usize] as u8
     }
 
+    /// The host address of replies (GP 76).
     pub fn host_address(&self) -> u8 {
         self.globals[0][gp::HOST_ADDRESS as usize] as u8
     }
@@ -191,11 +202,11 @@ impl Module {
     /// too, so that modules placed at different addresses on one bus are
     /// reached apart on every interface (docs/behaviour.md rule 92).
     pub fn set_address(&mut self, address: u8) {
-        self.globals[0][gp::SERIAL_ADDRESS as usize] = address as i32;
-        self.persistence.store_global(0, gp::SERIAL_ADDRESS, address as i32);
+        self.globals[0][gp::SERIAL_ADDRESS as usize] = i32::from(address);
+        self.persistence.store_global(0, gp::SERIAL_ADDRESS, i32::from(address));
         if let Some(can) = self.profile.features.can {
-            self.globals[0][can.id as usize] = address as i32;
-            self.persistence.store_global(0, can.id, address as i32);
+            self.globals[0][can.id as usize] = i32::from(address);
+            self.persistence.store_global(0, can.id, i32::from(address));
         }
     }
 

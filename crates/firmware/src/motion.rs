@@ -10,6 +10,8 @@
 //! of phases, not millions of ticks. Positions are kept unwrapped in `f64`
 //! and snapped to the exact target on arrival.
 
+/// The TMC429's clock in Hz: velocities and accelerations in internal units
+/// scale with it (pulse and ramp divisors, AP 154 and AP 153).
 pub const FCLK: f64 = 16_000_000.0;
 
 /// 2^e, exactly (the same value as `pow2(e)`, without the call).
@@ -47,7 +49,7 @@ pub fn positioning_accel(a: u32, ramp_div: u32, pulse_div: u32) -> f64 {
     let e = ramp_div as i32 - pulse_div as i32;
     let lower = pow2(e - 1);
     let upper = (pow2(e + 12) - 1.0).min(2047.0);
-    (a as f64).clamp(lower.min(upper), upper)
+    f64::from(a).clamp(lower.min(upper), upper)
 }
 
 /// `x.floor() as i64` without a call into the maths library: the
@@ -98,12 +100,17 @@ pub struct Step {
 /// AP 138.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RampMode {
+    /// Ramp to the target position with trapezoidal acceleration.
     Position = 0,
+    /// Approach the target position exponentially (soft ramp).
     Soft = 1,
+    /// Run at the target speed; the position is not a target.
     Velocity = 2,
 }
 
 impl RampMode {
+    /// The mode for a value of AP 138 (anything other than 1 and 2 is position
+    /// mode).
     pub fn from_code(v: i32) -> RampMode {
         match v {
             1 => RampMode::Soft,
@@ -192,6 +199,7 @@ pub struct Motion {
     pub v: f64,
     /// Acceleration in effect, µsteps/s² (for AP 135).
     pub a: f64,
+    /// The ramp mode in effect (AP 138).
     pub mode: RampMode,
     /// Target position in the unwrapped space of `x`.
     pub target: f64,
@@ -555,7 +563,7 @@ mod tests {
     fn floor_and_ceil_are_the_library_s() {
         let mut cases = vec![0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.5, -2.5, 1e-9, -1e-9, 4503599627370495.5, -4503599627370495.5];
         cases.extend([9.3e18, -9.3e18, 2f64.powi(63), -(2f64.powi(63)), 1e300, -1e300, f64::NAN, f64::INFINITY, f64::NEG_INFINITY]);
-        cases.extend((0..100_000).map(|i| i as f64 * 0.37 - 18_000.0 + 1e-9));
+        cases.extend((0..100_000).map(|i| f64::from(i) * 0.37 - 18_000.0 + 1e-9));
         for x in cases {
             assert_eq!(floor_i64(x), x.floor() as i64, "floor {x}");
             assert_eq!(ceil_i64(x), x.ceil() as i64, "ceil {x}");

@@ -57,26 +57,51 @@ pub mod ap {
 
 /// Global parameter numbers (bank 0) the firmware gives a meaning to.
 pub mod gp {
+    /// GP 64: the EEPROM magic word, which marks the stored settings as
+    /// valid.
     pub const EEPROM_MAGIC: u8 = 64;
+    /// GP 65: the RS-485 baud rate setting.
     pub const BAUD_RATE: u8 = 65;
+    /// GP 66: the module's serial address.
     pub const SERIAL_ADDRESS: u8 = 66;
+    /// GP 67: ASCII command mode on (1) or off.
     pub const ASCII_MODE: u8 = 67;
+    /// GP 68: serial heartbeat in ms (0: off).
     pub const HEARTBEAT: u8 = 68;
+    /// GP 77: auto start: the stored program runs after power-up.
     pub const AUTOSTART: u8 = 77;
+    /// GP 73: EEPROM lock (docs/behaviour.md rule 73).
     pub const EEPROM_LOCK: u8 = 73;
+    /// GP 80: shutdown pin function.
     pub const SHUTDOWN_PIN: u8 = 80;
+    /// GP 81: TMCL code protection.
     pub const CODE_PROTECTION: u8 = 81;
+    /// GP 75: telegram pause time, the delay before a reply.
     pub const TELEGRAM_PAUSE: u8 = 75;
+    /// GP 76: the serial host address of replies.
     pub const HOST_ADDRESS: u8 = 76;
+    /// GP 79: end switch polarity (one bit per switch).
     pub const END_SWITCH_POLARITY: u8 = 79;
+    /// GP 84: coordinate storage (0: RAM only, 1: coordinates are also stored
+    /// in the EEPROM).
     pub const COORDINATE_STORAGE: u8 = 84;
+    /// GP 85: do not restore user variables from the EEPROM at power-up.
     pub const DONT_RESTORE_USER_VARIABLES: u8 = 85;
+    /// GP 87: the serial secondary address (0: off).
     pub const SECONDARY_ADDRESS: u8 = 87;
+    /// GP 90: reverse shaft direction.
     pub const REVERSE_SHAFT: u8 = 90;
+    /// GP 128: TMCL application status (stop, run, step, reset).
     pub const APPLICATION_STATUS: u8 = 128;
+    /// GP 129: download mode on or off.
     pub const DOWNLOAD_MODE: u8 = 129;
+    /// GP 130: TMCL program counter.
     pub const PROGRAM_COUNTER: u8 = 130;
+    /// GP 132: the tick timer, counting ms from where it was last set.
     pub const TICK_TIMER: u8 = 132;
+    /// GP 133: a random number (a new one on each read).
     pub const RANDOM: u8 = 133;
+    /// GP 255: 1 suppresses the replies in direct mode, except for GAP, GGP
+    /// and GIO.
     pub const SUPPRESS_REPLY: u8 = 255;
 }

@@ -22,16 +22,22 @@ pub const DEFAULT_INSTRUCTION_NS: u64 = 25_000;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum RunMode {
     #[default]
+    /// Not running.
     Stop = 0,
+    /// Running.
     Run = 1,
+    /// Paused in step mode: the next instruction runs on a step command.
     Step = 2,
+    /// Stopped by a reset (131): counter and registers back at 0.
     Reset = 3,
 }
 
 /// A WAIT in progress.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Wait {
+    /// What the WAIT waits for.
     pub condition: WaitCondition,
+    /// The motor a WAIT on a motor's state watches.
     pub motor: u8,
     /// WAIT TICKS: when it ends; the others: when they time out (`None`:
     /// no timeout).
@@ -41,8 +47,11 @@ pub struct Wait {
 /// What an interrupt saves and RETI restores.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Context {
+    /// Accumulator, X register and flags.
     pub registers: Registers,
+    /// The program counter.
     pub pc: u16,
+    /// The WAIT in progress, if any.
     pub wait: Option<Wait>,
 }
 
@@ -54,7 +63,9 @@ pub use tmclsim_profile::InterruptSource as Source;
 pub struct TraceRecord {
     /// Virtual time at which the instruction ran.
     pub time_ns: u64,
+    /// Address of the instruction.
     pub pc: u16,
+    /// The instruction as it was fetched.
     pub instruction: Instruction,
     /// Registers after the instruction.
     pub registers: Registers,
@@ -65,13 +76,28 @@ pub struct TraceRecord {
     pub axes: Vec<(i32, i32)>,
 }
 
+/// What download mode means for a frame from one link.
+pub(crate) enum Download {
+    /// No download is going on.
+    Off,
+    /// This link downloads: its words are stored.
+    Owner,
+    /// Another link downloads: this one talks to the module in direct mode.
+    Other,
+}
+
 /// The interpreter's state.
 #[derive(Clone, Debug)]
 pub struct Program {
+    /// Program memory, one instruction per address.
     pub memory: Vec<Instruction>,
+    /// What the interpreter is doing (GP 128).
     pub mode: RunMode,
+    /// Address of the next instruction.
     pub pc: u16,
+    /// Return addresses of CSUB (at most `STACK_DEPTH`).
     pub stack: Vec<u16>,
+    /// The WAIT in progress, if any.
     pub wait: Option<Wait>,
     /// In an interrupt handler: the interrupted context.
     pub handler: Option<Context>,
@@ -79,6 +105,8 @@ pub struct Program {
     pub pending: [u64; 4],
     /// Virtual time at which the next instruction runs.
     pub next_ns: u64,
+    /// Virtual time one instruction takes, in ns (`DEFAULT_INSTRUCTION_NS`
+    /// unless set).
     pub instruction_ns: u64,
     /// Download mode: the address the next stored word goes to.
     pub download: Option<u16>,
@@ -89,9 +117,11 @@ pub struct Program {
     pub download_owner: Option<LinkId>,
     /// Next firing time of timers 0…2.
     pub timers: [Option<u64>; 3],
+    /// Addresses at which execution pauses (the debugger's breakpoints).
     pub breakpoints: Vec<u16>,
     /// Set when execution stopped at a breakpoint.
     pub hit_breakpoint: Option<u16>,
+    /// Executed instructions recorded while tracing is on (`None`: off).
     pub trace: Option<Vec<TraceRecord>>,
     /// Instructions executed since power-up.
     pub executed: u64,
@@ -100,6 +130,7 @@ pub struct Program {
 }
 
 impl Program {
+    /// An empty program of `words` instructions, stopped, at address 0.
     pub fn new(words: usize) -> Program {
         Program {
             memory: vec![Instruction::default(); words],
@@ -123,6 +154,7 @@ impl Program {
         }
     }
 
+    /// True while the program runs (GP 128 = 1).
     pub fn is_running(&self) -> bool {
         matches!(self.mode, RunMode::Run)
     }
@@ -134,16 +166,60 @@ impl Program {
         if self.wait.is_some() { self.pc.wrapping_sub(1) } else { self.pc }
     }
 
+    /// Marks interrupt `n` pending.
     pub fn set_pending(&mut self, n: u8) {
         self.pending[n as usize / 64] |= 1 << (n % 64);
     }
 
+    /// Clears interrupt `n`'s pending mark.
     pub fn clear_pending(&mut self, n: u8) {
         self.pending[n as usize / 64] &= !(1 << (n % 64));
     }
 
+    /// True when interrupt `n` is pending.
     pub fn is_pending(&self, n: u8) -> bool {
         self.pending[n as usize / 64] & (1 << (n % 64)) != 0
+    }
+
+    /// Download mode as link `link` meets it; a download whose owner is
+    /// gone passes to the link that speaks next.
+    pub(crate) fn download_role(&mut self, link: LinkId) -> Download {
+        if self.download.is_none() {
+            return Download::Off;
+        }
+        match self.download_owner {
+            Some(owner) if owner != link => Download::Other,
+            _ => {
+                self.download_owner = Some(link);
+                Download::Owner
+            }
+        }
+    }
+
+    /// Link `link` is gone: a download it owned waits for the next link
+    /// that speaks (docs/behaviour.md rule 91).
+    pub fn release_download(&mut self, link: LinkId) {
+        if self.download_owner == Some(link) {
+            self.download_owner = None;
+        }
+    }
+
+    /// Sets the breakpoints: the addresses inside program memory, each
+    /// once, in order (so at most one per word, and the interpreter finds
+    /// one by a binary search).
+    pub fn set_breakpoints(&mut self, addresses: &[u16]) {
+        let words = self.memory.len();
+        let mut kept: Vec<u16> = addresses.iter().copied().filter(|&a| usize::from(a) < words).collect();
+        kept.sort_unstable();
+        kept.dedup();
+        self.breakpoints = kept;
+    }
+
+    /// Pauses a running program (step mode), as a debugger does.
+    pub fn pause(&mut self) {
+        if self.mode == RunMode::Run {
+            self.mode = RunMode::Step;
+        }
     }
 
     /// Lowest pending interrupt number for which `ready` holds.
@@ -248,7 +324,7 @@ impl Program {
     /// pointer (type 0) or the program counter (1).
     pub fn status_word(&self, kind: u8) -> i32 {
         let address = if kind == 0 { self.download_pointer } else { self.counter() };
-        ((self.mode as i32) << 24) | ((self.wait.is_some() as i32) << 16) | address as i32
+        ((self.mode as i32) << 24) | (i32::from(self.wait.is_some()) << 16) | i32::from(address)
     }
 
     /// Loads a program from address 0 (the rest of memory empties); the
@@ -268,7 +344,7 @@ impl Program {
     /// Empties program memory and resets the interpreter (lifting the code
     /// protection against reading, SGP 81).
     pub fn erase(&mut self) {
-        for w in self.memory.iter_mut() {
+        for w in &mut self.memory {
             *w = Instruction::default();
         }
         self.reset();

@@ -36,15 +36,20 @@ pub trait SearchAxis {
 /// Which input a seek watches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Switch {
+    /// The left stop switch.
     Left,
+    /// The right stop switch.
     Right,
+    /// The home switch.
     Home,
 }
 
 /// One seek: move in `dir` until `switch` reads `active`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Seek {
+    /// The switch the seek watches.
     pub switch: Switch,
+    /// The level that ends the seek (true: pressed).
     pub active: bool,
     /// +1 or −1.
     pub dir: f64,
@@ -75,12 +80,13 @@ pub struct ReferenceSearch {
     next: usize,
     marks: Vec<f64>,
     result: Result_,
-    pub invert_home: bool,
+    /// The home switch's level is inverted (RFS mode with 128 added).
+    invert_home: bool,
     /// Direction of the current seek (flipped by `reverse_on`).
     pub dir: f64,
     /// Once all seeks are done: the reference point (motor coordinates)
     /// the motor moves to, and the distance for AP 196.
-    pub finish: Option<(f64, Option<f64>)>,
+    finish: Option<(f64, Option<f64>)>,
 }
 
 fn seek(switch: Switch, active: bool, dir: f64, fast: bool) -> Seek {

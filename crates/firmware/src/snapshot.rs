@@ -19,7 +19,9 @@ pub struct AxisSnapshot {
     pub stopped_by_switch: bool,
     /// Logical switch states after GP 79: left, right, home.
     pub left: bool,
+    /// The right switch reads pressed.
     pub right: bool,
+    /// The home switch reads pressed.
     pub home: bool,
     /// The load torque the world puts on the axis here, % of rated.
     pub load: f64,
@@ -34,14 +36,19 @@ pub struct AxisSnapshot {
 /// The program interpreter.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ProgramSnapshot {
+    /// What the interpreter is doing (GP 128).
     pub state: RunMode,
+    /// The program counter as the module reports it (GP 130).
     pub pc: u16,
+    /// The accumulator.
     pub accumulator: i32,
+    /// The X register.
     pub x: i32,
     /// Result of the last comparison: -1 less, 0 equal, 1 greater.
     pub compare: i8,
     /// Error flags (timeout, alarm, deviation, position, shutdown bits).
     pub errors: u8,
+    /// Return addresses on the CSUB stack.
     pub stack_depth: usize,
     /// A WAIT is in progress.
     pub waiting: bool,
@@ -60,22 +67,29 @@ pub struct IoSnapshot {
     pub analog: Vec<u16>,
     /// Supply voltage, volts.
     pub supply: f64,
+    /// Driver temperature, °C.
     pub temperature: f64,
 }
 
 /// One module.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModuleSnapshot {
+    /// The module's name, as its profile gives it.
     pub name: String,
+    /// The module's serial address (GP 66).
     pub address: u8,
     /// Virtual time of the picture, ns.
     pub time_ns: u64,
+    /// The axes, axis 0 first.
     pub axes: Vec<AxisSnapshot>,
+    /// The program interpreter.
     pub program: ProgramSnapshot,
+    /// Inputs and outputs.
     pub io: IoSnapshot,
 }
 
 impl ModuleSnapshot {
+    /// The picture of `m` at its virtual now.
     pub fn of(m: &Module) -> ModuleSnapshot {
         let t_s = m.now_ns() as f64 * 1e-9;
         let axes = (0..m.profile().module.axes as usize)
@@ -122,7 +136,7 @@ impl ModuleSnapshot {
             inputs: w.digital_inputs,
             outputs: m.outputs(),
             analog: w.analog_inputs.clone(),
-            supply: w.supply_decivolts as f64 / 10.0,
+            supply: f64::from(w.supply_decivolts) / 10.0,
             temperature: w.temperature,
         };
         ModuleSnapshot { name: m.profile().module.name.clone(), address: m.address(), time_ns: m.now_ns(), axes, program, io }

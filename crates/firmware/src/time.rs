@@ -289,7 +289,7 @@ impl Module {
             return None;
         }
         let n = self.profile.timer_interrupt(t)?;
-        let period_ms = self.globals[3][n as usize] as u32 as u64;
+        let period_ms = u64::from(self.globals[3][n as usize] as u32);
         (period_ms != 0 && self.interrupts.enabled[n as usize]).then_some((n, period_ms * 1_000_000))
     }
 

@@ -6,6 +6,11 @@
 //! when the host overwrites the actual position or the module restarts
 //! (the carriage does not move when the counter is reset).
 
+/// Digital inputs a world holds (bit n of a 32-bit word).
+pub const WORLD_DIGITAL_INPUTS: usize = 32;
+/// Analog inputs a world holds.
+pub const WORLD_ANALOG_INPUTS: usize = 8;
+
 /// Switches along one axis.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AxisWorld {
@@ -21,7 +26,9 @@ pub struct AxisWorld {
     pub home_switch: Option<(f64, f64)>,
     /// Levels driven by hand; they override the positions above.
     pub forced_left: Option<bool>,
+    /// Level of the right switch driven by hand (`None`: by position).
     pub forced_right: Option<bool>,
+    /// Level of the home switch driven by hand (`None`: by position).
     pub forced_home: Option<bool>,
     /// Mechanical end stops: the carriage cannot leave this range (the
     /// motor loses steps against them).
@@ -46,16 +53,21 @@ pub struct AxisWorld {
 /// a time window.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Load {
+    /// The torque demand, in % of the motor's rated torque.
     pub torque: f64,
     /// Mechanical position range (inclusive).
     pub from: Option<f64>,
+    /// End of the position range (inclusive).
     pub to: Option<f64>,
     /// Virtual time window in seconds.
     pub after: Option<f64>,
+    /// End of the time window (exclusive).
     pub until: Option<f64>,
 }
 
 impl Load {
+    /// True when the load acts at mechanical position `mech` and time `t_s`
+    /// (s).
     pub fn applies(&self, mech: f64, t_s: f64) -> bool {
         self.from.is_none_or(|a| mech >= a)
             && self.to.is_none_or(|b| mech <= b)
@@ -67,21 +79,31 @@ impl Load {
 /// Motor driver faults (TMC262 flags of AP 208).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct DriverFaults {
+    /// Coil A shorted to ground.
     pub short_a: bool,
+    /// Coil B shorted to ground.
     pub short_b: bool,
+    /// Coil A open.
     pub open_a: bool,
+    /// Coil B open.
     pub open_b: bool,
 }
 
 impl AxisWorld {
+    /// True when the left switch reads pressed with the carriage at `mech` (a
+    /// forced level wins).
     pub fn left_pressed(&self, mech: f64) -> bool {
         self.forced_left.unwrap_or_else(|| self.left_switch.is_some_and(|p| mech <= p && self.left_width.is_none_or(|w| mech >= p - w)))
     }
 
+    /// True when the right switch reads pressed with the carriage at `mech` (a
+    /// forced level wins).
     pub fn right_pressed(&self, mech: f64) -> bool {
         self.forced_right.unwrap_or_else(|| self.right_switch.is_some_and(|p| mech >= p && self.right_width.is_none_or(|w| mech <= p + w)))
     }
 
+    /// True when the home switch reads pressed with the carriage at `mech` (a
+    /// forced level wins).
     pub fn home_pressed(&self, mech: f64) -> bool {
         self.forced_home.unwrap_or_else(|| self.home_switch.is_some_and(|(a, b)| mech >= a && mech <= b))
     }
@@ -124,6 +146,7 @@ impl AxisWorld {
 /// Everything outside the module that it senses.
 #[derive(Clone, Debug, PartialEq)]
 pub struct World {
+    /// The world of each axis, axis 0 first.
     pub axes: Vec<AxisWorld>,
     /// Digital input levels, bit n = input n.
     pub digital_inputs: u32,
@@ -170,6 +193,7 @@ impl World {
         w
     }
 
+    /// True when digital input `n` is high (inputs past 31 read low).
     pub fn digital(&self, n: u8) -> bool {
         n < 32 && self.digital_inputs & (1 << n) != 0
     }

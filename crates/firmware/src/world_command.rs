@@ -6,35 +6,33 @@
 
 use crate::module::Module;
 use crate::world::Load;
+use crate::world_error::WorldError;
 use crate::world_rules::{ANALOG, POSITION, SUPPLY, TEMPERATURE, check, check_input, check_load, check_span, check_stop, check_travel};
 use tmclsim_profile::Profile;
 
-pub const HELP: &str = "commands: [@ADDRESS] input N 0|1 | analog N VALUE | supply VOLTS | temperature CELSIUS | \
-switch AXIS left|right|home press|release|auto | place AXIS left|right POSITION [WIDTH] | place AXIS home FROM TO | \
-place AXIS carriage POSITION | reset | travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \
-link drop N | link corrupt N | link delay MS | link mute on|off | link clear | show [AXIS] | help";
-
-/// The commands of [`HELP`], one per item, without the `[@ADDRESS]`
-/// that any of them may start with (for a help page that lists them a
-/// line each).
-pub fn help_items() -> impl Iterator<Item = &'static str> {
-    HELP.trim_start_matches("commands: [@ADDRESS] ").split(" | ")
-}
+pub use crate::world_help::{HELP, help_items};
 
 /// One of the three switches of an axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SwitchKind {
+    /// The left stop switch.
     Left,
+    /// The right stop switch.
     Right,
+    /// The home switch.
     Home,
 }
 
 /// One of the driver's coil faults.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CoilFault {
+    /// Coil A shorted.
     ShortA,
+    /// Coil B shorted.
     ShortB,
+    /// Coil A open.
     OpenA,
+    /// Coil B open.
     OpenB,
 }
 
@@ -45,67 +43,98 @@ pub enum WorldCommand {
     Reset,
     /// Puts the carriage of an axis at a position (the motor does not move).
     PlaceCarriage {
+        /// The axis.
         axis: usize,
+        /// The carriage's mechanical position, in µsteps.
         position: f64,
     },
     /// Drives a digital input high or low.
     Input {
+        /// The input's number.
         number: u8,
+        /// True: high.
         high: bool,
     },
     /// Sets an ADC reading (0…4095).
     Analog {
+        /// The analog input's number.
         number: u8,
+        /// The ADC reading.
         value: u16,
     },
     /// Supply voltage in volts.
     Supply {
+        /// The voltage.
         volts: f64,
     },
+    /// Driver temperature.
     Temperature {
+        /// The temperature, in °C.
         celsius: f64,
     },
     /// Forces a switch pressed (`Some(true)`), released, or back to what
     /// the carriage position says (`None`).
     Switch {
+        /// The axis.
         axis: usize,
+        /// Which switch.
         which: SwitchKind,
+        /// Pressed, released, or `None`: by position.
         pressed: Option<bool>,
     },
     /// Places a stop switch at a position (with an optional width).
     PlaceStop {
+        /// The axis.
         axis: usize,
+        /// Left or right.
         which: SwitchKind,
+        /// The switch's position, in µsteps.
         position: f64,
+        /// How far the switch reaches beyond it (`None`: all the way).
         width: Option<f64>,
     },
     /// Places the home switch between two positions.
     PlaceHome {
+        /// The axis.
         axis: usize,
+        /// Lower end, in µsteps.
         from: f64,
+        /// Upper end, in µsteps.
         to: f64,
     },
     /// Mechanical end stops of the axis.
     Travel {
+        /// The axis.
         axis: usize,
+        /// Lower end stop, in µsteps.
         from: f64,
+        /// Upper end stop, in µsteps.
         to: f64,
     },
     /// A load torque (% of rated) everywhere or between two positions; 0
     /// removes the loads.
     Load {
+        /// The axis.
         axis: usize,
+        /// Torque demand in % of the rated torque.
         torque: f64,
+        /// Start of the position range, in µsteps.
         from: Option<f64>,
+        /// End of the position range, in µsteps.
         to: Option<f64>,
     },
+    /// Injects or clears a driver coil fault (AP 208 flags).
     Fault {
+        /// The axis.
         axis: usize,
+        /// Which fault.
         which: CoilFault,
+        /// True: the fault is present.
         on: bool,
     },
     /// Positions and switches of one axis or all.
     Show {
+        /// The axis (`None`: all axes).
         axis: Option<usize>,
     },
 }
@@ -114,49 +143,57 @@ pub enum WorldCommand {
 /// first one) and what to do.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Addressed {
+    /// The module's address (`None`: the first module on the bus).
     pub address: Option<u8>,
+    /// What to do.
     pub command: WorldCommand,
 }
 
-fn num<T: std::str::FromStr>(w: Option<&str>, what: &str) -> Result<T, String> {
-    let w = w.ok_or_else(|| format!("{what} is missing"))?;
-    w.parse().map_err(|_| format!("'{w}' is not a valid {what}"))
+fn num<T: std::str::FromStr>(w: Option<&str>, what: &'static str) -> Result<T, WorldError> {
+    let w = w.ok_or(WorldError::Missing { what })?;
+    w.parse().map_err(|_| WorldError::Invalid { word: w.to_string(), what })
 }
 
-fn optional(w: Option<&str>) -> Result<Option<f64>, String> {
-    w.map(|x| x.parse().map_err(|_| format!("'{x}' is not a number"))).transpose()
+fn optional(w: Option<&str>) -> Result<Option<f64>, WorldError> {
+    w.map(|x| x.parse().map_err(|_| WorldError::NotANumber { word: x.to_string() })).transpose()
 }
 
-pub fn on_off(w: Option<&str>) -> Result<bool, String> {
+/// `on`/`1` or `off`/`0`, as a world or link command takes it.
+pub fn on_off(w: Option<&str>) -> Result<bool, WorldError> {
     match w {
-        Some("on") | Some("1") => Ok(true),
-        Some("off") | Some("0") => Ok(false),
-        other => Err(format!("expected on or off, found {}", other.unwrap_or("nothing"))),
+        Some("on" | "1") => Ok(true),
+        Some("off" | "0") => Ok(false),
+        other => Err(expected("on or off", other)),
     }
 }
 
-fn switch_kind(w: Option<&str>) -> Result<SwitchKind, String> {
+/// A keyword was expected; `found` is the word there, if any.
+fn expected(expected: &'static str, found: Option<&str>) -> WorldError {
+    WorldError::Expected { expected, found: found.map(str::to_string) }
+}
+
+fn switch_kind(w: Option<&str>) -> Result<SwitchKind, WorldError> {
     match w {
         Some("left") => Ok(SwitchKind::Left),
         Some("right") => Ok(SwitchKind::Right),
         Some("home") => Ok(SwitchKind::Home),
-        other => Err(format!("expected left, right or home, found {}", other.unwrap_or("nothing"))),
+        other => Err(expected("left, right or home", other)),
     }
 }
 
 impl WorldCommand {
     /// Parses the words of a control line (without `@ADDRESS`; `link` and
     /// `help` belong to the link, not the world).
-    pub fn parse(words: &[&str]) -> Result<WorldCommand, String> {
+    pub fn parse(words: &[&str]) -> Result<WorldCommand, WorldError> {
         let mut w = words.iter().copied();
-        let cmd = w.next().ok_or("empty command")?;
+        let cmd = w.next().ok_or(WorldError::EmptyCommand)?;
         Ok(match cmd {
             "input" => {
                 let number = num(w.next(), "input number")?;
                 let high = match w.next() {
                     Some("1") => true,
                     Some("0") => false,
-                    other => return Err(format!("expected level 0 or 1, found {}", other.unwrap_or("nothing"))),
+                    other => return Err(expected("level 0 or 1", other)),
                 };
                 WorldCommand::Input { number, high }
             }
@@ -164,7 +201,7 @@ impl WorldCommand {
                 let number = num(w.next(), "input number")?;
                 let value: u16 = num(w.next(), "value")?;
                 if value > 4095 {
-                    return Err(format!("{value} is above 4095"));
+                    return Err(WorldError::AnalogAbove { value });
                 }
                 WorldCommand::Analog { number, value }
             }
@@ -177,7 +214,7 @@ impl WorldCommand {
                     Some("press") => Some(true),
                     Some("release") => Some(false),
                     Some("auto") => None,
-                    other => return Err(format!("expected press, release or auto, found {}", other.unwrap_or("nothing"))),
+                    other => return Err(expected("press, release or auto", other)),
                 };
                 WorldCommand::Switch { axis, which, pressed }
             }
@@ -192,7 +229,7 @@ impl WorldCommand {
                 let position = num(w.next(), "position")?;
                 let rest = optional(w.next())?;
                 match which {
-                    SwitchKind::Home => WorldCommand::PlaceHome { axis, from: position, to: rest.ok_or("place home takes FROM and TO")? },
+                    SwitchKind::Home => WorldCommand::PlaceHome { axis, from: position, to: rest.ok_or(WorldError::HomeNeedsTo)? },
                     _ => WorldCommand::PlaceStop { axis, which, position, width: rest },
                 }
             }
@@ -211,12 +248,12 @@ impl WorldCommand {
                     Some("short-b") => CoilFault::ShortB,
                     Some("open-a") => CoilFault::OpenA,
                     Some("open-b") => CoilFault::OpenB,
-                    other => return Err(format!("expected short-a, short-b, open-a or open-b, found {}", other.unwrap_or("nothing"))),
+                    other => return Err(expected("short-a, short-b, open-a or open-b", other)),
                 };
                 WorldCommand::Fault { axis, which, on: on_off(w.next())? }
             }
             "show" => WorldCommand::Show { axis: w.next().map(|a| num(Some(a), "axis")).transpose()? },
-            other => return Err(format!("unknown command '{other}' ({HELP})")),
+            other => return Err(WorldError::UnknownCommand { word: other.to_string() }),
         })
     }
 
@@ -239,7 +276,7 @@ impl WorldCommand {
     /// ([`WorldCommand::validate`], docs/behaviour.md rule 84): a refused
     /// command changes nothing. `Ok` carries what to print after `ok`
     /// (only `show` prints something).
-    pub fn apply(&self, m: &mut Module) -> Result<String, String> {
+    pub fn apply(&self, m: &mut Module) -> Result<String, WorldError> {
         self.validate(m.profile())?;
         let axes = m.profile().module.axes as usize;
         match *self {
@@ -304,9 +341,9 @@ impl WorldCommand {
                         m.actual_position(a),
                         m.mechanical_position(a),
                         m.actual_speed(a),
-                        l as u8,
-                        r as u8,
-                        h as u8
+                        u8::from(l),
+                        u8::from(r),
+                        u8::from(h)
                     ));
                 }
                 return Ok(out);
@@ -319,19 +356,19 @@ impl WorldCommand {
 impl WorldCommand {
     /// Checks the command's values against the rule set and the module's
     /// profile (its axes and inputs); `apply` does this first.
-    pub fn validate(&self, profile: &Profile) -> Result<(), String> {
+    pub fn validate(&self, profile: &Profile) -> Result<(), WorldError> {
         let axes = profile.module.axes as usize;
         if let Some(a) = self.axis()
             && a >= axes
         {
-            return Err(format!("axis {a} does not exist (the module has {axes})"));
+            return Err(WorldError::NoAxis { axis: a, axes });
         }
-        let on_axis = |axis: usize, r: Result<(), String>| r.map_err(|e| format!("axis {axis}: {e}"));
+        let on_axis = |axis: usize, r: Result<(), WorldError>| r.map_err(|e| e.on_axis(axis));
         match *self {
             WorldCommand::Input { number, .. } => check_input(profile, 0, number),
             WorldCommand::Analog { number, value } => {
                 check_input(profile, 1, number)?;
-                check("analog value", value as f64, ANALOG).map(drop)
+                check("analog value", f64::from(value), ANALOG).map(drop)
             }
             WorldCommand::Supply { volts } => check("supply", volts, SUPPLY).map(drop),
             WorldCommand::Temperature { celsius } => check("temperature", celsius, TEMPERATURE).map(drop),
@@ -350,10 +387,10 @@ impl WorldCommand {
 
 impl Addressed {
     /// Parses `[@ADDRESS] COMMAND …`.
-    pub fn parse(line: &str) -> Result<Addressed, String> {
+    pub fn parse(line: &str) -> Result<Addressed, WorldError> {
         let words: Vec<&str> = line.split_whitespace().collect();
         let (address, rest) = match words.first().and_then(|w| w.strip_prefix('@')) {
-            Some(a) => (Some(a.parse().map_err(|_| format!("'@{a}' is not a module address (0…255)"))?), &words[1..]),
+            Some(a) => (Some(a.parse().map_err(|_| WorldError::BadAddress { word: a.to_string() })?), &words[1..]),
             None => (None, &words[..]),
         };
         Ok(Addressed { address, command: WorldCommand::parse(rest)? })
@@ -383,11 +420,14 @@ mod tests {
 
     #[test]
     fn bad_lines_say_what_is_wrong() {
-        assert_eq!(WorldCommand::parse(&["analog", "0", "5000"]).unwrap_err(), "5000 is above 4095");
-        assert_eq!(WorldCommand::parse(&["switch", "0", "middle", "press"]).unwrap_err(), "expected left, right or home, found middle");
-        assert_eq!(WorldCommand::parse(&["place", "0", "home", "5"]).unwrap_err(), "place home takes FROM and TO");
-        assert_eq!(Addressed::parse("@x input 0 1").unwrap_err(), "'@x' is not a module address (0…255)");
-        assert!(WorldCommand::parse(&["fly"]).unwrap_err().starts_with("unknown command 'fly'"));
+        assert_eq!(WorldCommand::parse(&["analog", "0", "5000"]).unwrap_err().to_string(), "5000 is above 4095");
+        assert_eq!(
+            WorldCommand::parse(&["switch", "0", "middle", "press"]).unwrap_err().to_string(),
+            "expected left, right or home, found middle"
+        );
+        assert_eq!(WorldCommand::parse(&["place", "0", "home", "5"]).unwrap_err().to_string(), "place home takes FROM and TO");
+        assert_eq!(Addressed::parse("@x input 0 1").unwrap_err().to_string(), "'@x' is not a module address (0…255)");
+        assert!(WorldCommand::parse(&["fly"]).unwrap_err().to_string().starts_with("unknown command 'fly'"));
     }
 
     #[test]
@@ -398,7 +438,7 @@ mod tests {
         WorldCommand::Supply { volts: 12.3 }.apply(&mut m).unwrap();
         assert_eq!(m.world().supply_decivolts, 123);
         assert_eq!(
-            WorldCommand::Travel { axis: 1, from: 0.0, to: 1.0 }.apply(&mut m).unwrap_err(),
+            WorldCommand::Travel { axis: 1, from: 0.0, to: 1.0 }.apply(&mut m).unwrap_err().to_string(),
             "axis 1 does not exist (the module has 1)"
         );
         WorldCommand::Switch { axis: 0, which: SwitchKind::Left, pressed: Some(true) }.apply(&mut m).unwrap();

@@ -1,6 +1,7 @@
 //! The world description file (TOML), see `docs/world.md`.
 
 use crate::world::{AxisWorld, Load, World};
+use crate::world_error::WorldError;
 use crate::world_rules::{ANALOG, WORLD_ANALOG_INPUTS, WORLD_DIGITAL_INPUTS, check};
 use serde::Deserialize;
 
@@ -84,15 +85,15 @@ impl World {
     }
 
     /// Reads a world description for a module with `axes` axes.
-    pub fn from_toml(text: &str, axes: usize) -> Result<World, String> {
-        let f: WorldFile = toml::from_str(text).map_err(|e| e.to_string())?;
+    pub fn from_toml(text: &str, axes: usize) -> Result<World, WorldError> {
+        let f: WorldFile = toml::from_str(text)?;
         let mut w = match f.base.as_deref() {
             None | Some("stage") => World::stage(axes),
             Some("free") => World::free(axes),
-            Some(other) => return Err(format!("base = \"{other}\": use \"stage\" or \"free\"")),
+            Some(other) => return Err(WorldError::UnknownBase { base: other.to_string() }),
         };
         if f.axis.len() > axes {
-            return Err(format!("the world describes {} axes, the module has {axes}", f.axis.len()));
+            return Err(WorldError::TooManyAxes { described: f.axis.len(), axes });
         }
         if let Some(v) = f.supply {
             crate::world_rules::check("supply", v, crate::world_rules::SUPPLY)?;
@@ -102,19 +103,19 @@ impl World {
             w.temperature = t;
         }
         if f.inputs.len() > WORLD_DIGITAL_INPUTS {
-            return Err(format!("inputs lists {} levels: the world has {WORLD_DIGITAL_INPUTS} digital inputs", f.inputs.len()));
+            return Err(WorldError::TooManyLevels { count: f.inputs.len() });
         }
         for (n, level) in f.inputs.iter().enumerate() {
             if *level > 1 {
-                return Err(format!("inputs[{n}] = {level}: a level is 0 or 1"));
+                return Err(WorldError::Level { index: n, level: *level });
             }
             w.set_digital(n as u8, *level != 0);
         }
         if f.analog.len() > WORLD_ANALOG_INPUTS {
-            return Err(format!("analog lists {} values: the world has {WORLD_ANALOG_INPUTS} analog inputs", f.analog.len()));
+            return Err(WorldError::TooManyAnalogValues { count: f.analog.len() });
         }
         for (n, v) in f.analog.iter().enumerate() {
-            check(&format!("analog[{n}]"), *v as f64, ANALOG)?;
+            check(&format!("analog[{n}]"), f64::from(*v), ANALOG)?;
             w.set_analog(n as u8, *v);
         }
         for (a, af) in f.axis.into_iter().enumerate() {
@@ -196,9 +197,9 @@ mod tests {
 
     #[test]
     fn errors_say_what_is_wrong() {
-        assert!(World::from_toml("[[axis]]\ntravel = [5, 1]\n", 1).unwrap_err().contains("empty"));
-        assert!(World::from_toml("[[axis]]\n[[axis]]\n", 1).unwrap_err().contains("1"));
+        assert!(World::from_toml("[[axis]]\ntravel = [5, 1]\n", 1).unwrap_err().to_string().contains("empty"));
+        assert!(World::from_toml("[[axis]]\n[[axis]]\n", 1).unwrap_err().to_string().contains("1"));
         assert!(World::from_toml("bogus = 1\n", 1).is_err());
-        assert!(World::from_toml("analog = [5000]\n", 1).unwrap_err().contains("4095"));
+        assert!(World::from_toml("analog = [5000]\n", 1).unwrap_err().to_string().contains("4095"));
     }
 }

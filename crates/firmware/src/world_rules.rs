@@ -7,25 +7,10 @@
 //! with the same words wherever it comes from.
 
 use crate::world::{AxisWorld, Load, World};
+pub use crate::world::{WORLD_ANALOG_INPUTS, WORLD_DIGITAL_INPUTS};
+use crate::world_error::WorldError;
+pub use crate::world_error::{Allowed, number};
 use tmclsim_profile::{PortDirection, Profile};
-
-/// An allowed range of a world value, with its unit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Allowed {
-    pub min: f64,
-    pub max: f64,
-    pub unit: &'static str,
-}
-
-impl std::fmt::Display for Allowed {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}…{}", number(self.min), number(self.max))?;
-        if !self.unit.is_empty() {
-            write!(f, " {}", self.unit)?;
-        }
-        Ok(())
-    }
-}
 
 /// Supply voltage.
 pub const SUPPLY: Allowed = Allowed { min: 0.0, max: 100.0, unit: "V" };
@@ -46,49 +31,39 @@ pub const ENCODER_COUNTS: Allowed = Allowed { min: 0.0, max: 1e6, unit: "counts"
 /// Motor full steps per revolution.
 pub const FULLSTEPS: Allowed = Allowed { min: 1.0, max: 10_000.0, unit: "steps" };
 
-/// Digital inputs a world holds (bit n of a 32-bit word).
-pub const WORLD_DIGITAL_INPUTS: usize = 32;
-/// Analog inputs a world holds.
-pub const WORLD_ANALOG_INPUTS: usize = 8;
-
-/// A value as a message shows it: `12.5`, `NaN`, `inf`, `1e300`.
-pub fn number(value: f64) -> String {
-    if value.is_finite() && value.abs() >= 1e9 { format!("{value:e}") } else { format!("{value}") }
-}
-
 /// `value` is a finite number in `allowed`; the error names `what`.
-pub fn check(what: &str, value: f64, allowed: Allowed) -> Result<f64, String> {
+pub fn check(what: &str, value: f64, allowed: Allowed) -> Result<f64, WorldError> {
     if !value.is_finite() {
-        return Err(format!("{what} {value} is not a finite number (allowed: {allowed})"));
+        return Err(WorldError::NotFinite { what: what.to_string(), value, allowed });
     }
     if value < allowed.min || value > allowed.max {
-        return Err(format!("{what} {} is outside {allowed}", number(value)));
+        return Err(WorldError::Outside { what: what.to_string(), value, allowed });
     }
     Ok(value)
 }
 
 /// End stops: two positions, `from` below `to`.
-pub fn check_travel(from: f64, to: f64) -> Result<(), String> {
+pub fn check_travel(from: f64, to: f64) -> Result<(), WorldError> {
     check("travel FROM", from, POSITION)?;
     check("travel TO", to, POSITION)?;
     if from >= to {
-        return Err(format!("travel from {} to {} is empty (FROM must be below TO)", number(from), number(to)));
+        return Err(WorldError::EmptyTravel { from, to });
     }
     Ok(())
 }
 
 /// A closed range of positions (`what` from `from` to `to`).
-pub fn check_span(what: &str, from: f64, to: f64) -> Result<(), String> {
+pub fn check_span(what: &str, from: f64, to: f64) -> Result<(), WorldError> {
     check(&format!("{what} FROM"), from, POSITION)?;
     check(&format!("{what} TO"), to, POSITION)?;
     if from > to {
-        return Err(format!("{what} from {} to {} is empty (FROM must not be above TO)", number(from), number(to)));
+        return Err(WorldError::EmptySpan { what: what.to_string(), from, to });
     }
     Ok(())
 }
 
 /// A stop switch at `position`, pressed for `width` beyond it.
-pub fn check_stop(which: &str, position: f64, width: Option<f64>) -> Result<(), String> {
+pub fn check_stop(which: &str, position: f64, width: Option<f64>) -> Result<(), WorldError> {
     check(&format!("{which} switch position"), position, POSITION)?;
     if let Some(w) = width {
         check(&format!("{which} switch width"), w, WIDTH)?;
@@ -97,7 +72,7 @@ pub fn check_stop(which: &str, position: f64, width: Option<f64>) -> Result<(), 
 }
 
 /// A load: its torque, its position range and its time window.
-pub fn check_load(load: &Load) -> Result<(), String> {
+pub fn check_load(load: &Load) -> Result<(), WorldError> {
     check("load torque", load.torque, TORQUE)?;
     match (load.from, load.to) {
         (Some(a), Some(b)) => check_span("load range", a, b)?,
@@ -112,7 +87,7 @@ pub fn check_load(load: &Load) -> Result<(), String> {
     if let (Some(a), Some(u)) = (load.after, load.until)
         && a >= u
     {
-        return Err(format!("load window after {a} s until {u} s is empty (AFTER must be below UNTIL)"));
+        return Err(WorldError::EmptyWindow { after: a, until: u });
     }
     Ok(())
 }
@@ -130,28 +105,18 @@ fn inputs(profile: &Profile, bank: u8) -> Vec<u8> {
     n
 }
 
-/// `0…3`, or `0, 2, 5` when there are gaps, or `none`.
-fn list(numbers: &[u8]) -> String {
-    match (numbers.first(), numbers.last()) {
-        (Some(a), Some(b)) if numbers.len() > 1 && (*b - *a) as usize + 1 == numbers.len() => format!("{a}…{b}"),
-        (Some(_), _) => numbers.iter().map(u8::to_string).collect::<Vec<_>>().join(", "),
-        _ => "none".into(),
-    }
-}
-
 /// Input `number` of `bank` (0: digital, 1: analog) exists on the module.
-pub fn check_input(profile: &Profile, bank: u8, number: u8) -> Result<(), String> {
+pub fn check_input(profile: &Profile, bank: u8, number: u8) -> Result<(), WorldError> {
     let have = inputs(profile, bank);
     if have.contains(&number) {
         return Ok(());
     }
-    let kind = if bank == 0 { "digital" } else { "analog" };
-    Err(format!("{kind} input {number} does not exist on the {} ({kind} inputs: {})", profile.module.name, list(&have)))
+    Err(WorldError::NoInput { bank, number, module: profile.module.name.clone(), have })
 }
 
 impl AxisWorld {
     /// Checks the axis's values against the rule set.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), WorldError> {
         if let Some(p) = self.left_switch {
             check_stop("left", p, self.left_width)?;
         }
@@ -178,17 +143,17 @@ impl AxisWorld {
 
 impl World {
     /// Checks every value of the world against the rule set.
-    pub fn validate(&self) -> Result<(), String> {
-        check("supply", self.supply_decivolts as f64 / 10.0, SUPPLY)?;
+    pub fn validate(&self) -> Result<(), WorldError> {
+        check("supply", f64::from(self.supply_decivolts) / 10.0, SUPPLY)?;
         check("temperature", self.temperature, TEMPERATURE)?;
         if self.analog_inputs.len() > WORLD_ANALOG_INPUTS {
-            return Err(format!("{} analog inputs: the world has {WORLD_ANALOG_INPUTS}", self.analog_inputs.len()));
+            return Err(WorldError::TooManyAnalogInputs { count: self.analog_inputs.len() });
         }
         for (n, v) in self.analog_inputs.iter().enumerate() {
-            check(&format!("analog[{n}]"), *v as f64, ANALOG)?;
+            check(&format!("analog[{n}]"), f64::from(*v), ANALOG)?;
         }
         for (a, axis) in self.axes.iter().enumerate() {
-            axis.validate().map_err(|e| format!("axis {a}: {e}"))?;
+            axis.validate().map_err(|e| e.on_axis(a))?;
         }
         Ok(())
     }

@@ -234,7 +234,7 @@ impl SharedBus {
     /// Applies a world command to the module at `address` (`None`: the
     /// first one).
     pub fn apply_world(&self, address: Option<u8>, command: &WorldCommand) -> Result<String, String> {
-        self.with_bus(|bus| bus.apply_world(address, command))
+        self.with_bus(|bus| bus.apply_world(address, command)).map_err(String::from)
     }
 
     /// Takes the modules out (the bus is left empty), e.g. to put them on

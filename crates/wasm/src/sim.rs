@@ -326,8 +326,8 @@ impl Sim {
             None | Some("help") => Ok(HELP.to_string()),
             Some("link") => Err("link faults belong to a served link; this module has none".into()),
             Some(_) => {
-                let Addressed { address, command } = Addressed::parse(line)?;
-                let answer = self.bus.apply_world(address, &command)?;
+                let Addressed { address, command } = Addressed::parse(line).map_err(String::from)?;
+                let answer = self.bus.apply_world(address, &command).map_err(String::from)?;
                 self.collect_events();
                 Ok(answer)
             }

@@ -8,16 +8,17 @@ use tmclsim_protocol::{FRAME_LEN, Reply, Status, opcode};
 impl Module {
     /// Unsolicited frames (138 events) produced since the last call.
     pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
-        std::mem::take(&mut self.interrupts.events)
+        self.interrupts.take_events()
     }
 
+    /// True when 138 event frames are waiting to be taken (`take_events`).
     pub fn has_events(&self) -> bool {
-        !self.interrupts.events.is_empty()
+        self.interrupts.has_events()
     }
 
     pub(crate) fn push_event(&mut self, mask: u32) {
         let reply = Reply::new(self.host_address(), self.link.last_address, Status::Event, opcode::TARGET_REACHED_EVENT, mask as i32);
-        self.interrupts.events.push(reply.encode());
+        self.interrupts.push_event(reply.encode());
     }
 }
 
@@ -49,13 +50,13 @@ mod tests {
     fn arming_138_checks_the_mask() {
         let mut m = module("tmcm-1141");
         assert_eq!(direct(&mut m, "#138 0 0 1"), (Status::Ok, 1));
-        assert_eq!(m.interrupts.event_arm, Some((false, 1)));
+        assert_eq!(m.interrupts.event_arm(), Some((false, 1)));
         assert_eq!(direct(&mut m, "#138 1 0 1"), (Status::Ok, 1));
-        assert_eq!(m.interrupts.event_arm, Some((true, 1)));
+        assert_eq!(m.interrupts.event_arm(), Some((true, 1)));
         assert_eq!(status(&mut m, "#138 0 0 2"), Status::InvalidValue, "one motor");
         assert_eq!(status(&mut m, "#138 0 0 0"), Status::InvalidValue);
         assert_eq!(status(&mut m, "#138 0 0 -1"), Status::InvalidValue);
-        assert_eq!(m.interrupts.event_arm, Some((true, 1)), "a refused arming changes nothing");
+        assert_eq!(m.interrupts.event_arm(), Some((true, 1)), "a refused arming changes nothing");
         let mut m = module("tmcm-351");
         assert_eq!(status(&mut m, "#138 0 0 1"), Status::InvalidCommand, "the TMCM-351 lacks 138");
     }
@@ -66,7 +67,7 @@ mod tests {
         ok(&mut m, "SAP 4, 0, 2047");
         ok(&mut m, "#138 0 0 1");
         ok(&mut m, "MVP ABS, 0, 2000");
-        assert!(m.interrupts.event_arm.is_none(), "used up by the move");
+        assert!(m.interrupts.event_arm().is_none(), "used up by the move");
         m.advance(1_000 * MS);
         let events = m.take_events();
         assert_eq!(events.len(), 1);

@@ -10,6 +10,8 @@ impl Module {
         self.io.outputs()
     }
 
+    /// True when the inputs' pull-up resistors are on (they are at
+    /// power-up).
     pub fn pullups(&self) -> bool {
         self.io.pullups()
     }

@@ -44,7 +44,7 @@ impl Module {
                 }
                 Ok(())
             })?,
-            RfsAction::Status => return Ok(Some(self.reference_search_active(m) as i32)),
+            RfsAction::Status => return Ok(Some(i32::from(self.reference_search_active(m)))),
         }
         Ok(None)
     }
@@ -69,7 +69,7 @@ impl Module {
         let m = self.motor(motor)?;
         let target = match mode {
             MoveMode::Absolute => value,
-            MoveMode::Relative => self.wrap_position(self.actual_position(m) as i64 + value as i64),
+            MoveMode::Relative => self.wrap_position(i64::from(self.actual_position(m)) + i64::from(value)),
             MoveMode::Coordinate => {
                 let n = usize::try_from(value).map_err(|_| Status::InvalidValue)?;
                 *self.axes[m].coordinates.get(n).ok_or(Status::InvalidValue)?
@@ -160,11 +160,11 @@ impl Module {
     /// round in the module's position counter width.
     pub(crate) fn set_target(&mut self, m: usize, target: i32) {
         let actual = self.actual_position(m);
-        let diff = self.wrap_position(target as i64 - actual as i64);
+        let diff = self.wrap_position(i64::from(target) - i64::from(actual));
         let axis = &mut self.axes[m];
         axis.target_word = target;
         axis.params[ap::TARGET_POSITION as usize] = target;
-        axis.motion.target = axis.motion.position() as f64 + diff as f64;
+        axis.motion.target = axis.motion.position() as f64 + f64::from(diff);
     }
 
     /// A reference search is running on this axis.

@@ -42,6 +42,8 @@ impl Module {
         Ok(())
     }
 
+    /// SAP: writes axis parameter `param` of `motor` after the profile's access
+    /// and range checks; the status says why a write was refused.
     pub fn set_axis_parameter(&mut self, param: u8, motor: u8, value: i32) -> Result<(), Status> {
         let m = self.motor(motor)?;
         takes(axis_spec(&self.profile, param, |a| a.write)?, value)?;
@@ -49,6 +51,8 @@ impl Module {
         Ok(())
     }
 
+    /// GAP: reads axis parameter `param` of `motor` (measured values are
+    /// computed at the module's now); the status says why a read was refused.
     pub fn get_axis_parameter(&mut self, param: u8, motor: u8) -> Result<i32, Status> {
         let m = self.motor(motor)?;
         axis_spec(&self.profile, param, |a| a.read)?;
@@ -73,7 +77,7 @@ impl Module {
                 let axis = &mut self.axes[m];
                 // The carriage does not move: only the counter changes.
                 let mech = axis.motion.x * sign + axis.mech_offset;
-                axis.motion.x = value as f64;
+                axis.motion.x = f64::from(value);
                 axis.mech_offset = mech - axis.motion.x * sign;
                 self.set_target(m, target);
                 self.closed_loop_sync(m);
@@ -85,13 +89,13 @@ impl Module {
                 axis.params[param as usize] = value;
             }
             ap::ENCODER_POSITION if self.has_closed_loop() => {
-                let now = self.closed_loop_encoder(m) as f64 - self.axes[m].closed_loop.encoder_offset;
-                self.axes[m].closed_loop.encoder_offset = value as f64 - now;
+                let now = f64::from(self.closed_loop_encoder(m)) - self.axes[m].closed_loop.encoder_offset;
+                self.axes[m].closed_loop.encoder_offset = f64::from(value) - now;
             }
             // Without an encoder input AP 209 is a plain value (profiles/README.md).
             ap::ENCODER_POSITION if self.profile.features.encoder != tmclsim_profile::Encoder::None => {
-                let now = self.encoder_position(m) as i64 - self.axes[m].encoder_offset;
-                self.axes[m].encoder_offset = value as i64 - now;
+                let now = i64::from(self.encoder_position(m)) - self.axes[m].encoder_offset;
+                self.axes[m].encoder_offset = i64::from(value) - now;
             }
             cl::TORQUE_TARGET if self.has_closed_loop() => {
                 // Torque mode: the driver sets this current (mA).
@@ -132,10 +136,10 @@ impl Module {
             ap::ACTUAL_POSITION => self.actual_position(m),
             ap::ACTUAL_SPEED => self.actual_speed(m),
             ap::ACTUAL_ACCELERATION => motion::accel_internal(motion.a, rd, pd).round().clamp(-2047.0, 2047.0) as i32,
-            ap::POSITION_REACHED => (self.actual_position(m) == self.axes[m].target_word) as i32,
-            ap::LEFT_SWITCH => self.switches(m).0 as i32,
-            ap::RIGHT_SWITCH => self.switches(m).1 as i32,
-            ap::HOME_SWITCH => self.switches(m).2 as i32,
+            ap::POSITION_REACHED => i32::from(self.actual_position(m) == self.axes[m].target_word),
+            ap::LEFT_SWITCH => i32::from(self.switches(m).0),
+            ap::RIGHT_SWITCH => i32::from(self.switches(m).1),
+            ap::HOME_SWITCH => i32::from(self.switches(m).2),
             ap::ACTUAL_CURRENT => self.current_scale(m).round() as i32,
             ap::LOAD_VALUE => self.axes[m].driver.load_value,
             ap::ENCODER_POSITION if self.profile.features.encoder != tmclsim_profile::Encoder::None => self.encoder_position(m),
@@ -144,6 +148,9 @@ impl Module {
         }
     }
 
+    /// SGP: writes global parameter `param` of `bank` after the profile's
+    /// access and range checks, with the parameter's side effects (address,
+    /// ASCII mode, download mode…).
     pub fn set_global_parameter(&mut self, param: u8, bank: u8, value: i32) -> Result<(), Status> {
         let spec = global_spec(&self.profile, param, bank, |a| a.write)?;
         takes(spec, value)?;
@@ -155,7 +162,7 @@ impl Module {
             self.persistence.check_unlocked(&self.globals)?;
         }
         match (bank, param) {
-            (0, gp::TICK_TIMER) => self.globals.set_tick_timer(self.now_ns, value as i64),
+            (0, gp::TICK_TIMER) => self.globals.set_tick_timer(self.now_ns, i64::from(value)),
             (0, gp::RANDOM) => self.globals.seed_random(value),
             (0, gp::CODE_PROTECTION) => {
                 let old = self.globals[0][param as usize];
@@ -183,6 +190,8 @@ impl Module {
         Ok(())
     }
 
+    /// GGP: reads global parameter `param` of `bank` (GP 133 draws a new random
+    /// number).
     pub fn get_global_parameter(&mut self, param: u8, bank: u8) -> Result<i32, Status> {
         let v = self.peek_global_parameter(param, bank)?;
         if (bank, param) == (0, gp::RANDOM) {
@@ -199,8 +208,8 @@ impl Module {
         Ok(match (bank, param) {
             (0, gp::TICK_TIMER) => self.globals.tick_timer(self.now_ns),
             (0, gp::APPLICATION_STATUS) => self.program.mode as i32,
-            (0, gp::DOWNLOAD_MODE) => self.program.download.is_some() as i32,
-            (0, gp::PROGRAM_COUNTER) => self.program.counter() as i32,
+            (0, gp::DOWNLOAD_MODE) => i32::from(self.program.download.is_some()),
+            (0, gp::PROGRAM_COUNTER) => i32::from(self.program.counter()),
             (0, gp::RANDOM) => self.globals.peek_random(),
             _ => self.globals[bank as usize][param as usize],
         })

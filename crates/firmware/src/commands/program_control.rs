@@ -78,9 +78,7 @@ impl Module {
 
     /// Pauses the program (step mode), as a debugger does.
     pub fn pause_program(&mut self) {
-        if self.program.mode == RunMode::Run {
-            self.program.mode = RunMode::Step;
-        }
+        self.program.pause();
     }
 }
 

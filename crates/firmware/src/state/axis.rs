@@ -13,6 +13,7 @@ pub struct Axis {
     /// RAM values of the axis parameters (stored ones; measured ones are
     /// computed on read).
     pub params: [i32; 256],
+    /// The ramp generator: position, velocity and ramp of the motor.
     pub motion: Motion,
     /// AP 0 as the host wrote it.
     pub target_word: i32,
@@ -26,11 +27,14 @@ pub struct Axis {
     pub notify_on_arrival: bool,
     /// The reference search in progress.
     pub rfs: Option<ReferenceSearch>,
+    /// The motor driver's state (currents, stallGuard, faults).
     pub driver: Driver,
     /// An interpolated move's ramp (MVP COORD with bit 6), until it ends.
     pub ramp_override: Option<Ramp>,
     /// AP 209 minus what the encoder measures (set by SAP 209).
     pub encoder_offset: i64,
+    /// The closed-loop controller's state (modules with an encoder and
+    /// closed-loop mode).
     pub closed_loop: ClosedLoop,
     /// The plain ramp last worked out and the parameter words it came
     /// from (`Module::ramp`).

@@ -108,7 +108,7 @@ mod tests {
         g.set_tick_timer(10_000_000, 100);
         assert_eq!(g.tick_timer(10_000_000), 100);
         assert_eq!(g.tick_timer(15_999_999), 105);
-        g.set_tick_timer(0, i32::MAX as i64);
+        g.set_tick_timer(0, i64::from(i32::MAX));
         assert_eq!(g.tick_timer(1_000_000), 0, "31 bits wrap");
     }
 

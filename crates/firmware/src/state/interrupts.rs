@@ -13,9 +13,9 @@ pub struct Interrupts {
     pub global: bool,
     /// 138: arm for the next MVP (`Some(false)`) or every MVP (`Some(true)`),
     /// with the motor mask.
-    pub event_arm: Option<(bool, u32)>,
+    event_arm: Option<(bool, u32)>,
     /// Event frames not yet taken.
-    pub events: Vec<[u8; FRAME_LEN]>,
+    events: Vec<[u8; FRAME_LEN]>,
 }
 
 impl Default for Interrupts {
@@ -32,6 +32,28 @@ impl Interrupts {
         self.global = false;
         self.event_arm = None;
         self.events.clear();
+    }
+
+    /// The 138 arming: `Some((every_move, mask))`, or `None` when no
+    /// event is armed.
+    #[cfg(test)]
+    pub fn event_arm(&self) -> Option<(bool, u32)> {
+        self.event_arm
+    }
+
+    /// Queues an event frame (138) for the front end to send.
+    pub fn push_event(&mut self, frame: [u8; FRAME_LEN]) {
+        self.events.push(frame);
+    }
+
+    /// The event frames queued since the last call, oldest first.
+    pub fn take_events(&mut self) -> Vec<[u8; FRAME_LEN]> {
+        std::mem::take(&mut self.events)
+    }
+
+    /// True when event frames are queued.
+    pub fn has_events(&self) -> bool {
+        !self.events.is_empty()
     }
 
     /// EI, DI: interrupt 255 is the global enable; the others must be in
@@ -51,7 +73,7 @@ impl Interrupts {
         if interrupt == 255 || profile.interrupt(interrupt).is_none() {
             return Err(Status::WrongType);
         }
-        if address < 0 || address >= profile.module.program_memory as i32 {
+        if address < 0 || address >= i32::from(profile.module.program_memory) {
             return Err(Status::InvalidValue);
         }
         self.vectors[interrupt as usize] = Some(address as u16);

@@ -89,17 +89,17 @@ impl Io {
             return Ok(if first.direction == PortDirection::Output {
                 (self.outputs & output_mask(profile, bank)) as i32
             } else {
-                in_bank.filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | (world.digital(p.number) as i32) << p.number)
+                in_bank.filter(|p| p.max == 1 && p.number < 8).fold(0, |m, p| m | i32::from(world.digital(p.number)) << p.number)
             });
         }
         let p = in_bank.find(|p| p.number == port).ok_or(Status::WrongType)?;
         Ok(match p.direction {
             PortDirection::Output => (self.outputs >> port & 1) as i32,
-            _ if p.max == 1 => world.digital(port) as i32,
+            _ if p.max == 1 => i32::from(world.digital(port)),
             // The supply voltage channel is the one with a 0.1 V unit.
-            _ if p.role == Some(PortRole::Supply) => world.supply_decivolts as i32,
+            _ if p.role == Some(PortRole::Supply) => i32::from(world.supply_decivolts),
             _ => {
-                let v = world.analog_inputs.get(port as usize).copied().unwrap_or(0) as i64;
+                let v = i64::from(world.analog_inputs.get(port as usize).copied().unwrap_or(0));
                 // The world's ADC values are 12 bit (0…4095). A plain analog
                 // input (no unit) with a coarser ADC reads them at its own
                 // resolution: range 0…1023 reads a quarter.

@@ -63,14 +63,17 @@ pub struct LineState {
 }
 
 impl AsciiLine {
+    /// The characters received so far.
     pub fn bytes(&self) -> &[u8] {
         &self.buf
     }
 
+    /// How many characters the line holds.
     pub fn len(&self) -> usize {
         self.buf.len()
     }
 
+    /// True when the line holds no character.
     pub fn is_empty(&self) -> bool {
         self.buf.is_empty()
     }
@@ -89,6 +92,7 @@ impl AsciiLine {
         self.buf.pop();
     }
 
+    /// Empties the line.
     pub fn clear(&mut self) {
         self.buf.clear();
     }

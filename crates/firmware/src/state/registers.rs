@@ -6,13 +6,17 @@ use tmclsim_protocol::{Condition, ErrorFlag};
 /// Result of the last comparison (or of an accumulator load against 0).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Compare {
+    /// The first operand was below the second.
     Less,
     #[default]
+    /// The operands were equal.
     Equal,
+    /// The first operand was above the second.
     Greater,
 }
 
 impl Compare {
+    /// How `a` compares with `b`.
     pub fn of(a: i32, b: i32) -> Compare {
         match a.cmp(&b) {
             std::cmp::Ordering::Less => Compare::Less,
@@ -24,18 +28,27 @@ impl Compare {
 
 /// Error flags (CLE / JC ETO…EPO), one bit each.
 pub mod error_flag {
+    /// ETO: a WAIT timed out.
     pub const TIMEOUT: u8 = 1 << 1;
+    /// EAL: external alarm.
     pub const ALARM: u8 = 1 << 2;
+    /// EDV: deviation error (the encoder or closed loop lost track of the
+    /// motor).
     pub const DEVIATION: u8 = 1 << 3;
+    /// EPO: position error.
     pub const POSITION: u8 = 1 << 4;
+    /// ESD: shutdown error.
     pub const SHUTDOWN: u8 = 1 << 5;
 }
 
 /// Accumulator, X register and flags of the TMCL interpreter.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Registers {
+    /// The accumulator.
     pub accumulator: i32,
+    /// The X register.
     pub x: i32,
+    /// Result of the last comparison.
     pub compare: Compare,
     /// Error flags, see [`error_flag`].
     pub errors: u8,

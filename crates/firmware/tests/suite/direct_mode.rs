@@ -106,15 +106,15 @@ fn every_table_16_parameter_obeys_its_access_and_range() {
         let get = reply(&mut m, &format!("GAP {n}, 0"));
         assert_eq!(get.status, if p.access.read { 100 } else { 3 }, "GAP {n}");
         if p.access.write {
-            let max = p.max.min(i32::MAX as i64);
+            let max = p.max.min(i64::from(i32::MAX));
             if !matches!(n, 0..=2) {
                 assert_eq!(status(&mut m, &format!("SAP {n}, 0, {max}")), 100, "SAP {n} max");
                 assert_eq!(send(&mut m, &format!("GAP {n}, 0")), max as i32, "GAP {n} after SAP");
             }
-            if p.max < i32::MAX as i64 {
+            if p.max < i64::from(i32::MAX) {
                 assert_eq!(status(&mut m, &format!("SAP {n}, 0, {}", p.max + 1)), 4, "SAP {n} above max");
             }
-            if p.min > i32::MIN as i64 {
+            if p.min > i64::from(i32::MIN) {
                 assert_eq!(status(&mut m, &format!("SAP {n}, 0, {}", p.min - 1)), 4, "SAP {n} below min");
             }
         } else {

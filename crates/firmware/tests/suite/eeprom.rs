@@ -101,7 +101,7 @@ fn every_image_a_module_stores_passes_the_check_of_rule_88() {
                 run(&mut m, &format!("STAP {}, {motor}", p.number));
             }
             for n in 1..=profile.module.coordinates {
-                run(&mut m, &format!("SCO {n}, {motor}, {}", i32::MIN + n as i32));
+                run(&mut m, &format!("SCO {n}, {motor}, {}", i32::MIN + i32::from(n)));
             }
             run(&mut m, &format!("CCO 1, {motor}"));
         }

@@ -126,7 +126,7 @@ fn can_identifiers_follow_the_can_table() {
     send(&mut m, "SGP 66, 0, 5");
     send(&mut m, "SGP 71, 0, 9");
     assert_eq!(m.can_ids(), (5, None), "GP 66");
-    assert_eq!(m.can_reply_id(), m.host_address() as u32);
+    assert_eq!(m.can_reply_id(), u32::from(m.host_address()));
 }
 
 #[test]

@@ -21,8 +21,8 @@ fn time_to_reach(m: &mut BusOfOne, poll_ms: u64, limit_s: u64) -> f64 {
 /// The closed-form duration from the axis parameters, per rules 23–24.
 fn closed_form(vmax: u32, a: u32, vmin: u32, rd: u32, pd: u32, distance: f64) -> f64 {
     let ramp = Ramp {
-        vmax: motion::velocity_pps(vmax as f64, pd),
-        vmin: motion::velocity_pps(vmin as f64, pd),
+        vmax: motion::velocity_pps(f64::from(vmax), pd),
+        vmin: motion::velocity_pps(f64::from(vmin), pd),
         accel_position: motion::accel_pps2(motion::positioning_accel(a, rd, pd), rd, pd),
         accel_velocity: 0.0,
         target_velocity: 0.0,
@@ -54,7 +54,7 @@ fn mvp_durations_match_the_closed_form() {
         }
         send(&mut m, &format!("MVP ABS, 0, {dist}"));
         let t = time_to_reach(&mut m, 1, 3600);
-        let expect = closed_form(vmax, a, vmin, rd, pd, dist as f64);
+        let expect = closed_form(vmax, a, vmin, rd, pd, f64::from(dist));
         let tolerance = (0.005 * expect).max(0.001) + 0.001; // + one poll period
         assert!((t - expect).abs() <= tolerance, "{vmax}/{a}/{vmin}/{rd}/{pd} {dist}: {t} s vs {expect} s");
         assert_eq!(send(&mut m, "GAP 1, 0"), dist, "exact final position");
@@ -238,6 +238,6 @@ fn an_hour_of_motion_in_one_advance() {
 fn every_built_in_profile_states_the_clock_the_ramps_run_at() {
     for name in tmclsim_profile::Profile::names() {
         let p = tmclsim_profile::Profile::built_in(name).unwrap();
-        assert_eq!(p.features.motion_clock_hz as f64, motion::FCLK, "{name}");
+        assert_eq!(f64::from(p.features.motion_clock_hz), motion::FCLK, "{name}");
     }
 }

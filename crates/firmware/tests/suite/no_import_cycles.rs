@@ -85,7 +85,7 @@ fn dependencies(text: &str, module: &str, files: &BTreeSet<String>) -> BTreeSet<
         let mut rest = &path[..];
         let absolute = match rest.first().map(String::as_str) {
             Some("crate") => join(&[], &rest[1..]),
-            Some("super") | Some("self") => {
+            Some("super" | "self") => {
                 while let Some(s) = rest.first().map(String::as_str) {
                     match s {
                         "super" => {

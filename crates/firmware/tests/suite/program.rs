@@ -108,7 +108,7 @@ fn subroutines_stack_depth_and_empty_rsub() {
     prog[8] = "CSUB 20".into(); // would go to 20
     prog.push("CALCV ADD, 12, 1".into()); // 9: reached after the ignored call
     prog.push("STOP".into()); // 10
-    let lines: Vec<&str> = prog.iter().map(|s| s.as_str()).collect();
+    let lines: Vec<&str> = prog.iter().map(String::as_str).collect();
     run(&mut m, &lines, 10);
     assert_eq!(var(&mut m, 12), 1);
     // RSUB with an empty stack is ignored.

@@ -89,7 +89,7 @@ fn home_switch_modes() {
         assert_eq!(send(&mut m, "GAP 1, 0"), 0);
         assert!((zero_point(&m) - zero).abs() <= 0.5, "mode {mode} from {start}: zero at {}", zero_point(&m));
         // The counter read the carriage's position before the search.
-        assert_eq!(send(&mut m, "GAP 197, 0") as f64, zero, "mode {mode} from {start}");
+        assert_eq!(f64::from(send(&mut m, "GAP 197, 0")), zero, "mode {mode} from {start}");
     }
 }
 

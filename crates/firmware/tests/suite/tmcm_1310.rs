@@ -16,7 +16,7 @@ fn module() -> BusOfOne {
 
 fn setup(m: &mut BusOfOne, closed: bool) {
     send(m, "SAP 6, 0, 128"); // open loop: 50 % current
-    send(m, &format!("SAP 129, 0, {}", closed as i32));
+    send(m, &format!("SAP 129, 0, {}", i32::from(closed)));
     send(m, "SAP 113, 0, 10");
     send(m, "SAP 114, 0, 100");
     send(m, "SAP 122, 0, 1");

@@ -114,7 +114,7 @@ fn generated_lines_never_break_the_module() {
     let (mut accepted, mut refused) = (0, 0);
     for n in 0..20_000 {
         let text = if n % 100 < abuse.len() { abuse[n % 100].to_string() } else { line(&mut rng) };
-        match Addressed::parse(&text).and_then(|a| bus.apply_world(a.address, &a.command)) {
+        match Addressed::parse(&text).and_then(|a| bus.apply_world(a.address, &a.command)).map_err(String::from) {
             Ok(_) => {
                 assert!(!abuse.contains(&text.as_str()), "{text:?} was accepted");
                 accepted += 1;

@@ -12,7 +12,7 @@ use tmclsim_firmware::{Bus, Module, World};
 /// Parses and applies a control line to the first module of `bus`.
 fn say(bus: &mut Bus, line: &str) -> Result<String, String> {
     let Addressed { address, command } = Addressed::parse(line)?;
-    bus.apply_world(address, &command)
+    bus.apply_world(address, &command).map_err(String::from)
 }
 
 fn bus_of(profile: &str) -> Bus {
@@ -128,7 +128,7 @@ fn world_files_follow_the_same_rules() {
         ("[[axis]]\nleft_switch = { position = 0, width = -5 }\n", "place 0 left 0 -5"),
     ];
     for (file, line) in pairs {
-        let from_file = World::from_toml(file, 1).unwrap_err();
+        let from_file = World::from_toml(file, 1).unwrap_err().to_string();
         let from_line = say(&mut bus, line).unwrap_err();
         assert_eq!(from_file, from_line, "{file}");
     }
@@ -143,7 +143,7 @@ fn world_files_follow_the_same_rules() {
         ("analog = [0, 0, 0, 0, 0, 0, 0, 0, 0]\n", "analog lists 9 values: the world has 8 analog inputs"),
         ("supply = 101\n", "supply 101 is outside 0…100 V"),
     ] {
-        let e = World::from_toml(file, 1).unwrap_err();
+        let e = World::from_toml(file, 1).unwrap_err().to_string();
         assert!(e.starts_with(expected), "{file}: {e}");
     }
     assert!(World::from_toml("supply = 12\ntemperature = 80\n[[axis]]\ntravel = [-5, 5]\nstart = 0\n", 1).is_ok());

@@ -40,7 +40,7 @@ pub fn tokens(text: &str) -> Vec<Token> {
                     i += 1;
                 }
             }
-        } else if ch == 'r' && (next == Some('"') || (next == Some('#') && matches!(c.get(i + 2), Some('"') | Some('#')))) {
+        } else if ch == 'r' && (next == Some('"') || (next == Some('#') && matches!(c.get(i + 2), Some('"' | '#')))) {
             // Raw string: r"…", r#"…"#.
             let mut j = i + 1;
             let mut hashes = 0;
