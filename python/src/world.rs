@@ -15,7 +15,7 @@ pub fn run(shared: &SharedBus, index: usize, line: &str, served: bool) -> Result
         Some(_) => {
             let Addressed { address, command } = Addressed::parse(line)?;
             match address {
-                Some(_) => shared.apply_world(address, &command),
+                Some(_) => shared.apply_world(address, &command).map_err(String::from),
                 None => shared.with_module(index, |m| command.apply(m)).map_err(String::from),
             }
         }

@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::can::CanFrame;
 use tmclsim_firmware::world_command::{Addressed, HELP, WorldCommand, on_off};
-use tmclsim_firmware::{Bus, Module};
+use tmclsim_firmware::{Bus, Module, WorldError};
 use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Status};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
@@ -233,8 +233,8 @@ impl SharedBus {
 
     /// Applies a world command to the module at `address` (`None`: the
     /// first one).
-    pub fn apply_world(&self, address: Option<u8>, command: &WorldCommand) -> Result<String, String> {
-        self.with_bus(|bus| bus.apply_world(address, command)).map_err(String::from)
+    pub fn apply_world(&self, address: Option<u8>, command: &WorldCommand) -> Result<String, WorldError> {
+        self.with_bus(|bus| bus.apply_world(address, command))
     }
 
     /// Takes the modules out (the bus is left empty), e.g. to put them on
