@@ -31,17 +31,6 @@ impl Module {
         self.link.ascii
     }
 
-    pub(crate) fn enter_ascii_mode(&mut self) {
-        self.link.ascii = true;
-        self.new_ascii_session();
-    }
-
-    /// Lines typed before now are dropped at their next character.
-    pub(crate) fn new_ascii_session(&mut self) {
-        self.link.ascii_session += 1;
-        self.link.ascii_line.clear();
-    }
-
     fn echo_mode(&self) -> i32 {
         (self.globals[0][gp::ASCII_MODE as usize] >> 4) & 3
     }

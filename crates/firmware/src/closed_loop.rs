@@ -82,7 +82,7 @@ impl Module {
     /// Encoder counts of the rotor (raw, before SAP 209's offset).
     fn encoder_counts(&self, m: usize) -> f64 {
         let p = &self.axes[m].params;
-        let per_rev = f64::from(p[cl::FULLSTEPS as usize].max(1)) * self.microsteps(m);
+        let per_rev = f64::from(p[cl::FULLSTEPS as usize].max(1)) * self.axes[m].microsteps();
         self.mechanical_position(m) / per_rev * f64::from(p[cl::ENCODER_RESOLUTION as usize].max(1))
     }
 
@@ -104,7 +104,7 @@ impl Module {
     /// The rotor position the encoder reports, in µsteps of the counter.
     pub(crate) fn measured_position(&self, m: usize) -> f64 {
         let p = &self.axes[m].params;
-        let per_rev = f64::from(p[cl::FULLSTEPS as usize].max(1)) * self.microsteps(m);
+        let per_rev = f64::from(p[cl::FULLSTEPS as usize].max(1)) * self.axes[m].microsteps();
         let counts = self.encoder_now(m);
         // The counter and the rotor agreed at `sync_offset`.
         let sign = self.shaft_sign();
@@ -134,7 +134,7 @@ impl Module {
 
     /// Torque available at a current scale (% of rated torque).
     fn torque_at(&self, m: usize, scale_percent: f64) -> f64 {
-        let fullsteps = self.axes[m].motion.v.abs() / self.microsteps(m);
+        let fullsteps = self.axes[m].motion.v.abs() / self.axes[m].microsteps();
         if self.driver_off(m) {
             return 0.0;
         }
@@ -152,7 +152,7 @@ impl Module {
         let before = self.mechanical_position(m) - moved * sign;
         if self.closed_loop_on(m) {
             let (lo, hi) = (f64::from(p[cl::SCALE_MIN as usize].clamp(0, 100)), f64::from(p[cl::SCALE_MAX as usize].clamp(0, 100)));
-            let speed_factor = (1.0 - self.axes[m].motion.v.abs() / self.microsteps(m) / crate::driver::CORNER_FULLSTEPS).max(0.01);
+            let speed_factor = (1.0 - self.axes[m].motion.v.abs() / self.axes[m].microsteps() / crate::driver::CORNER_FULLSTEPS).max(0.01);
             let needed = load / speed_factor + RESERVE_PERCENT;
             let scale = if self.axes[m].closed_loop.torque_mode {
                 f64::from(p[cl::TORQUE_TARGET as usize]).abs() / self.full_scale_ma() * 100.0
@@ -239,7 +239,7 @@ impl Module {
             return 0.0;
         }
         let fullsteps = crate::driver::CORNER_FULLSTEPS * (1.0 - load / percent);
-        let pps = fullsteps * self.microsteps(m);
+        let pps = fullsteps * self.axes[m].microsteps();
         let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         (motion::velocity_internal(pps, pd).min(2047.0)) * target.signum()
     }

@@ -62,7 +62,7 @@ impl Module {
     pub(crate) fn encoder_position(&self, m: usize) -> i32 {
         let w = &self.world.axes[m];
         let Some(counts_per_rev) = w.encoder_counts else { return self.axes[m].encoder_offset as i32 };
-        let microsteps_per_rev = w.fullsteps_per_rev * self.microsteps(m);
+        let microsteps_per_rev = w.fullsteps_per_rev * self.axes[m].microsteps();
         let counts = self.mechanical_position(m) / microsteps_per_rev * counts_per_rev;
         let factor = f64::from(self.axes[m].params[ap::ENCODER_PRESCALER as usize]) / PRESCALER_UNIT;
         ((counts * factor).round() as i64 + self.axes[m].encoder_offset) as i32
@@ -92,10 +92,6 @@ impl Module {
         }
     }
 
-    pub(crate) fn microsteps(&self, m: usize) -> f64 {
-        crate::motion::pow2(self.axes[m].params[ap::MICROSTEP_RESOLUTION as usize].clamp(0, 8))
-    }
-
     /// Torque margin `1 − load/available` at the axis's state now; `off`:
     /// the driver is switched off ([`Module::driver_off`]).
     fn margin(&self, m: usize, scale: f64, off: bool) -> f64 {
@@ -112,7 +108,7 @@ impl Module {
             // Nothing to carry: the whole torque is margin, at any speed.
             return 1.0;
         }
-        let fullsteps = axis.motion.v.abs() / self.microsteps(m);
+        let fullsteps = axis.motion.v.abs() / self.axes[m].microsteps();
         let available = (scale + 1.0) / 32.0 * (1.0 - fullsteps / CORNER_FULLSTEPS).max(0.0) * 100.0;
         if available <= 0.0 {
             return if load > 0.0 { -1.0 } else { 1.0 };
@@ -150,7 +146,7 @@ impl Module {
             }
             // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
             if moving && stall_speed > 0 && self.actual_speed(m).abs() >= stall_speed && self.axes[m].driver.load_value == 0 {
-                self.stop_now(m);
+                self.axes[m].stop_now();
                 self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
                 self.raise(Source::Stall(m as u8));
             }
@@ -161,7 +157,7 @@ impl Module {
                 self.axes[m].driver.load_value = round_in(7.0 * (1.0 - margin), 7.0);
             }
             if moving && threshold > 0 && self.axes[m].driver.load_value > threshold {
-                self.stop_now(m);
+                self.axes[m].stop_now();
             }
         }
         // The carriage follows the motor unless it cannot.
@@ -184,7 +180,7 @@ impl Module {
         if limit > 0 && moving && self.profile.features.encoder_deviation_stop {
             let deviation = (i64::from(self.actual_position(m)) - i64::from(self.encoder_position(m))).abs();
             if deviation > i64::from(limit) {
-                self.stop_now(m);
+                self.axes[m].stop_now();
                 self.registers.errors |= error_flag::DEVIATION;
                 self.raise(Source::Deviation(m as u8));
             }
@@ -201,7 +197,7 @@ impl Module {
             if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
         let mut cs = self.axes[m].driver.cool_scale.unwrap_or(max);
         let per_measurement = if p[ap::STALLGUARD_FILTER as usize] == 1 { 4.0 } else { 1.0 };
-        let measurements = (moved.abs() / self.microsteps(m) / per_measurement).min(256.0);
+        let measurements = (moved.abs() / self.axes[m].microsteps() / per_measurement).min(256.0);
         let lower = semin * 32;
         let upper = (semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32;
         let up = [1.0, 2.0, 4.0, 8.0][p[ap::SMART_ENERGY_CURRENT_UP_STEP as usize].clamp(0, 3) as usize];
@@ -222,12 +218,6 @@ impl Module {
         }
         self.axes[m].driver.cool_scale = Some(cs);
         self.axes[m].driver.down_count = count;
-    }
-
-    /// A hard stop: velocity mode, zero speed, at once.
-    fn stop_now(&mut self, m: usize) {
-        self.motor_stop(m);
-        self.axes[m].motion.v = 0.0;
     }
 
     /// The current setting in effect (0…255): run, boost, standby or off.

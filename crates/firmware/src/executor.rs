@@ -75,8 +75,14 @@ impl Module {
             // ----- motion (commands/motion.rs) --------------------------
             Ror { motor, velocity } => self.rotate_group(motor, velocity, 1).map(|_| echo)?,
             Rol { motor, velocity } => self.rotate_group(motor, velocity, -1).map(|_| echo)?,
-            Rora { motor } => self.rotate(motor, accumulator, 1).map(|_| echo)?,
-            Rola { motor } => self.rotate(motor, accumulator, -1).map(|_| echo)?,
+            Rora { motor } => {
+                let m = self.motor(motor)?;
+                self.axes[m].rotate(accumulator, 1).map(|_| echo)?
+            }
+            Rola { motor } => {
+                let m = self.motor(motor)?;
+                self.axes[m].rotate(accumulator, -1).map(|_| echo)?
+            }
             Mst { motor } => self.stop_group(motor).map(|_| echo)?,
             Mvp { mode, motor, value } => self.move_group(mode, motor, value).map(|_| echo)?,
             Mvpa { mode, motor } => self.move_to(mode, motor, accumulator).map(|_| echo)?,
@@ -208,7 +214,7 @@ impl Module {
             }
             AsciiMode => {
                 // The reply goes out in binary; then the link speaks text.
-                self.enter_ascii_mode();
+                self.link.enter_ascii_mode();
                 echo
             }
             UserFunction { .. } => return Err(Status::NotAvailable),

@@ -80,38 +80,9 @@ impl Module {
             return r;
         }
         if axis.closed_loop.torque_mode || axis.rfs.is_some() {
-            return self.work_out_ramp(motor);
+            return axis.work_out_ramp(axis.closed_loop.torque_mode.then(|| self.torque_mode_velocity(motor)));
         }
-        axis.plain_ramp(|| self.work_out_ramp(motor))
-    }
-
-    fn work_out_ramp(&self, motor: usize) -> motion::Ramp {
-        let p = &self.axes[motor].params;
-        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
-        let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
-        let mut vmax = f64::from(p[ap::MAX_SPEED as usize].clamp(0, 2047));
-        let mut target_velocity = f64::from(p[ap::TARGET_SPEED as usize]);
-        if self.axes[motor].closed_loop.torque_mode {
-            target_velocity = self.torque_mode_velocity(motor);
-        }
-        if let Some(rfs) = &self.axes[motor].rfs {
-            let slow = f64::from(p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047));
-            match rfs.current() {
-                Some(seek) => {
-                    let fast = f64::from(p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047));
-                    target_velocity = seek.dir * if seek.fast { fast } else { slow };
-                }
-                None => vmax = slow.max(1.0),
-            }
-        }
-        motion::Ramp {
-            vmax: motion::velocity_pps(vmax, pd),
-            vmin: motion::velocity_pps(f64::from(p[ap::MIN_SPEED as usize].clamp(0, 2047)), pd),
-            accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
-            accel_velocity: motion::accel_pps2(f64::from(a.max(1)), rd, pd),
-            target_velocity: motion::velocity_pps(target_velocity, pd),
-        }
+        axis.plain_ramp(|| axis.work_out_ramp(None))
     }
 }
 

@@ -290,7 +290,7 @@ impl Module {
             self.closed_loop_power_on(m);
         }
         self.link.ascii = self.globals[0][gp::ASCII_MODE as usize] & 1 == 1;
-        self.new_ascii_session();
+        self.link.new_ascii_session();
         if self.globals[0][gp::AUTOSTART as usize] == 1 && self.program.length() > 0 {
             self.program.mode = RunMode::Run;
         }

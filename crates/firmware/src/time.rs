@@ -111,7 +111,7 @@ impl Module {
         {
             self.link.heartbeat_tripped = true;
             for motor in 0..self.axes.len() {
-                self.motor_stop(motor);
+                self.axes[motor].run_at(0);
             }
         }
         if look {
@@ -430,7 +430,7 @@ impl Module {
                 let (l, r, _) = self.switches(m);
                 l || r
             }
-            WaitCondition::ReferenceSearch => !self.reference_search_active(m),
+            WaitCondition::ReferenceSearch => !self.axes[m].reference_search_active(),
         };
         if met {
             self.program.wait = None;

@@ -11,14 +11,17 @@ use tmclsim_protocol::{MoveMode, RfsAction, Status};
 impl Module {
     /// ROR, ROL: rotation of `motor` and its group.
     pub(crate) fn rotate_group(&mut self, motor: u8, velocity: i32, sign: i32) -> Result<(), Status> {
-        self.for_group(motor, |s, m| s.rotate(m, velocity, sign))
+        self.for_group(motor, |s, m| {
+            let m = s.motor(m)?;
+            s.axes[m].rotate(velocity, sign)
+        })
     }
 
     /// MST: `motor` and its group stop.
     pub(crate) fn stop_group(&mut self, motor: u8) -> Result<(), Status> {
         self.for_group(motor, |s, m| {
             let m = s.motor(m)?;
-            s.motor_stop(m);
+            s.axes[m].run_at(0);
             Ok(())
         })
     }
@@ -39,30 +42,15 @@ impl Module {
         match action {
             RfsAction::Start => self.for_group(motor, |s, g| s.start_reference_search(g as usize))?,
             RfsAction::Stop => self.for_group(motor, |s, g| {
-                if s.axes[g as usize].rfs.take().is_some() {
-                    s.motor_stop(g as usize);
+                let axis = &mut s.axes[g as usize];
+                if axis.rfs.take().is_some() {
+                    axis.run_at(0);
                 }
                 Ok(())
             })?,
-            RfsAction::Status => return Ok(Some(i32::from(self.reference_search_active(m)))),
+            RfsAction::Status => return Ok(Some(i32::from(self.axes[m].reference_search_active()))),
         }
         Ok(None)
-    }
-
-    pub(crate) fn rotate(&mut self, motor: u8, velocity: i32, sign: i32) -> Result<(), Status> {
-        let m = self.motor(motor)?;
-        if !(-2047..=2047).contains(&velocity) {
-            return Err(Status::InvalidValue);
-        }
-        let axis = &mut self.axes[m];
-        axis.clear_motion_errors();
-        axis.run_at(velocity * sign);
-        Ok(())
-    }
-
-    /// MST: velocity mode with target speed 0.
-    pub(crate) fn motor_stop(&mut self, m: usize) {
-        self.axes[m].run_at(0);
     }
 
     pub(crate) fn move_to(&mut self, mode: MoveMode, motor: u8, value: i32) -> Result<(), Status> {
@@ -165,11 +153,6 @@ impl Module {
         axis.target_word = target;
         axis.params[ap::TARGET_POSITION as usize] = target;
         axis.motion.target = axis.motion.position() as f64 + f64::from(diff);
-    }
-
-    /// A reference search is running on this axis.
-    pub(crate) fn reference_search_active(&self, m: usize) -> bool {
-        self.axes[m].rfs.is_some()
     }
 
     /// RFS START with the mode of AP 193.

@@ -2,10 +2,11 @@
 //! the per-axis state of the reference search, the driver and the closed
 //! loop.
 
-use crate::motion::{Motion, Ramp, RampMode};
+use crate::motion::{self, Motion, Ramp, RampMode};
 use crate::parameter_numbers::ap;
 use crate::reference_search::ReferenceSearch;
 use std::cell::Cell;
+use tmclsim_protocol::Status;
 
 /// One motor axis.
 #[derive(Clone, Debug)]
@@ -79,6 +80,34 @@ impl Axis {
         self.notify_on_arrival = false;
     }
 
+    /// ROR, ROL (`sign` 1, −1) with a speed of −2047…2047 (else status 4):
+    /// the motion errors are cleared and the axis runs at `velocity · sign`.
+    pub fn rotate(&mut self, velocity: i32, sign: i32) -> Result<(), Status> {
+        if !(-2047..=2047).contains(&velocity) {
+            return Err(Status::InvalidValue);
+        }
+        self.clear_motion_errors();
+        self.run_at(velocity * sign);
+        Ok(())
+    }
+
+    /// A hard stop (the driver's protections): velocity mode, zero speed,
+    /// at once.
+    pub fn stop_now(&mut self) {
+        self.run_at(0);
+        self.motion.v = 0.0;
+    }
+
+    /// µsteps per full step (AP 140: 2 to the power 0…8).
+    pub fn microsteps(&self) -> f64 {
+        motion::pow2(self.params[ap::MICROSTEP_RESOLUTION as usize].clamp(0, 8))
+    }
+
+    /// A reference search is running on this axis (RFS STATUS).
+    pub fn reference_search_active(&self) -> bool {
+        self.rfs.is_some()
+    }
+
     /// A new motion command clears the motion errors of AP 207.
     pub fn clear_motion_errors(&mut self) {
         self.params[ap::EXTENDED_ERROR_FLAGS as usize] = 0;
@@ -97,6 +126,38 @@ impl Axis {
         let r = work_out();
         self.ramp_cache.set(Some((key, r)));
         r
+    }
+
+    /// Works the ramp out from the axis parameters in µsteps and seconds:
+    /// the target speed is `torque_velocity` in torque mode (internal
+    /// units), the reference search's while one runs.
+    pub(crate) fn work_out_ramp(&self, torque_velocity: Option<f64>) -> Ramp {
+        let p = &self.params;
+        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
+        let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
+        let mut vmax = f64::from(p[ap::MAX_SPEED as usize].clamp(0, 2047));
+        let mut target_velocity = f64::from(p[ap::TARGET_SPEED as usize]);
+        if let Some(v) = torque_velocity {
+            target_velocity = v;
+        }
+        if let Some(rfs) = &self.rfs {
+            let slow = f64::from(p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047));
+            match rfs.current() {
+                Some(seek) => {
+                    let fast = f64::from(p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047));
+                    target_velocity = seek.dir * if seek.fast { fast } else { slow };
+                }
+                None => vmax = slow.max(1.0),
+            }
+        }
+        Ramp {
+            vmax: motion::velocity_pps(vmax, pd),
+            vmin: motion::velocity_pps(f64::from(p[ap::MIN_SPEED as usize].clamp(0, 2047)), pd),
+            accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
+            accel_velocity: motion::accel_pps2(f64::from(a.max(1)), rd, pd),
+            target_velocity: motion::velocity_pps(target_velocity, pd),
+        }
     }
 
     /// Ends what takes the ramp generator over from the plain ramp: a

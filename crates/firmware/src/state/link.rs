@@ -45,6 +45,19 @@ impl Link {
         self.last_frame_ns = now_ns;
         self.heartbeat_tripped = false;
     }
+
+    /// Command 139: the link speaks text, in a new session.
+    pub fn enter_ascii_mode(&mut self) {
+        self.ascii = true;
+        self.new_ascii_session();
+    }
+
+    /// A new ASCII session: lines typed before now are dropped at their
+    /// next character.
+    pub fn new_ascii_session(&mut self) {
+        self.ascii_session += 1;
+        self.ascii_line.clear();
+    }
 }
 
 /// The ASCII line being typed on one link.
