@@ -17,10 +17,8 @@
 //!   stop, the motor loses steps: the position counter goes on, the
 //!   carriage does not.
 
-use crate::module::Module;
+use crate::motor::{Alarms, Motor, MotorMut};
 use crate::parameter_numbers::ap;
-use crate::program::Source;
-use crate::state::registers::error_flag;
 use tmclsim_profile::StallDetection;
 
 /// Full steps per second at which the motor has no torque left.
@@ -38,42 +36,37 @@ pub const STANDSTILL_NS: u64 = 65_536_000;
 
 pub use crate::state::axis::Driver;
 
-impl Module {
+impl Motor<'_> {
     /// The driver is switched off (no torque).
-    pub(crate) fn driver_off(&self, m: usize) -> bool {
-        let f = self.world.axes[m].faults;
-        let toff_zero = self.profile.features.chopper_off_disables_driver && self.axes[m].params[ap::CHOPPER_OFF_TIME as usize] == 0;
-        let shutdown_pin = match self.profile.features.shutdown_pin.map(|n| self.globals[0][n as usize]) {
-            Some(1) => self.world.shutdown_input,
-            Some(2) => !self.world.shutdown_input,
-            _ => false,
-        };
-        self.world.temperature >= SHUTDOWN_C
+    pub(crate) fn driver_off(&self) -> bool {
+        let f = self.world.faults;
+        let toff_zero = self.at.features().chopper_off_disables_driver && self.axis.params[ap::CHOPPER_OFF_TIME as usize] == 0;
+        self.at.temperature() >= SHUTDOWN_C
             || f.short_a
             || f.short_b
-            || self.world.supply_decivolts < UNDERVOLTAGE_DV
+            || self.at.supply_decivolts() < UNDERVOLTAGE_DV
             || toff_zero
-            || shutdown_pin
+            || self.at.shutdown()
     }
 
     /// AP 209: the encoder's count scaled by the prescaler (AP 210; the
     /// manual's example 68672 is a factor of 6.4, and the factor is taken
     /// as proportional: value / 10730), plus the offset SAP 209 set.
-    pub(crate) fn encoder_position(&self, m: usize) -> i32 {
-        let w = &self.world.axes[m];
-        let Some(counts_per_rev) = w.encoder_counts else { return self.axes[m].encoder_offset as i32 };
-        let microsteps_per_rev = w.fullsteps_per_rev * self.axes[m].microsteps();
-        let counts = self.mechanical_position(m) / microsteps_per_rev * counts_per_rev;
-        let factor = f64::from(self.axes[m].params[ap::ENCODER_PRESCALER as usize]) / PRESCALER_UNIT;
-        ((counts * factor).round() as i64 + self.axes[m].encoder_offset) as i32
+    pub(crate) fn encoder_position(&self) -> i32 {
+        let axis = self.axis;
+        let Some(counts_per_rev) = self.world.encoder_counts else { return axis.encoder_offset as i32 };
+        let microsteps_per_rev = self.world.fullsteps_per_rev * axis.microsteps();
+        let counts = self.mechanical_position() / microsteps_per_rev * counts_per_rev;
+        let factor = f64::from(axis.params[ap::ENCODER_PRESCALER as usize]) / PRESCALER_UNIT;
+        ((counts * factor).round() as i64 + axis.encoder_offset) as i32
     }
 
     /// AP 208.
-    pub(crate) fn driver_flags(&self, m: usize) -> i32 {
-        let f = self.world.axes[m].faults;
-        let axis = &self.axes[m];
-        let t = self.world.temperature;
-        let still = axis.standstill_since.is_some_and(|s| self.now_ns.saturating_sub(s) >= STANDSTILL_NS);
+    pub(crate) fn driver_flags(&self) -> i32 {
+        let f = self.world.faults;
+        let axis = self.axis;
+        let t = self.at.temperature();
+        let still = axis.standstill_since.is_some_and(|s| self.at.now_ns().saturating_sub(s) >= STANDSTILL_NS);
         i32::from(axis.motion.v != 0.0 && axis.driver.load_value == 0)
             | i32::from(t >= SHUTDOWN_C) << 1
             | i32::from(t >= PREWARNING_C) << 2
@@ -85,20 +78,20 @@ impl Module {
     }
 
     /// Current scale in effect (0…31): coolStep's, or the current setting's.
-    pub(crate) fn current_scale(&self, m: usize) -> f64 {
-        match self.axes[m].driver.cool_scale {
-            Some(cs) if self.axes[m].motion.v != 0.0 => cs,
-            _ => f64::from(self.motor_current(m) >> 3),
+    pub(crate) fn current_scale(&self) -> f64 {
+        match self.axis.driver.cool_scale {
+            Some(cs) if self.axis.motion.v != 0.0 => cs,
+            _ => f64::from(self.motor_current() >> 3),
         }
     }
 
     /// Torque margin `1 − load/available` at the axis's state now; `off`:
-    /// the driver is switched off ([`Module::driver_off`]).
-    fn margin(&self, m: usize, scale: f64, off: bool) -> f64 {
-        let axis = &self.axes[m];
-        let world = &self.world.axes[m];
-        let load = if world.loads.is_empty() { 0.0 } else { world.load_at(self.mech(m, axis.motion.x), self.now_ns as f64 * 1e-9) };
-        if scale <= 0.0 && self.motor_current(m) == 0 {
+    /// the driver is switched off ([`Motor::driver_off`]).
+    fn margin(&self, scale: f64, off: bool) -> f64 {
+        let axis = self.axis;
+        let world = self.world;
+        let load = if world.loads.is_empty() { 0.0 } else { world.load_at(self.mech(axis.motion.x), self.at.now_ns() as f64 * 1e-9) };
+        if scale <= 0.0 && self.motor_current() == 0 {
             return if load > 0.0 { -1.0 } else { 1.0 };
         }
         if off {
@@ -108,7 +101,7 @@ impl Module {
             // Nothing to carry: the whole torque is margin, at any speed.
             return 1.0;
         }
-        let fullsteps = axis.motion.v.abs() / self.axes[m].microsteps();
+        let fullsteps = axis.motion.v.abs() / axis.microsteps();
         let available = (scale + 1.0) / 32.0 * (1.0 - fullsteps / CORNER_FULLSTEPS).max(0.0) * 100.0;
         if available <= 0.0 {
             return if load > 0.0 { -1.0 } else { 1.0 };
@@ -116,120 +109,21 @@ impl Module {
         1.0 - load / available
     }
 
-    fn stallguard(&self, m: usize, margin: f64) -> i32 {
-        let sgt = self.axes[m].params[ap::STALLGUARD_THRESHOLD as usize];
+    fn stallguard(&self, margin: f64) -> i32 {
+        let sgt = self.axis.params[ap::STALLGUARD_THRESHOLD as usize];
         round_in(800.0 * margin + 8.0 * f64::from(sgt), 1023.0)
     }
 
-    /// After the motion controller moved the axis from `x_before` during
-    /// `dt` seconds: the driver measures, regulates, stops on stall and the
-    /// carriage follows, or not.
-    pub(crate) fn drive(&mut self, m: usize, x_before: f64, dt: f64) {
-        let moved = self.axes[m].motion.x - x_before;
-        let moving = self.axes[m].motion.v != 0.0 || moved != 0.0;
-        let p = &self.axes[m].params;
-        let (stall_speed, threshold, limit) =
-            (p[ap::STOP_ON_STALL as usize], p[ap::STALL_THRESHOLD as usize], p[ap::MAX_ENCODER_DEVIATION as usize]);
-        let off = self.driver_off(m);
-        // coolStep regulates above its threshold speed, when enabled.
-        let semin = if self.profile.features.coolstep { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
-        let cool = semin > 0 && moving && self.actual_speed(m).abs() >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
-        if cool {
-            self.cool_step(m, moved, off, semin);
-        } else {
-            self.axes[m].driver.cool_scale = None;
-        }
-        let margin = if self.world.axes[m].loads.is_empty() && !off { 1.0 } else { self.margin(m, self.current_scale(m), off) };
-        if self.profile.features.stall_detection == StallDetection::Stallguard2 {
-            if moving {
-                self.axes[m].driver.load_value = self.stallguard(m, margin);
-            }
-            // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
-            if moving && stall_speed > 0 && self.actual_speed(m).abs() >= stall_speed && self.axes[m].driver.load_value == 0 {
-                self.axes[m].stop_now();
-                self.axes[m].params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
-                self.raise(Source::Stall(m as u8));
-            }
-        } else if self.profile.features.stall_detection == StallDetection::Tmc249 {
-            // TMC249 load indicator (TMCM-351): 0…7, higher is more load;
-            // a reading above AP 205 (not 0) stops the motor.
-            if moving {
-                self.axes[m].driver.load_value = round_in(7.0 * (1.0 - margin), 7.0);
-            }
-            if moving && threshold > 0 && self.axes[m].driver.load_value > threshold {
-                self.axes[m].stop_now();
-            }
-        }
-        // The carriage follows the motor unless it cannot.
-        let slips = moved != 0.0 && (margin < 0.0 || off);
-        if self.has_closed_loop() {
-            self.closed_loop_step(m, moved, dt, slips);
-            return;
-        }
-        let sign = self.shaft_sign();
-        let axis = &mut self.axes[m];
-        if slips {
-            axis.mech_offset -= moved * sign;
-        }
-        if self.world.axes[m].travel.is_some() {
-            let mech = axis.motion.x * sign + axis.mech_offset;
-            axis.mech_offset += self.world.axes[m].within_travel(mech) - mech;
-        }
-        // Encoder deviation (AP 212): the motor stops when the position
-        // counter and the encoder drift apart further than allowed.
-        if limit > 0 && moving && self.profile.features.encoder_deviation_stop {
-            let deviation = (i64::from(self.actual_position(m)) - i64::from(self.encoder_position(m))).abs();
-            if deviation > i64::from(limit) {
-                self.axes[m].stop_now();
-                self.registers.errors |= error_flag::DEVIATION;
-                self.raise(Source::Deviation(m as u8));
-            }
-        }
-        let _ = dt;
-    }
-
-    /// coolStep's regulation over the measurements of a move of `moved`
-    /// µsteps: the current scale goes up under load and down without.
-    fn cool_step(&mut self, m: usize, moved: f64, off: bool, semin: i32) {
-        let p = &self.axes[m].params;
-        let max = f64::from(p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3);
-        let min =
-            if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
-        let mut cs = self.axes[m].driver.cool_scale.unwrap_or(max);
-        let per_measurement = if p[ap::STALLGUARD_FILTER as usize] == 1 { 4.0 } else { 1.0 };
-        let measurements = (moved.abs() / self.axes[m].microsteps() / per_measurement).min(256.0);
-        let lower = semin * 32;
-        let upper = (semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32;
-        let up = [1.0, 2.0, 4.0, 8.0][p[ap::SMART_ENERGY_CURRENT_UP_STEP as usize].clamp(0, 3) as usize];
-        let down_every = [32.0, 8.0, 2.0, 1.0][p[ap::SMART_ENERGY_CURRENT_DOWN_STEP as usize].clamp(0, 3) as usize];
-        let mut count = self.axes[m].driver.down_count;
-        for _ in 0..measurements.ceil() as usize {
-            let sg = self.stallguard(m, self.margin(m, cs, off));
-            if sg < lower {
-                cs = (cs + up).min(max);
-                count = 0.0;
-            } else if sg > upper {
-                count += 1.0;
-                if count >= down_every {
-                    cs = (cs - 1.0).max(min);
-                    count = 0.0;
-                }
-            }
-        }
-        self.axes[m].driver.cool_scale = Some(cs);
-        self.axes[m].driver.down_count = count;
-    }
-
     /// The current setting in effect (0…255): run, boost, standby or off.
-    pub fn motor_current(&self, m: usize) -> u32 {
-        let axis = &self.axes[m];
+    pub(crate) fn motor_current(&self) -> u32 {
+        let axis = self.axis;
         let p = &axis.params;
         let run = p[ap::MAX_CURRENT as usize].clamp(0, 255) as u32;
         if axis.motion.v != 0.0 {
             let slow = p[ap::SMART_ENERGY_SLOW_RUN_CURRENT as usize].clamp(0, 255) as u32;
             if p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0
                 && slow > 0
-                && self.actual_speed(m).abs() < p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize]
+                && self.actual_speed().abs() < p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize]
             {
                 return slow;
             }
@@ -241,13 +135,153 @@ impl Module {
             return standby;
         }
         let Some(since) = axis.standstill_since else { return run };
-        let still_ms = (self.now_ns.saturating_sub(since)) / 1_000_000;
+        let still_ms = (self.at.now_ns().saturating_sub(since)) / 1_000_000;
         let freewheel = p[ap::FREEWHEELING as usize].max(0) as u64 * 10;
         if freewheel > 0 && still_ms >= freewheel {
             return 0;
         }
         let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * 10;
         if still_ms >= delay { standby } else { run }
+    }
+
+    /// The driver has something to look at often while the motor moves
+    /// or is about to: a load, stall detection, coolStep, an encoder
+    /// deviation limit, a driver that is off; in closed loop also torque
+    /// mode and a lag to correct.
+    pub(crate) fn watched(&self) -> bool {
+        let f = self.at.features();
+        let axis = self.axis;
+        let p = &axis.params;
+        if f.closed_loop && (axis.closed_loop.torque_mode || self.lag().abs() > 1e-6) {
+            return true;
+        }
+        let will_move = axis.motion.v != 0.0
+            || match axis.motion.mode {
+                crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
+                _ => axis.motion.x != axis.motion.target,
+            };
+        will_move
+            && (!self.world.loads.is_empty()
+                || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
+                || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
+                || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
+                || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
+                || self.driver_off())
+    }
+}
+
+impl MotorMut<'_> {
+    /// After the motion controller moved the axis from `x_before` during
+    /// `dt` seconds: the driver measures, regulates, stops on stall and the
+    /// carriage follows, or not. Answers the alarms the module raises.
+    pub(crate) fn drive(&mut self, x_before: f64, dt: f64) -> Alarms {
+        let mut alarms = Alarms::default();
+        let moved = self.axis.motion.x - x_before;
+        let moving = self.axis.motion.v != 0.0 || moved != 0.0;
+        let p = &self.axis.params;
+        let (stall_speed, threshold, limit) =
+            (p[ap::STOP_ON_STALL as usize], p[ap::STALL_THRESHOLD as usize], p[ap::MAX_ENCODER_DEVIATION as usize]);
+        let features = self.at.features();
+        let off = self.view().driver_off();
+        // coolStep regulates above its threshold speed, when enabled.
+        let semin = if features.coolstep { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
+        let cool = semin > 0 && moving && self.view().actual_speed().abs() >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
+        if cool {
+            self.cool_step(moved, off, semin);
+        } else {
+            self.axis.driver.cool_scale = None;
+        }
+        let margin = if self.world.loads.is_empty() && !off {
+            1.0
+        } else {
+            let view = self.view();
+            view.margin(view.current_scale(), off)
+        };
+        if features.stall_detection == StallDetection::Stallguard2 {
+            if moving {
+                self.axis.driver.load_value = self.view().stallguard(margin);
+            }
+            // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
+            if moving && stall_speed > 0 && self.view().actual_speed().abs() >= stall_speed && self.axis.driver.load_value == 0 {
+                self.axis.stop_now();
+                self.axis.params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
+                alarms.stall = true;
+            }
+        } else if features.stall_detection == StallDetection::Tmc249 {
+            // TMC249 load indicator (TMCM-351): 0…7, higher is more load;
+            // a reading above AP 205 (not 0) stops the motor.
+            if moving {
+                self.axis.driver.load_value = round_in(7.0 * (1.0 - margin), 7.0);
+            }
+            if moving && threshold > 0 && self.axis.driver.load_value > threshold {
+                self.axis.stop_now();
+            }
+        }
+        // The carriage follows the motor unless it cannot.
+        let slips = moved != 0.0 && (margin < 0.0 || off);
+        if features.closed_loop {
+            alarms.deviation = self.closed_loop_step(moved, dt, slips);
+            return alarms;
+        }
+        let sign = self.at.shaft_sign();
+        if slips {
+            self.axis.mech_offset -= moved * sign;
+        }
+        self.keep_within_travel();
+        // Encoder deviation (AP 212): the motor stops when the position
+        // counter and the encoder drift apart further than allowed.
+        if limit > 0 && moving && features.encoder_deviation_stop {
+            let view = self.view();
+            let deviation = (i64::from(view.actual_position()) - i64::from(view.encoder_position())).abs();
+            if deviation > i64::from(limit) {
+                self.axis.stop_now();
+                alarms.deviation = true;
+            }
+        }
+        alarms
+    }
+
+    /// A carriage on a stage of limited travel stays on it: the motor
+    /// turns on, the carriage stands at the end.
+    pub(crate) fn keep_within_travel(&mut self) {
+        if self.world.travel.is_some() {
+            let axis = &mut *self.axis;
+            let mech = axis.motion.x * self.at.shaft_sign() + axis.mech_offset;
+            axis.mech_offset += self.world.within_travel(mech) - mech;
+        }
+    }
+
+    /// coolStep's regulation over the measurements of a move of `moved`
+    /// µsteps: the current scale goes up under load and down without.
+    fn cool_step(&mut self, moved: f64, off: bool, semin: i32) {
+        let p = &self.axis.params;
+        let max = f64::from(p[ap::MAX_CURRENT as usize].clamp(0, 255) >> 3);
+        let min =
+            if p[ap::SMART_ENERGY_CURRENT_MINIMUM as usize] == 1 { (max + 1.0) / 4.0 - 1.0 } else { (max + 1.0) / 2.0 - 1.0 }.max(0.0);
+        let mut cs = self.axis.driver.cool_scale.unwrap_or(max);
+        let per_measurement = if p[ap::STALLGUARD_FILTER as usize] == 1 { 4.0 } else { 1.0 };
+        let measurements = (moved.abs() / self.axis.microsteps() / per_measurement).min(256.0);
+        let lower = semin * 32;
+        let upper = (semin + p[ap::SMART_ENERGY_HYSTERESIS as usize] + 1) * 32;
+        let up = [1.0, 2.0, 4.0, 8.0][p[ap::SMART_ENERGY_CURRENT_UP_STEP as usize].clamp(0, 3) as usize];
+        let down_every = [32.0, 8.0, 2.0, 1.0][p[ap::SMART_ENERGY_CURRENT_DOWN_STEP as usize].clamp(0, 3) as usize];
+        let mut count = self.axis.driver.down_count;
+        let view = self.view();
+        for _ in 0..measurements.ceil() as usize {
+            let sg = view.stallguard(view.margin(cs, off));
+            if sg < lower {
+                cs = (cs + up).min(max);
+                count = 0.0;
+            } else if sg > upper {
+                count += 1.0;
+                if count >= down_every {
+                    cs = (cs - 1.0).max(min);
+                    count = 0.0;
+                }
+            }
+        }
+        self.axis.driver.cool_scale = Some(cs);
+        self.axis.driver.down_count = count;
     }
 }
 

@@ -1,32 +1,17 @@
-//! The command executor: `execute` takes a command in direct mode (a host
-//! sent it), the interpreter (`interpreter.rs`) one of a program, and both
-//! hand the decoded command to [`Module::dispatch`], the one place a
-//! command is matched. Each arm goes to the part of the module that owns
+//! The command executor: direct mode (`control.rs`, for every command but
+//! the control commands) and the interpreter (`interpreter.rs`) hand a
+//! decoded command to [`Module::dispatch`], the one place it is matched.
+//! Each arm goes to the part of the module that owns
 //! the command's family: the I/O (`state/io.rs`), the registers and user
 //! variables (`state/calculator.rs`), the interrupts (`state/interrupts.rs`),
 //! the EEPROM (`state/persistence.rs`), the program (`program.rs`); the
 //! families that need more than one part are coordinated in `commands/`.
 
 use crate::module::Module;
-use crate::outcome::{Origin, Outcome, Special};
-use tmclsim_protocol::{Command, Instruction, Status, opcode};
-
-/// Key that 137 and 255 require.
-pub const MAGIC_KEY: i32 = 1234;
+use crate::outcome::{Origin, Outcome};
+use tmclsim_protocol::{Command, Instruction, Status};
 
 impl Module {
-    /// Executes one instruction in direct mode.
-    pub fn execute(&mut self, ins: Instruction) -> Outcome {
-        if !self.profile.has_opcode(ins.opcode) {
-            return Outcome::error(Status::InvalidCommand, ins.value);
-        }
-        let cmd = match Command::decode(ins) {
-            Ok(c) => c,
-            Err(e) => return Outcome::error(e.status(), ins.value),
-        };
-        self.dispatch(cmd, ins, Origin::Direct, self.now_ns).unwrap_or_else(|status| Outcome::error(status, ins.value))
-    }
-
     /// Executes a decoded command, reached by `origin` at virtual time
     /// `at`: the one match over the commands. The branch commands are a
     /// program's only (in direct mode: status 5); the control commands
@@ -158,66 +143,24 @@ impl Module {
             Ei { interrupt } => self.interrupts.enable(&self.profile, interrupt, true).map(|_| echo)?,
             Di { interrupt } => self.interrupts.enable(&self.profile, interrupt, false).map(|_| echo)?,
             Vect { interrupt, address } => self.interrupts.set_vector(&self.profile, interrupt, address).map(|_| echo)?,
-            TargetReachedEvent { every_move, mask } => self.interrupts.arm_events(every_move, mask, self.axes.len())?,
 
-            // ----- program control, 128–135 (commands/program_control.rs)
-            StopApplication => {
-                self.program.stop_application();
-                0
-            }
-            RunApplication { from } => self.run_application(from)?,
-            StepApplication => {
-                self.step_application();
-                0
-            }
-            ResetApplication => {
-                self.program.reset_application();
-                self.registers = Default::default();
-                0
-            }
-            EnterDownload { address } => self.enter_download(address)?,
-            ExitDownload => {
-                if self.program.exit_download() {
-                    // The downloaded words are in the EEPROM image; save it.
-                    self.persistence.mark_written();
-                }
-                0
-            }
-            ReadMemory { address } => {
-                let stored = self.read_memory(address)?;
-                let frame = tmclsim_protocol::frame::memory_reply(self.host_address(), stored);
-                return Ok(Outcome { status: Status::Ok, value: address, special: Special::Frame(frame) });
-            }
-            ApplicationStatus { kind } => self.application_status(kind),
-
-            // ----- the module ---------------------------------------------
-            FirmwareVersion { binary: true } => self.profile.version_word(),
-            FirmwareVersion { binary: false } => {
-                return Ok(Outcome { status: Status::Ok, value: 0, special: Special::Frame(self.special_version()) });
-            }
-            FactoryDefaults { key } => {
-                if key != MAGIC_KEY {
-                    return Err(Status::InvalidValue);
-                }
-                // A locked configuration EEPROM is not erased either
-                // (docs/behaviour.md rule 73).
-                self.persistence.factory_defaults(&self.globals)?;
-                self.reset();
-                return Ok(Outcome { status: Status::Ok, value: key, special: Special::Silent });
-            }
-            Reset { key } => {
-                if key != MAGIC_KEY {
-                    return Err(Status::InvalidValue);
-                }
-                // handle_frame resets after the reply has been built.
-                echo
-            }
-            AsciiMode => {
-                // The reply goes out in binary; then the link speaks text.
-                self.link.enter_ascii_mode();
-                echo
-            }
             UserFunction { .. } => return Err(Status::NotAvailable),
+
+            // ----- the control commands (128–139, 255) are the direct
+            // mode's (control.rs); a program has them refused.
+            StopApplication
+            | RunApplication { .. }
+            | StepApplication
+            | ResetApplication
+            | EnterDownload { .. }
+            | ExitDownload
+            | ReadMemory { .. }
+            | ApplicationStatus { .. }
+            | FirmwareVersion { .. }
+            | FactoryDefaults { .. }
+            | TargetReachedEvent { .. }
+            | AsciiMode
+            | Reset { .. } => return Err(Status::InvalidCommand),
         };
         Ok(Outcome::ok(value))
     }
@@ -230,9 +173,4 @@ impl Module {
         }
         v
     }
-}
-
-/// Frame-level helpers for tests and tools.
-pub fn opcode_name(op: u8) -> &'static str {
-    opcode::name(op)
 }

@@ -7,7 +7,6 @@ use crate::module::Module;
 use crate::outcome::{Outcome, Special};
 use crate::parameter_numbers::gp;
 use crate::program::Download;
-use tmclsim_protocol::frame::version_string_reply;
 use tmclsim_protocol::{Command, FRAME_LEN, Instruction, Reply, Request, Status, opcode};
 
 use crate::link_id::{IN_PROCESS, LinkId};
@@ -137,11 +136,6 @@ impl Module {
     /// and GIO.
     fn replies_suppressed(&self, op: u8) -> bool {
         self.globals[0][gp::SUPPRESS_REPLY as usize] == 1 && !matches!(op, opcode::GAP | opcode::GGP | opcode::GIO)
-    }
-
-    /// 136 type 0: the version text as a frame.
-    pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
-        version_string_reply(self.host_address(), &self.profile.version_text())
     }
 }
 

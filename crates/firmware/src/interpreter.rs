@@ -1,36 +1,16 @@
 //! The TMCL program interpreter: one instruction at a time, with jumps,
 //! WAIT, subroutines and interrupts; and the debugger's controls
-//! (breakpoints, single steps, the trace). The control commands 128–135
-//! are in `commands/program_control.rs`, the interpreter's clock in
-//! `time.rs`.
+//! (breakpoints, the trace). DJNZ and WAIT are in `commands/flow.rs`, the
+//! control commands 128–135 in `control.rs`, the interpreter's clock and
+//! the debugger's single step in `time.rs`.
 
 use crate::module::Module;
 use crate::outcome::Origin;
-use crate::program::{RunMode, Source, TraceRecord, Wait};
-use tmclsim_protocol::{Command, Instruction, Status, WaitCondition, opcode};
-
-/// Ten milliseconds: one WAIT tick.
-const TICK_NS: u64 = 10_000_000;
+use crate::program::{RunMode, TraceRecord};
+use tmclsim_protocol::{Command, Instruction, Status, opcode};
 
 impl Module {
     // ----- the debugger -------------------------------------------------
-
-    /// Runs until one more instruction has executed (a WAIT in progress
-    /// first ends), then pauses; time stops at most `slice_ns` after it.
-    /// Returns false when `limit_ns` came first. Front ends step with
-    /// [`crate::Bus::step_instruction`].
-    pub(crate) fn step_instruction(&mut self, limit_ns: u64, slice_ns: u64) -> bool {
-        let before = self.program.executed;
-        self.program.single_step = true;
-        self.start_program();
-        while self.program.executed == before && self.now_ns < limit_ns && self.program.mode == RunMode::Run {
-            let next = if self.program.wait.is_some() { self.now_ns + slice_ns } else { self.program.next_ns.max(self.now_ns + 1) };
-            self.advance_to(next.min(limit_ns));
-        }
-        self.program.single_step = false;
-        self.pause_program();
-        self.program.executed != before
-    }
 
     /// The TMCL program: its memory, counter, stack, timers and run mode.
     pub fn program(&self) -> &crate::program::Program {
@@ -116,34 +96,6 @@ impl Module {
         self.dispatch(cmd, ins, Origin::Program, at).map(|_| ())
     }
 
-    /// DJNZ: decrements a user variable and jumps while it stays above 0.
-    pub(crate) fn decrement_and_jump(&mut self, var: u8, address: i32) -> Result<(), Status> {
-        let a = self.program.target(address)?;
-        let i = var as usize;
-        if i >= self.profile.module.user_variables as usize {
-            return Err(Status::InvalidValue);
-        }
-        let v = self.globals.user_variable(i).wrapping_sub(1);
-        self.globals.set_user_variable(i, v);
-        if v > 0 {
-            self.program.pc = a;
-        }
-        Ok(())
-    }
-
-    /// WAIT: the program waits from `at` until the condition holds or the
-    /// ticks (or the accumulator's, with -1) have passed.
-    pub(crate) fn start_wait(&mut self, condition: WaitCondition, motor: u8, ticks: i32, at: u64) -> Result<(), Status> {
-        let ticks = if ticks == -1 { self.registers.accumulator } else { ticks }.max(0) as u64;
-        let until = (ticks > 0 || condition == WaitCondition::Ticks).then_some(at + ticks * TICK_NS);
-        if condition != WaitCondition::Ticks {
-            self.motor(motor)?;
-        }
-        self.program.wait = Some(Wait { condition, motor, until_ns: until });
-        self.check_wait();
-        Ok(())
-    }
-
     /// Enters the handler of the most urgent pending interrupt, if the
     /// program may take one now (docs/behaviour.md rule 22).
     /// An enabled interrupt with a vector is pending and may be taken.
@@ -165,17 +117,5 @@ impl Module {
         self.program.clear_pending(n);
         let vector = self.interrupts.vectors[n as usize].expect("checked");
         self.program.enter_handler(vector, self.registers, self.now_ns);
-    }
-
-    /// Raises the interrupt of a source, if the program has it enabled.
-    pub(crate) fn raise(&mut self, source: Source) {
-        if !self.program.is_running() {
-            return;
-        }
-        if let Some(n) = self.profile.interrupt_for(source)
-            && self.interrupts.enabled[n as usize]
-        {
-            self.program.set_pending(n);
-        }
     }
 }

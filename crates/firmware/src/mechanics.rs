@@ -3,67 +3,64 @@
 //! switches the carriage presses (GP 79, AP 12/13) and the ramp the axis
 //! runs with (AP 4/5/130/153/154, reference search speeds, torque mode).
 
-use crate::module::Module;
-use crate::motion;
-use crate::parameter_numbers::{ap, gp};
+use crate::motion::{self, RampMode};
+use crate::motor::{Motor, MotorMut};
+use crate::parameter_numbers::ap;
+use crate::reference_search::{SearchAxis, Switch};
 
-impl Module {
+impl Motor<'_> {
     /// AP 1: the position counter.
-    pub fn actual_position(&self, m: usize) -> i32 {
-        self.wrap_position(self.axes[m].motion.position())
+    pub(crate) fn actual_position(&self) -> i32 {
+        self.wrap_position(self.axis.motion.position())
     }
 
     /// AP 3: the actual speed in internal units.
-    pub fn actual_speed(&self, m: usize) -> i32 {
-        let pd = self.axes[m].params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+    pub(crate) fn actual_speed(&self) -> i32 {
+        let pd = self.axis.params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         // `as` truncates towards zero (and saturates), as the register does.
-        motion::velocity_internal(self.axes[m].motion.v, pd) as i32
+        motion::velocity_internal(self.axis.motion.v, pd) as i32
     }
 
     /// Sign-extends to the module's position width (32 or 24 bits).
     pub(crate) fn wrap_position(&self, v: i64) -> i32 {
-        let bits = self.profile.position_bits();
-        let shift = 64 - bits;
-        ((v << shift) >> shift) as i32
+        crate::motor::wrap_position(v, self.at.position_bits())
     }
 
-    /// Where the carriage of an axis is, in the world's coordinates.
-    pub fn mechanical_position(&self, motor: usize) -> f64 {
-        self.mech(motor, self.axes[motor].motion.x)
+    /// Where the carriage is, in the world's coordinates.
+    pub(crate) fn mechanical_position(&self) -> f64 {
+        self.mech(self.axis.motion.x)
     }
 
-    pub(crate) fn shaft_sign(&self) -> f64 {
-        if self.globals[0][gp::REVERSE_SHAFT as usize] == 1 { -1.0 } else { 1.0 }
-    }
-
-    /// Mechanical position of an axis for a motor position.
-    pub(crate) fn mech(&self, motor: usize, x: f64) -> f64 {
-        x * self.shaft_sign() + self.axes[motor].mech_offset
+    /// Mechanical position of the carriage for a motor position.
+    pub(crate) fn mech(&self, x: f64) -> f64 {
+        x * self.at.shaft_sign() + self.axis.mech_offset
     }
 
     /// Logical switch states (after GP 79 polarity): (left, right, home).
-    pub fn switches(&self, motor: usize) -> (bool, bool, bool) {
-        self.switches_at(motor, self.axes[motor].motion.x)
+    pub(crate) fn switches(&self) -> (bool, bool, bool) {
+        self.switches_at(self.axis.motion.x)
     }
 
-    pub(crate) fn switches_at(&self, motor: usize, x: f64) -> (bool, bool, bool) {
-        let w = &self.world.axes[motor];
-        let invert = self.globals[0][gp::END_SWITCH_POLARITY as usize] == 1;
+    /// The switch states with the motor at `x`.
+    pub(crate) fn switches_at(&self, x: f64) -> (bool, bool, bool) {
+        let w = self.world;
+        let invert = self.at.switches_inverted();
         if !w.has_switch_positions() {
             // Only levels driven by hand: the same everywhere.
             return (w.forced_left.unwrap_or(false) ^ invert, w.forced_right.unwrap_or(false) ^ invert, w.forced_home.unwrap_or(false));
         }
-        let m = self.mech(motor, x);
+        let m = self.mech(x);
         (w.left_pressed(m) ^ invert, w.right_pressed(m) ^ invert, w.home_pressed(m))
     }
 
-    pub(crate) fn stops_at(&self, motor: usize, x: f64) -> motion::Stops {
-        if self.axes[motor].rfs.is_some() {
+    /// What the switches stop with the motor at `x` (AP 12/13, AP 149).
+    pub(crate) fn stops_at(&self, x: f64) -> motion::Stops {
+        if self.axis.rfs.is_some() {
             // AP 12/13 do not influence the reference search.
             return motion::Stops::default();
         }
-        let (left, right, _) = self.switches_at(motor, x);
-        let p = &self.axes[motor].params;
+        let (left, right, _) = self.switches_at(x);
+        let p = &self.axis.params;
         motion::Stops {
             block_positive: right && p[ap::RIGHT_SWITCH_DISABLE as usize] == 0,
             block_negative: left && p[ap::LEFT_SWITCH_DISABLE as usize] == 0,
@@ -71,65 +68,129 @@ impl Module {
         }
     }
 
-    /// Ramp settings of an axis in µsteps and seconds. The plain ramp (no
+    /// Ramp settings of the axis in µsteps and seconds. The plain ramp (no
     /// interpolated move, torque mode or reference search) is worked out
     /// once per change of the axis parameters it comes from.
-    pub(crate) fn ramp(&self, motor: usize) -> motion::Ramp {
-        let axis = &self.axes[motor];
+    #[inline]
+    pub(crate) fn ramp(&self) -> motion::Ramp {
+        let axis = self.axis;
         if let Some(r) = axis.ramp_override {
             return r;
         }
         if axis.closed_loop.torque_mode || axis.rfs.is_some() {
-            return axis.work_out_ramp(axis.closed_loop.torque_mode.then(|| self.torque_mode_velocity(motor)));
+            return axis.work_out_ramp(axis.closed_loop.torque_mode.then(|| self.torque_mode_velocity()));
         }
         axis.plain_ramp(|| axis.work_out_ramp(None))
     }
+
+    /// An axis parameter as a read finds it: the measured ones (position,
+    /// speed, acceleration, switches, current, load, encoder, driver flags,
+    /// closed loop) computed now, the others as stored.
+    #[inline]
+    pub(crate) fn parameter(&self, param: u8) -> i32 {
+        if let Some(v) = self.read_closed_loop(param) {
+            return v;
+        }
+        let axis = self.axis;
+        let pd = axis.params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
+        let rd = axis.params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
+        let motion = &axis.motion;
+        match param {
+            ap::TARGET_POSITION => axis.target_word,
+            ap::ACTUAL_POSITION => self.actual_position(),
+            ap::ACTUAL_SPEED => self.actual_speed(),
+            ap::ACTUAL_ACCELERATION => motion::accel_internal(motion.a, rd, pd).round().clamp(-2047.0, 2047.0) as i32,
+            ap::POSITION_REACHED => i32::from(self.actual_position() == axis.target_word),
+            ap::LEFT_SWITCH => i32::from(self.switches().0),
+            ap::RIGHT_SWITCH => i32::from(self.switches().1),
+            ap::HOME_SWITCH => i32::from(self.switches().2),
+            ap::ACTUAL_CURRENT => self.current_scale().round() as i32,
+            ap::LOAD_VALUE => axis.driver.load_value,
+            ap::ENCODER_POSITION if self.at.features().encoder != tmclsim_profile::Encoder::None => self.encoder_position(),
+            ap::DRIVER_ERROR_FLAGS => self.driver_flags(),
+            _ => axis.params[param as usize],
+        }
+    }
+
+    /// Where the switches change state, in motor coordinates (at most
+    /// eight edges): the edges and how many there are.
+    pub(crate) fn switch_edges(&self) -> ([f64; 8], usize) {
+        let mut edges = [0.0f64; 8];
+        if !self.world.has_switch_positions() {
+            return (edges, 0);
+        }
+        let offset = self.axis.mech_offset;
+        let sign = self.at.shaft_sign();
+        let mut count = 0;
+        for m in self.world.thresholds().take(edges.len()) {
+            edges[count] = (m - offset) * sign;
+            count += 1;
+        }
+        (edges, count)
+    }
 }
 
-#[cfg(test)]
-mod tests {
-    use crate::test_support::{module, ok};
-
-    #[test]
-    fn positions_wrap_in_the_counter_width() {
-        let m = module("tmcm-351");
-        assert_eq!(m.wrap_position(8_388_608), -8_388_608, "24 bits");
-        assert_eq!(m.wrap_position(-8_388_609), 8_388_607);
-        let m = module("tmcm-1141");
-        assert_eq!(m.wrap_position(i64::from(i32::MAX) + 1), i32::MIN, "32 bits");
+impl MotorMut<'_> {
+    /// Sets AP 0 and the target the ramp generator runs to: the short way
+    /// round in the module's position counter width.
+    pub(crate) fn set_target(&mut self, target: i32) {
+        let view = self.view();
+        let diff = view.wrap_position(i64::from(target) - i64::from(view.actual_position()));
+        let axis = &mut *self.axis;
+        axis.target_word = target;
+        axis.params[ap::TARGET_POSITION as usize] = target;
+        axis.motion.target = axis.motion.position() as f64 + f64::from(diff);
     }
 
-    #[test]
-    fn reversed_shaft_mirrors_the_carriage() {
-        let mut m = module("tmcm-1141");
-        ok(&mut m, "SAP 1, 0, 1000");
-        assert_eq!(m.mechanical_position(0), 0.0, "setting the counter does not move the carriage");
-        m.axes[0].motion.x += 500.0;
-        assert_eq!(m.mechanical_position(0), 500.0);
-        ok(&mut m, "SGP 90, 0, 1");
-        assert_eq!(m.mechanical_position(0), -2500.0, "1500 · −1 − 1000");
+    /// Writing AP 1: the position counter takes `value` and the carriage
+    /// does not move; the target stays where AP 0 says.
+    pub(crate) fn set_counter(&mut self, value: i32) {
+        let target = self.axis.target_word;
+        let sign = self.at.shaft_sign();
+        let axis = &mut *self.axis;
+        let mech = axis.motion.x * sign + axis.mech_offset;
+        axis.motion.x = f64::from(value);
+        axis.mech_offset = mech - axis.motion.x * sign;
+        self.set_target(target);
+        self.closed_loop_sync();
+    }
+}
+
+/// The reference search runs on the motor model's view of its axis.
+impl SearchAxis for MotorMut<'_> {
+    fn position(&self) -> f64 {
+        self.axis.motion.x
     }
 
-    #[test]
-    fn switch_polarity_gp79_and_disabled_switches() {
-        let mut m = module("tmcm-1141");
-        m.world_mut().axes[0].left_switch = Some(0.0);
-        assert_eq!(m.switches(0), (true, false, false));
-        assert!(m.stops_at(0, 0.0).block_negative);
-        ok(&mut m, "SAP 13, 0, 1");
-        assert!(!m.stops_at(0, 0.0).block_negative, "AP 13 disables the left switch");
-        ok(&mut m, "SGP 79, 0, 1");
-        assert_eq!(m.switches(0), (false, true, false), "GP 79 inverts the stop switches");
+    fn switch_at(&self, switch: Switch, probe: f64) -> bool {
+        let (l, r, h) = self.view().switches_at(probe);
+        match switch {
+            Switch::Left => l,
+            Switch::Right => r,
+            Switch::Home => h,
+        }
     }
 
-    #[test]
-    fn ramp_follows_the_axis_parameters() {
-        let mut m = module("tmcm-1141");
-        ok(&mut m, "SAP 4, 0, 1000");
-        ok(&mut m, "SAP 154, 0, 3");
-        let r = m.ramp(0);
-        assert_eq!(r.vmax, crate::motion::velocity_pps(1000.0, 3));
-        ok(&mut m, "ROR 0, 200");
-        assert_eq!(m.ramp(0).target_velocity, crate::motion::velocity_pps(200.0, 3));
+    fn halt(&mut self) {
+        self.axis.motion.v = 0.0;
+    }
+
+    fn approach(&mut self, reference: f64) -> bool {
+        let axis = &mut *self.axis;
+        axis.set_ramp_mode(RampMode::Position);
+        axis.motion.target = reference.round();
+        axis.motion.x == axis.motion.target && axis.motion.v == 0.0
+    }
+
+    /// At the reference point: AP 197 keeps the old count, the counter
+    /// becomes 0 here, AP 196 gets the switch distance.
+    fn zero_here(&mut self, distance: Option<f64>) {
+        let last = self.view().actual_position();
+        self.axis.params[ap::LAST_REFERENCE_POSITION as usize] = last;
+        if let Some(d) = distance {
+            self.axis.params[ap::END_SWITCH_DISTANCE as usize] = d.round() as i32;
+        }
+        self.set_counter(0);
+        self.set_target(0);
     }
 }

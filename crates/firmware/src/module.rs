@@ -1,11 +1,13 @@
 //! A virtual TMCL module: the `Module` struct, a composition of its state
-//! (`state/`), its constructors and accessors, and power-up and reset. What
-//! it does lives in the `impl Module` files: the links (`frames.rs`,
-//! `can.rs`, `ascii.rs`), the commands (`executor.rs`, `commands/`), the
-//! program (`interpreter.rs`), the axes (`mechanics.rs`, `driver.rs`,
-//! `closed_loop.rs`) and virtual time (`time.rs`).
+//! (`state/`), its constructors and accessors, the motor model's views of
+//! its axes (`motor.rs`), and power-up and reset. What it does lives in the
+//! `impl Module` files, which call each other top-down: the links
+//! (`frames.rs`, `can.rs`, `ascii.rs`), virtual time (`time.rs`), direct
+//! mode (`control.rs`), the program (`interpreter.rs`), the one dispatch
+//! (`executor.rs`) and the command families (`commands/`).
 
 use crate::eeprom::Eeprom;
+use crate::motor::{Motor, MotorMut, Surroundings};
 use crate::program::{Program, RunMode};
 use crate::state::globals::Globals;
 use crate::state::interrupts::Interrupts;
@@ -121,7 +123,7 @@ impl Module {
     /// mechanical position) without moving the motor: the position counter
     /// keeps its value, as when a carriage is pushed by hand.
     pub fn place_carriage(&mut self, axis: usize, position: f64) {
-        let sign = self.shaft_sign();
+        let sign = self.surroundings().shaft_sign();
         let a = &mut self.axes[axis];
         a.mech_offset = position - a.motion.x * sign;
     }
@@ -168,6 +170,54 @@ impl Module {
     /// Axis `motor` (panics when the module has no such axis).
     pub fn axis(&self, motor: usize) -> &Axis {
         &self.axes[motor]
+    }
+
+    /// The motor model's view of axis `m` (panics when there is none).
+    pub(crate) fn motor_view(&self, m: usize) -> Motor<'_> {
+        Motor { axis: &self.axes[m], world: &self.world.axes[m], at: self.surroundings() }
+    }
+
+    /// The motor model's view of axis `m`, to step it.
+    pub(crate) fn motor_view_mut(&mut self, m: usize) -> MotorMut<'_> {
+        let at = Surroundings::of(&self.profile, &self.globals, &self.world, self.now_ns);
+        MotorMut { axis: &mut self.axes[m], world: &self.world.axes[m], at }
+    }
+
+    /// What the motor model reads of the module around its axes now.
+    pub(crate) fn surroundings(&self) -> Surroundings<'_> {
+        Surroundings::of(&self.profile, &self.globals, &self.world, self.now_ns)
+    }
+
+    /// AP 1 of axis `m`: the position counter.
+    pub fn actual_position(&self, m: usize) -> i32 {
+        self.motor_view(m).actual_position()
+    }
+
+    /// AP 3 of axis `m`: the actual speed in internal units.
+    pub fn actual_speed(&self, m: usize) -> i32 {
+        self.motor_view(m).actual_speed()
+    }
+
+    /// Where the carriage of axis `m` is, in the world's coordinates.
+    pub fn mechanical_position(&self, m: usize) -> f64 {
+        self.motor_view(m).mechanical_position()
+    }
+
+    /// The switches of axis `m` as the module reads them (after GP 79
+    /// polarity): (left, right, home).
+    pub fn switches(&self, m: usize) -> (bool, bool, bool) {
+        self.motor_view(m).switches()
+    }
+
+    /// The current setting in effect on axis `m` (0…255): run, boost,
+    /// standby or off.
+    pub fn motor_current(&self, m: usize) -> u32 {
+        self.motor_view(m).motor_current()
+    }
+
+    /// Sign-extends to the module's position counter width (32 or 24 bits).
+    pub(crate) fn wrap_position(&self, v: i64) -> i32 {
+        crate::motor::wrap_position(v, self.profile.position_bits())
     }
 
     /// The module address (GP 66).
@@ -254,7 +304,7 @@ impl Module {
                 }
             }
             // The carriage stays where it is; the position counter restarts at 0.
-            let sign = self.shaft_sign();
+            let sign = self.surroundings().shaft_sign();
             let mech = old_axes.get(motor as usize).map_or(self.world.axes[motor as usize].start, |a| a.motion.x * sign + a.mech_offset);
             self.axes.push(Axis::new(params, coordinates, mech, self.now_ns));
         }
@@ -287,7 +337,7 @@ impl Module {
             .collect();
         self.io.power_on(pullups, self.world.digital_inputs, switches);
         for m in 0..self.axes.len() {
-            self.closed_loop_power_on(m);
+            self.motor_view_mut(m).closed_loop_power_on();
         }
         self.link.ascii = self.globals[0][gp::ASCII_MODE as usize] & 1 == 1;
         self.link.new_ascii_session();

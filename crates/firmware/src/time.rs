@@ -1,12 +1,11 @@
 //! Virtual time: advancing the module and what happens on its own — the
 //! program's batches and WAITs, timers, input and switch edges, the
-//! heartbeat, the motors moving and the driver watching them.
+//! heartbeat, the motors moving and the driver watching them; and the
+//! debugger's single step, which runs time until one instruction is done.
 
 use crate::module::Module;
-use crate::parameter_numbers::{ap, gp};
+use crate::parameter_numbers::gp;
 use crate::program::{RunMode, Source};
-use crate::state::registers::error_flag;
-use tmclsim_profile::StallDetection;
 use tmclsim_protocol::{Instruction, WaitCondition, opcode};
 
 /// The driver measures load, stall and encoder deviation of a watched,
@@ -166,6 +165,23 @@ impl Module {
         }
     }
 
+    /// Runs until one more instruction has executed (a WAIT in progress
+    /// first ends), then pauses; time stops at most `slice_ns` after it.
+    /// Returns false when `limit_ns` came first. Front ends step with
+    /// [`crate::Bus::step_instruction`].
+    pub(crate) fn step_instruction(&mut self, limit_ns: u64, slice_ns: u64) -> bool {
+        let before = self.program.executed;
+        self.program.single_step = true;
+        self.start_program();
+        while self.program.executed == before && self.now_ns < limit_ns && self.program.mode == RunMode::Run {
+            let next = if self.program.wait.is_some() { self.now_ns + slice_ns } else { self.program.next_ns.max(self.now_ns + 1) };
+            self.advance_to(next.min(limit_ns));
+        }
+        self.program.single_step = false;
+        self.pause_program();
+        self.program.executed != before
+    }
+
     /// Advances virtual time to an absolute time (no-op if in the past).
     pub(crate) fn advance_to(&mut self, t_ns: u64) {
         if t_ns > self.now_ns {
@@ -223,7 +239,7 @@ impl Module {
             next = earliest(next, Some(self.now_ns + DRIVER_SAMPLE_NS));
         }
         let armed = self.motion_interrupts_armed();
-        let mut quiet = !watches && !armed && !self.has_closed_loop();
+        let mut quiet = !watches && !armed && !self.profile.features.closed_loop;
         for (motor, axis) in self.axes.iter().enumerate() {
             quiet &= !axis.notify_on_arrival && axis.rfs.is_none();
             if axis.motion.v == 0.0 && !axis.notify_on_arrival && !armed {
@@ -253,33 +269,16 @@ impl Module {
         if self.axes[motor].motion.v == 0.0 && self.time_to_rest(motor).is_some_and(|s| s <= 0.0) {
             return None;
         }
-        let (edges, count) = self.switch_edges(motor);
+        let view = self.motor_view(motor);
+        let (edges, count) = view.switch_edges();
         if count == 0 {
             return None;
         }
-        let ramp = self.ramp(motor);
-        let mut probe = self.axes[motor].motion.clone();
-        let mut stops = |x: f64| self.stops_at(motor, x);
+        let ramp = view.ramp();
+        let mut probe = view.axis.motion.clone();
+        let mut stops = |x: f64| view.stops_at(x);
         let step = probe.advance(EDGE_HORIZON_S, &ramp, &mut stops, &edges[..count], true);
         step.crossed.map(|_| self.now_ns + (step.elapsed * 1e9).ceil().max(1.0) as u64)
-    }
-
-    /// Where the switches of an axis change state, in motor coordinates
-    /// (at most eight edges): the edges and how many there are.
-    fn switch_edges(&self, motor: usize) -> ([f64; 8], usize) {
-        let mut edges = [0.0f64; 8];
-        let world = &self.world.axes[motor];
-        if !world.has_switch_positions() {
-            return (edges, 0);
-        }
-        let offset = self.axes[motor].mech_offset;
-        let sign = self.shaft_sign();
-        let mut count = 0;
-        for m in world.thresholds().take(edges.len()) {
-            edges[count] = (m - offset) * sign;
-            count += 1;
-        }
-        (edges, count)
     }
 
     /// Timer `t`'s interrupt number and period in ns, while it runs (the
@@ -305,13 +304,14 @@ impl Module {
     }
 
     fn time_to_rest(&self, motor: usize) -> Option<f64> {
-        let ramp = self.ramp(motor);
-        let mut stops = |x: f64| self.stops_at(motor, x);
-        self.axes[motor].motion.time_to_rest(&ramp, &mut stops)
+        let view = self.motor_view(motor);
+        let ramp = view.ramp();
+        let mut stops = |x: f64| view.stops_at(x);
+        view.axis.motion.time_to_rest(&ramp, &mut stops)
     }
 
     fn advance_axis(&mut self, motor: usize, dt_ns: u64) {
-        let (edges, count) = self.switch_edges(motor);
+        let (edges, count) = self.motor_view(motor).switch_edges();
         let edges = &edges[..count];
         let was_moving = self.axes[motor].motion.v != 0.0;
         let searching = self.axes[motor].rfs.is_some();
@@ -322,20 +322,22 @@ impl Module {
         // A reference search looks at every switch edge it passes; plain
         // motion goes through the whole step at once.
         for _ in 0..64 {
-            let ramp = self.ramp(motor);
+            let ramp = self.motor_view(motor).ramp();
             let x_before = self.axes[motor].motion.x;
             let step = if self.world.axes[motor].has_switch_positions() {
                 let mut motion = std::mem::take(&mut self.axes[motor].motion);
-                let mut stops = |x: f64| self.stops_at(motor, x);
+                let view = self.motor_view(motor);
+                let mut stops = |x: f64| view.stops_at(x);
                 let step = motion.advance(left, &ramp, &mut stops, edges, searching);
                 self.axes[motor].motion = motion;
                 step
             } else {
                 // The switches read the same everywhere: so do the stops.
-                let fixed = self.stops_at(motor, x_before);
+                let fixed = self.motor_view(motor).stops_at(x_before);
                 self.axes[motor].motion.advance(left, &ramp, &mut |_| fixed, edges, searching)
             };
-            self.drive(motor, x_before, step.elapsed);
+            let alarms = self.motor_view_mut(motor).drive(x_before, step.elapsed);
+            self.sound(motor, alarms);
             if let Some(t) = step.stopped_at {
                 stopped_at = Some(elapsed + t);
             }
@@ -354,7 +356,8 @@ impl Module {
         let rest = dt_ns as f64 * 1e-9 - elapsed;
         if rest > 1e-12 {
             let x = self.axes[motor].motion.x;
-            self.drive(motor, x, rest);
+            let alarms = self.motor_view_mut(motor).drive(x, rest);
+            self.sound(motor, alarms);
         }
         let moving = self.axes[motor].motion.v != 0.0;
         let axis = &mut self.axes[motor];
@@ -418,31 +421,6 @@ impl Module {
         }
     }
 
-    /// Ends a WAIT whose condition holds or whose time is up.
-    pub(crate) fn check_wait(&mut self) {
-        let Some(w) = self.program.wait else { return };
-        let m = w.motor as usize;
-        let met = match w.condition {
-            WaitCondition::Ticks => w.until_ns.is_none_or(|u| self.now_ns >= u),
-            WaitCondition::Position => self.actual_position(m) == self.axes[m].target_word && self.axes[m].motion.v == 0.0,
-            WaitCondition::ReferenceSwitch => self.switches(m).2,
-            WaitCondition::LimitSwitch => {
-                let (l, r, _) = self.switches(m);
-                l || r
-            }
-            WaitCondition::ReferenceSearch => !self.axes[m].reference_search_active(),
-        };
-        if met {
-            self.program.wait = None;
-        } else if w.condition != WaitCondition::Ticks && w.until_ns.is_some_and(|u| self.now_ns >= u) {
-            self.registers.errors |= error_flag::TIMEOUT;
-            self.program.wait = None;
-        }
-        if self.program.wait.is_none() {
-            self.program.next_ns = self.program.next_ns.max(self.now_ns);
-        }
-    }
-
     /// When the world must be looked at again for the WAIT in progress.
     pub(crate) fn wait_horizon(&self) -> Option<u64> {
         let w = self.program.wait?;
@@ -503,30 +481,10 @@ impl Module {
         next
     }
 
-    /// Some moving axis has something the driver must look at often: a
-    /// load, stall detection, coolStep, an encoder deviation limit, or a
-    /// driver that is off.
+    /// Some moving axis has something the driver must look at often
+    /// ([`crate::motor::Motor::watched`]).
     pub(crate) fn driver_watches(&self) -> bool {
-        let f = &self.profile.features;
-        let closed_loop = self.has_closed_loop();
-        self.axes.iter().zip(&self.world.axes).enumerate().any(|(m, (axis, world))| {
-            let p = &axis.params;
-            if closed_loop && (axis.closed_loop.torque_mode || self.lag(m).abs() > 1e-6) {
-                return true;
-            }
-            let will_move = axis.motion.v != 0.0
-                || match axis.motion.mode {
-                    crate::motion::RampMode::Velocity => p[ap::TARGET_SPEED as usize] != 0,
-                    _ => axis.motion.x != axis.motion.target,
-                };
-            will_move
-                && (!world.loads.is_empty()
-                    || (f.stall_detection == StallDetection::Stallguard2 && p[ap::STOP_ON_STALL as usize] > 0)
-                    || (f.stall_detection == StallDetection::Tmc249 && p[ap::STALL_THRESHOLD as usize] > 0)
-                    || (f.coolstep && p[ap::SMART_ENERGY_HYSTERESIS_START as usize] > 0)
-                    || (f.encoder_deviation_stop && p[ap::MAX_ENCODER_DEVIATION as usize] > 0)
-                    || self.driver_off(m))
-        })
+        (0..self.axes.len()).any(|m| self.motor_view(m).watched())
     }
 }
 

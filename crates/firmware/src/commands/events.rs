@@ -1,8 +1,12 @@
 //! Interrupts and events: EI, DI, VECT and 138 are the interrupt part's
-//! (`state/interrupts.rs`); here the event frames that the arrival of an
-//! armed move produces, addressed as the link last spoke.
+//! (`state/interrupts.rs`); here what raises an interrupt (a source the
+//! program enabled, the alarms of a driver step) and the event frames that
+//! the arrival of an armed move produces, addressed as the link last spoke.
 
 use crate::module::Module;
+use crate::motor::Alarms;
+use crate::program::Source;
+use crate::state::registers::error_flag;
 use tmclsim_protocol::{FRAME_LEN, Reply, Status, opcode};
 
 impl Module {
@@ -16,6 +20,32 @@ impl Module {
         self.interrupts.has_events()
     }
 
+    /// Raises the interrupt of a source, if the program has it enabled.
+    pub(crate) fn raise(&mut self, source: Source) {
+        if !self.program.is_running() {
+            return;
+        }
+        if let Some(n) = self.profile.interrupt_for(source)
+            && self.interrupts.enabled[n as usize]
+        {
+            self.program.set_pending(n);
+        }
+    }
+
+    /// Raises what a driver step of axis `m` found: a stall, a deviation
+    /// (with its error flag).
+    pub(crate) fn sound(&mut self, m: usize, alarms: Alarms) {
+        if alarms.stall {
+            self.raise(Source::Stall(m as u8));
+        }
+        if alarms.deviation {
+            self.registers.errors |= error_flag::DEVIATION;
+            self.raise(Source::Deviation(m as u8));
+        }
+    }
+
+    /// Queues a 138 event frame for the motors of `mask`, addressed as the
+    /// link last spoke.
     pub(crate) fn push_event(&mut self, mask: u32) {
         let reply = Reply::new(self.host_address(), self.link.last_address, Status::Event, opcode::TARGET_REACHED_EVENT, mask as i32);
         self.interrupts.push_event(reply.encode());

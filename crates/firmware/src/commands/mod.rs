@@ -1,15 +1,15 @@
 //! The command families that span several parts of the module, one file
-//! per family; `executor.rs` matches every decoded command once and hands
-//! it here or straight to the part that owns it. Here: what the families
-//! share.
+//! per family; `executor.rs` matches every decoded command but the
+//! control commands (`control.rs`) once and hands it here or straight to
+//! the part that owns it. Here: what the families share.
 
 mod calculation;
 mod coordinates;
 mod events;
+mod flow;
 mod io;
 mod motion;
 mod parameters;
-mod program_control;
 
 use crate::module::Module;
 use tmclsim_protocol::Status;

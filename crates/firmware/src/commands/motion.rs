@@ -5,7 +5,7 @@
 use crate::module::Module;
 use crate::motion::{Motion, RampMode};
 use crate::parameter_numbers::ap;
-use crate::reference_search::{ReferenceSearch, SearchAxis, Switch};
+use crate::reference_search::ReferenceSearch;
 use tmclsim_protocol::{MoveMode, RfsAction, Status};
 
 impl Module {
@@ -73,7 +73,7 @@ impl Module {
         if axis.motion.mode != RampMode::Soft {
             axis.set_ramp_mode(RampMode::Position);
         }
-        self.set_target(m, target);
+        self.motor_view_mut(m).set_target(target);
         if self.interrupts.claim_arrival_event(m) {
             self.axes[m].notify_on_arrival = true;
             if self.axes[m].motion.x == self.axes[m].motion.target && self.axes[m].motion.v == 0.0 {
@@ -123,14 +123,14 @@ impl Module {
             .iter()
             .map(|&m| {
                 let d = (self.axes[m].motion.target - self.axes[m].motion.x).abs();
-                (m, d, Motion::closed_form_duration(d, &self.ramp(m)))
+                (m, d, Motion::closed_form_duration(d, &self.motor_view(m).ramp()))
             })
             .collect();
         let &(lead, d_lead, _) = plans.iter().max_by(|a, b| a.2.total_cmp(&b.2)).expect("motors is not empty");
         if d_lead == 0.0 {
             return Ok(());
         }
-        let lead_ramp = self.ramp(lead);
+        let lead_ramp = self.motor_view(lead).ramp();
         for (m, d, _) in plans {
             if m != lead {
                 let k = d / d_lead;
@@ -142,17 +142,6 @@ impl Module {
             }
         }
         Ok(())
-    }
-
-    /// Sets AP 0 and the target the ramp generator runs to: the short way
-    /// round in the module's position counter width.
-    pub(crate) fn set_target(&mut self, m: usize, target: i32) {
-        let actual = self.actual_position(m);
-        let diff = self.wrap_position(i64::from(target) - i64::from(actual));
-        let axis = &mut self.axes[m];
-        axis.target_word = target;
-        axis.params[ap::TARGET_POSITION as usize] = target;
-        axis.motion.target = axis.motion.position() as f64 + f64::from(diff);
     }
 
     /// RFS START with the mode of AP 193.
@@ -175,57 +164,9 @@ impl Module {
     /// Lets the reference search look at its axis after a step of motion.
     pub(crate) fn reference_search_step(&mut self, m: usize, crossed: bool, arrived: bool) {
         let Some(mut rfs) = self.axes[m].rfs.take() else { return };
-        if rfs.step(&mut SearchedAxis { module: self, m }, crossed, arrived) {
+        if rfs.step(&mut self.motor_view_mut(m), crossed, arrived) {
             self.axes[m].rfs = Some(rfs);
         }
-    }
-
-    /// At the reference point: AP 197 keeps the old count, the counter
-    /// becomes 0 here, AP 196 gets the switch distance.
-    fn finish_reference_search(&mut self, m: usize, distance: Option<f64>) {
-        let last = self.actual_position(m);
-        self.axes[m].params[ap::LAST_REFERENCE_POSITION as usize] = last;
-        if let Some(d) = distance {
-            self.axes[m].params[ap::END_SWITCH_DISTANCE as usize] = d.round() as i32;
-        }
-        self.write_axis_parameter(m, ap::ACTUAL_POSITION, 0);
-        self.set_target(m, 0);
-    }
-}
-
-/// The axis a reference search runs on, as the search sees it.
-struct SearchedAxis<'a> {
-    module: &'a mut Module,
-    m: usize,
-}
-
-impl SearchAxis for SearchedAxis<'_> {
-    fn position(&self) -> f64 {
-        self.module.axes[self.m].motion.x
-    }
-
-    fn switch_at(&self, switch: Switch, probe: f64) -> bool {
-        let (l, r, h) = self.module.switches_at(self.m, probe);
-        match switch {
-            Switch::Left => l,
-            Switch::Right => r,
-            Switch::Home => h,
-        }
-    }
-
-    fn halt(&mut self) {
-        self.module.axes[self.m].motion.v = 0.0;
-    }
-
-    fn approach(&mut self, reference: f64) -> bool {
-        let axis = &mut self.module.axes[self.m];
-        axis.set_ramp_mode(RampMode::Position);
-        axis.motion.target = reference.round();
-        axis.motion.x == axis.motion.target && axis.motion.v == 0.0
-    }
-
-    fn zero_here(&mut self, distance: Option<f64>) {
-        self.module.finish_reference_search(self.m, distance);
     }
 }
 

@@ -8,7 +8,7 @@
 
 use crate::closed_loop::cl;
 use crate::module::Module;
-use crate::motion::{self, RampMode};
+use crate::motion::RampMode;
 use crate::parameter_numbers::{ap, gp};
 use crate::state::parameters::{axis_spec, global_spec, takes};
 use tmclsim_protocol::Status;
@@ -69,47 +69,39 @@ impl Module {
 
     /// Writes a parameter with its side effects (no access check).
     pub(crate) fn write_axis_parameter(&mut self, m: usize, param: u8, value: i32) {
+        let closed_loop = self.profile.features.closed_loop;
+        let encoder = self.profile.features.encoder != tmclsim_profile::Encoder::None;
+        let mut motor = self.motor_view_mut(m);
         match param {
-            ap::TARGET_POSITION => self.set_target(m, value),
-            ap::ACTUAL_POSITION => {
-                let target = self.axes[m].target_word;
-                let sign = self.shaft_sign();
-                let axis = &mut self.axes[m];
-                // The carriage does not move: only the counter changes.
-                let mech = axis.motion.x * sign + axis.mech_offset;
-                axis.motion.x = f64::from(value);
-                axis.mech_offset = mech - axis.motion.x * sign;
-                self.set_target(m, target);
-                self.closed_loop_sync(m);
-            }
+            ap::TARGET_POSITION => motor.set_target(value),
+            ap::ACTUAL_POSITION => motor.set_counter(value),
             ap::RAMP_MODE => {
-                let axis = &mut self.axes[m];
-                axis.set_ramp_mode(RampMode::from_code(value));
+                motor.axis.set_ramp_mode(RampMode::from_code(value));
                 // AP 138 keeps the word as written.
-                axis.params[param as usize] = value;
+                motor.axis.params[param as usize] = value;
             }
-            ap::ENCODER_POSITION if self.has_closed_loop() => {
-                let now = f64::from(self.closed_loop_encoder(m)) - self.axes[m].closed_loop.encoder_offset;
-                self.axes[m].closed_loop.encoder_offset = f64::from(value) - now;
+            ap::ENCODER_POSITION if closed_loop => {
+                let now = f64::from(motor.view().closed_loop_encoder()) - motor.axis.closed_loop.encoder_offset;
+                motor.axis.closed_loop.encoder_offset = f64::from(value) - now;
             }
             // Without an encoder input AP 209 is a plain value (profiles/README.md).
-            ap::ENCODER_POSITION if self.profile.features.encoder != tmclsim_profile::Encoder::None => {
-                let now = i64::from(self.encoder_position(m)) - self.axes[m].encoder_offset;
-                self.axes[m].encoder_offset = i64::from(value) - now;
+            ap::ENCODER_POSITION if encoder => {
+                let now = i64::from(motor.view().encoder_position()) - motor.axis.encoder_offset;
+                motor.axis.encoder_offset = i64::from(value) - now;
             }
-            cl::TORQUE_TARGET if self.has_closed_loop() => {
+            cl::TORQUE_TARGET if closed_loop => {
                 // Torque mode: the driver sets this current (mA).
-                let axis = &mut self.axes[m];
+                let axis = &mut *motor.axis;
                 axis.params[param as usize] = value;
                 axis.end_overrides();
                 axis.closed_loop.torque_mode = true;
                 axis.set_ramp_mode(RampMode::Velocity);
             }
-            cl::MODE if self.has_closed_loop() => {
-                self.axes[m].params[param as usize] = value;
-                self.closed_loop_sync(m);
+            cl::MODE if closed_loop => {
+                motor.axis.params[param as usize] = value;
+                motor.closed_loop_sync();
             }
-            _ => self.axes[m].params[param as usize] = value,
+            _ => motor.axis.params[param as usize] = value,
         }
     }
 
@@ -125,27 +117,7 @@ impl Module {
 
     /// A parameter's value as a read finds it, computing the measured ones.
     pub(crate) fn axis_parameter_value(&self, m: usize, param: u8) -> i32 {
-        if let Some(v) = self.read_closed_loop(m, param) {
-            return v;
-        }
-        let pd = self.axes[m].params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        let rd = self.axes[m].params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
-        let motion = &self.axes[m].motion;
-        match param {
-            ap::TARGET_POSITION => self.axes[m].target_word,
-            ap::ACTUAL_POSITION => self.actual_position(m),
-            ap::ACTUAL_SPEED => self.actual_speed(m),
-            ap::ACTUAL_ACCELERATION => motion::accel_internal(motion.a, rd, pd).round().clamp(-2047.0, 2047.0) as i32,
-            ap::POSITION_REACHED => i32::from(self.actual_position(m) == self.axes[m].target_word),
-            ap::LEFT_SWITCH => i32::from(self.switches(m).0),
-            ap::RIGHT_SWITCH => i32::from(self.switches(m).1),
-            ap::HOME_SWITCH => i32::from(self.switches(m).2),
-            ap::ACTUAL_CURRENT => self.current_scale(m).round() as i32,
-            ap::LOAD_VALUE => self.axes[m].driver.load_value,
-            ap::ENCODER_POSITION if self.profile.features.encoder != tmclsim_profile::Encoder::None => self.encoder_position(m),
-            ap::DRIVER_ERROR_FLAGS => self.driver_flags(m),
-            _ => self.axes[m].params[param as usize],
-        }
+        self.motor_view(m).parameter(param)
     }
 
     /// SGP: writes global parameter `param` of `bank` after the profile's
@@ -348,5 +320,50 @@ mod tests {
         let a = [ok(&mut m, "GGP 133, 0"), ok(&mut m, "GGP 133, 0")];
         ok(&mut m, "SGP 133, 0, 99");
         assert_eq!([ok(&mut m, "GGP 133, 0"), ok(&mut m, "GGP 133, 0")], a, "the same seed, the same numbers");
+    }
+
+    // ----- the motor model read through the parameters (mechanics.rs)
+
+    #[test]
+    fn positions_wrap_in_the_counter_width() {
+        let m = module("tmcm-351");
+        assert_eq!(m.wrap_position(8_388_608), -8_388_608, "24 bits");
+        assert_eq!(m.wrap_position(-8_388_609), 8_388_607);
+        let m = module("tmcm-1141");
+        assert_eq!(m.wrap_position(i64::from(i32::MAX) + 1), i32::MIN, "32 bits");
+    }
+
+    #[test]
+    fn reversed_shaft_mirrors_the_carriage() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "SAP 1, 0, 1000");
+        assert_eq!(m.mechanical_position(0), 0.0, "setting the counter does not move the carriage");
+        m.axes[0].motion.x += 500.0;
+        assert_eq!(m.mechanical_position(0), 500.0);
+        ok(&mut m, "SGP 90, 0, 1");
+        assert_eq!(m.mechanical_position(0), -2500.0, "1500 · −1 − 1000");
+    }
+
+    #[test]
+    fn switch_polarity_gp79_and_disabled_switches() {
+        let mut m = module("tmcm-1141");
+        m.world_mut().axes[0].left_switch = Some(0.0);
+        assert_eq!(m.switches(0), (true, false, false));
+        assert!(m.motor_view(0).stops_at(0.0).block_negative);
+        ok(&mut m, "SAP 13, 0, 1");
+        assert!(!m.motor_view(0).stops_at(0.0).block_negative, "AP 13 disables the left switch");
+        ok(&mut m, "SGP 79, 0, 1");
+        assert_eq!(m.switches(0), (false, true, false), "GP 79 inverts the stop switches");
+    }
+
+    #[test]
+    fn ramp_follows_the_axis_parameters() {
+        let mut m = module("tmcm-1141");
+        ok(&mut m, "SAP 4, 0, 1000");
+        ok(&mut m, "SAP 154, 0, 3");
+        let r = m.motor_view(0).ramp();
+        assert_eq!(r.vmax, crate::motion::velocity_pps(1000.0, 3));
+        ok(&mut m, "ROR 0, 200");
+        assert_eq!(m.motor_view(0).ramp().target_velocity, crate::motion::velocity_pps(200.0, 3));
     }
 }

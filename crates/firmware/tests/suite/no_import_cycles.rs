@@ -200,12 +200,95 @@ fn no_crate_has_import_cycles() {
 #[test]
 fn state_and_leaf_types_do_not_depend_on_module() {
     let graph = crate_graph("firmware");
-    let leaves = ["outcome", "parameter_numbers", "program", "motion", "reference_search", "eeprom", "world", "world_file", "world_rules"];
+    let leaves = [
+        "outcome",
+        "parameter_numbers",
+        "program",
+        "motion",
+        "reference_search",
+        "eeprom",
+        "world",
+        "world_file",
+        "world_rules",
+        // The motor model: it sees an axis, its world and its surroundings.
+        "motor",
+        "mechanics",
+        "driver",
+        "closed_loop",
+    ];
     let checked: Vec<&String> = graph.keys().filter(|m| m.starts_with("state") || leaves.contains(&m.as_str())).collect();
     assert!(checked.iter().any(|m| m.starts_with("state::")), "the state files are found");
     for m in checked {
         assert!(!reaches(&graph, m, "module"), "{m} depends on module.rs");
     }
+}
+
+/// The files of the firmware that extend `Module` (`impl Module { … }`),
+/// each with the methods it defines there and the `self.method(…)` calls
+/// its blocks make.
+fn module_methods() -> BTreeMap<String, (BTreeSet<String>, BTreeSet<String>)> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut paths = Vec::new();
+    rust_files(&src, &mut paths);
+    let mut out = BTreeMap::new();
+    for p in paths {
+        let t = tokens(&std::fs::read_to_string(&p).unwrap());
+        let (mut defined, mut called) = (BTreeSet::new(), BTreeSet::new());
+        let mut i = 0;
+        while i + 2 < t.len() {
+            let opens = ident(t.get(i)) == Some("impl") && ident(t.get(i + 1)) == Some("Module") && t[i + 2] == Token::Punct('{');
+            if !opens {
+                i += 1;
+                continue;
+            }
+            i += 3;
+            let mut depth = 1;
+            while i < t.len() && depth > 0 {
+                match (&t[i], t.get(i + 1), t.get(i + 2), t.get(i + 3)) {
+                    (Token::Punct('{'), ..) => depth += 1,
+                    (Token::Punct('}'), ..) => depth -= 1,
+                    (Token::Ident(f), Some(name), ..) if f == "fn" && depth == 1 => {
+                        defined.extend(ident(Some(name)).map(String::from));
+                    }
+                    (Token::Ident(s), Some(Token::Punct('.')), Some(name), Some(Token::Punct('('))) if s == "self" => {
+                        called.extend(ident(Some(name)).map(String::from));
+                    }
+                    _ => {}
+                }
+                i += 1;
+            }
+        }
+        if !defined.is_empty() {
+            out.insert(module_of(&src, &p), (defined, called));
+        }
+    }
+    out
+}
+
+/// Which `impl Module` file calls which: a file depends on each other
+/// file that defines a method its blocks call.
+fn call_graph() -> Graph {
+    let files = module_methods();
+    files
+        .iter()
+        .map(|(file, (_, called))| {
+            let deps = files.iter().filter(|(f, (defined, _))| *f != file && !defined.is_disjoint(called)).map(|(f, _)| f.clone());
+            (file.clone(), deps.collect())
+        })
+        .collect()
+}
+
+/// The `impl Module` files call each other top-down too: the links on the
+/// direct mode, the direct mode on the interpreter, the interpreter on the
+/// one dispatch, the dispatch on the command families, the families on the
+/// module's accessors; time on the interpreter and the families.
+#[test]
+fn the_module_files_call_each_other_without_cycles() {
+    let graph = call_graph();
+    assert!(graph.get("time").is_some_and(|d| d.contains("interpreter")), "the graph sees time.rs run the interpreter: {graph:?}");
+    assert!(graph.get("interpreter").is_some_and(|d| d.contains("executor")), "and the interpreter dispatch");
+    let found: Vec<String> = cycles(&graph).iter().map(|c| c.join(" → ")).collect();
+    assert!(found.is_empty(), "call cycles between `impl Module` files:\n{}", found.join("\n"));
 }
 
 #[test]

@@ -1,14 +1,111 @@
-//! Program control, 128–135: stop, run, step and reset the program; enter
-//! and leave download mode and store words in it; read program memory and
-//! the application status. Also the same operations for tools.
+//! Direct mode: a host's command. The control commands (128–139, 255)
+//! are a host's only: stop, run, step and reset the program; enter and
+//! leave download mode and store words in it; read program memory and the
+//! application status; the version, factory defaults, 138 events, ASCII
+//! mode and reset. Every other command goes to the one dispatch
+//! (`executor.rs`), as a program's instructions do. Also the same program
+//! operations for tools.
 
 use crate::module::Module;
-use crate::outcome::{Outcome, Special};
+use crate::outcome::{Origin, Outcome, Special};
 use crate::parameter_numbers::gp;
 use crate::program::RunMode;
-use tmclsim_protocol::{Instruction, Status};
+use tmclsim_protocol::frame::version_string_reply;
+use tmclsim_protocol::{Command, FRAME_LEN, Instruction, Status, opcode};
+
+/// Key that 137 and 255 require.
+pub(crate) const MAGIC_KEY: i32 = 1234;
 
 impl Module {
+    /// Executes one instruction in direct mode.
+    pub fn execute(&mut self, ins: Instruction) -> Outcome {
+        if !self.profile.has_opcode(ins.opcode) {
+            return Outcome::error(Status::InvalidCommand, ins.value);
+        }
+        let cmd = match Command::decode(ins) {
+            Ok(c) => c,
+            Err(e) => return Outcome::error(e.status(), ins.value),
+        };
+        let outcome =
+            if opcode::is_control(ins.opcode) { self.control(cmd, ins) } else { self.dispatch(cmd, ins, Origin::Direct, self.now_ns) };
+        outcome.unwrap_or_else(|status| Outcome::error(status, ins.value))
+    }
+
+    /// A control command (128–139, 255), the one match over them. The
+    /// value of the outcome is what the reply carries.
+    fn control(&mut self, cmd: Command, ins: Instruction) -> Result<Outcome, Status> {
+        use Command::*;
+        let echo = ins.value;
+        let value = match cmd {
+            // ----- the program: 128–135 -----------------------------------
+            StopApplication => {
+                self.program.stop_application();
+                0
+            }
+            RunApplication { from } => self.run_application(from)?,
+            StepApplication => {
+                self.step_application();
+                0
+            }
+            ResetApplication => {
+                self.program.reset_application();
+                self.registers = Default::default();
+                0
+            }
+            EnterDownload { address } => self.enter_download(address)?,
+            ExitDownload => {
+                if self.program.exit_download() {
+                    // The downloaded words are in the EEPROM image; save it.
+                    self.persistence.mark_written();
+                }
+                0
+            }
+            ReadMemory { address } => {
+                let stored = self.read_memory(address)?;
+                let frame = tmclsim_protocol::frame::memory_reply(self.host_address(), stored);
+                return Ok(Outcome { status: Status::Ok, value: address, special: Special::Frame(frame) });
+            }
+            ApplicationStatus { kind } => self.application_status(kind),
+
+            // ----- the module: 136–139, 255 -------------------------------
+            FirmwareVersion { binary: true } => self.profile.version_word(),
+            FirmwareVersion { binary: false } => {
+                return Ok(Outcome { status: Status::Ok, value: 0, special: Special::Frame(self.special_version()) });
+            }
+            FactoryDefaults { key } => {
+                if key != MAGIC_KEY {
+                    return Err(Status::InvalidValue);
+                }
+                // A locked configuration EEPROM is not erased either
+                // (docs/behaviour.md rule 73).
+                self.persistence.factory_defaults(&self.globals)?;
+                self.reset();
+                return Ok(Outcome { status: Status::Ok, value: key, special: Special::Silent });
+            }
+            Reset { key } => {
+                if key != MAGIC_KEY {
+                    return Err(Status::InvalidValue);
+                }
+                // handle_frame resets after the reply has been built.
+                echo
+            }
+            TargetReachedEvent { every_move, mask } => self.interrupts.arm_events(every_move, mask, self.axes.len())?,
+            AsciiMode => {
+                // The reply goes out in binary; then the link speaks text.
+                self.link.enter_ascii_mode();
+                echo
+            }
+            // Not a control command: `execute` dispatches those.
+            _ => return Err(Status::InvalidCommand),
+        };
+        Ok(Outcome::ok(value))
+    }
+
+    /// 136 type 0: the version text as a frame.
+    pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
+        version_string_reply(self.host_address(), &self.profile.version_text())
+    }
+
     /// 129: runs the program, from `from` when given; the reply carries it.
     pub(crate) fn run_application(&mut self, from: Option<i32>) -> Result<i32, Status> {
         if let Some(address) = from {
