@@ -9,9 +9,9 @@
 //! must carry out (EEPROM images to persist, 138 events to send) it takes
 //! with [`Bus::take_effects`]; observers look at [`Bus::snapshot`].
 
-use crate::can::CanFrame;
 use crate::clock::Clock;
 use crate::module::Module;
+use crate::module::can::CanFrame;
 use crate::snapshot::ModuleSnapshot;
 use crate::world_command::WorldCommand;
 use crate::world_error::WorldError;
@@ -240,7 +240,7 @@ impl Bus {
     /// One byte of text for the modules in ASCII mode from a link whose
     /// lines are `lines` (docs/behaviour.md rule 83); echoes and replies
     /// are appended to `out`.
-    pub fn ascii_byte(&mut self, lines: &mut crate::ascii::LineState, byte: u8, out: &mut Vec<u8>) {
+    pub fn ascii_byte(&mut self, lines: &mut crate::module::ascii::LineState, byte: u8, out: &mut Vec<u8>) {
         self.catch_up();
         if lines.lines.len() < self.modules.len() {
             lines.lines.resize_with(self.modules.len(), Default::default);

@@ -6,19 +6,12 @@
 //! [`Module::handle_frame`] / [`Module::execute`] and the passing of
 //! virtual time, which only a [`Bus`] moves ([`Bus::advance_to`]).
 
-pub mod ascii;
 pub mod bus;
-pub mod can;
 pub mod clock;
 pub mod closed_loop;
-mod commands;
-mod control;
 pub mod driver;
 pub mod eeprom;
 pub mod eeprom_rules;
-mod executor;
-mod frames;
-mod interpreter;
 pub mod link_id;
 mod mechanics;
 pub mod module;
@@ -33,7 +26,6 @@ pub mod snapshot;
 mod state;
 #[cfg(test)]
 mod test_support;
-mod time;
 pub mod world;
 pub mod world_command;
 pub mod world_error;
@@ -46,6 +38,7 @@ pub use clock::Clock;
 pub use eeprom::Eeprom;
 pub use link_id::{IN_PROCESS, LinkId};
 pub use module::{Module, Outcome, Special};
+pub use module::{ascii, can};
 pub use profile::Profile;
 pub use world::World;
 pub use world_error::WorldError;

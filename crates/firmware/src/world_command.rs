@@ -1,7 +1,7 @@
 //! Typed commands that change (or show) the world around a module, and
 //! their text form: the control protocol of docs/world.md. Every front end
 //! (control socket, `tmclsim world`, Python) parses a line into a
-//! [`WorldCommand`] and applies it through [`Bus::apply_world`]
+//! [`WorldCommand`] and applies it through [`crate::Bus::apply_world`]
 //! (crate::bus::Bus::apply_world).
 
 use crate::module::Module;

@@ -200,7 +200,7 @@ impl Module {
     /// 138 event watches, a heartbeat stop, the driver's next measurement
     /// of a watched moving motor (docs/behaviour.md rule 81). `None`: nothing
     /// happens until a request comes. A deadline at or before now means
-    /// "due now". [`Module::advance`] moves from one deadline to the next.
+    /// "due now". `Module::advance` moves from one deadline to the next.
     pub fn next_deadline(&self) -> Option<u64> {
         self.deadline_after(self.next_timer())
     }

@@ -1,10 +1,21 @@
-//! A virtual TMCL module: the `Module` struct, a composition of its state
-//! (`state/`), its constructors and accessors, the motor model's views of
-//! its axes (`motor.rs`), and power-up and reset. What it does lives in the
-//! `impl Module` files, which call each other top-down: the links
+//! A virtual TMCL module: the `Module` struct, a composition of its parts
+//! (`state/`, `program.rs`), its constructors and accessors, the motor
+//! model's views of its axes (`motor.rs`), and power-up and reset. The
+//! parts are private to the files of this directory: what the module does
+//! lives in them, and they call each other top-down: the links
 //! (`frames.rs`, `can.rs`, `ascii.rs`), virtual time (`time.rs`), direct
 //! mode (`control.rs`), the program (`interpreter.rs`), the one dispatch
-//! (`executor.rs`) and the command families (`commands/`).
+//! (`executor.rs`) and the command families (`commands/`). Everything else
+//! (the bus, snapshots, the world's commands) goes through the accessors.
+
+pub mod ascii;
+pub mod can;
+mod commands;
+mod control;
+mod executor;
+mod frames;
+mod interpreter;
+mod time;
 
 use crate::eeprom::Eeprom;
 use crate::motor::{Motor, MotorMut, Surroundings};
@@ -26,24 +37,24 @@ pub use crate::state::registers::{Compare, Registers, error_flag};
 /// A virtual TMCL module: a composition of its state, one part per concern.
 #[derive(Clone, Debug)]
 pub struct Module {
-    pub(crate) profile: Arc<Profile>,
+    profile: Arc<Profile>,
     /// Virtual time in nanoseconds since the module was created.
-    pub(crate) now_ns: u64,
-    pub(crate) axes: Vec<Axis>,
+    now_ns: u64,
+    axes: Vec<Axis>,
     /// Global parameter RAM, banks 0…3.
-    pub(crate) globals: Globals,
-    pub(crate) io: Io,
-    pub(crate) world: World,
+    globals: Globals,
+    io: Io,
+    world: World,
     /// The world the module was created in (`reset` of the world control
     /// goes back to it).
     initial_world: World,
     /// The EEPROM image and whether it was written.
-    pub(crate) persistence: Persistence,
-    pub(crate) registers: Registers,
-    pub(crate) interrupts: Interrupts,
+    persistence: Persistence,
+    registers: Registers,
+    interrupts: Interrupts,
     /// The host link: last address, heartbeat, ASCII mode.
-    pub(crate) link: Link,
-    pub(crate) program: Program,
+    link: Link,
+    program: Program,
     /// Resets (255) and reinitialisations (137) since the module was created.
     resets: u32,
 }
