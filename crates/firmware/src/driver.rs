@@ -29,8 +29,17 @@ pub const SHUTDOWN_C: f64 = 150.0;
 pub const PREWARNING_C: f64 = 120.0;
 /// Below this supply (0.1 V) the driver is off (undervoltage).
 pub const UNDERVOLTAGE_DV: u16 = 80;
-/// AP 210 value for an encoder factor of 1 (68672 ↔ 6.4).
-pub const PRESCALER_UNIT: f64 = 10730.0;
+/// AP 210's bit 0: the encoder counts the other way (adds when the motor
+/// turns left).
+pub const PRESCALER_REVERSED: i32 = 1;
+
+/// The encoder factor an AP 210 value selects (TMCM-351 V4.45 §7.2,
+/// docs/behaviour.md rule 79): bits 0…4 are the special functions; without
+/// bit 16 the factor is bits 5…15 in sixteenths (512 = 1, 800 = 1.5625);
+/// with bit 16 it is bits 9…15 plus bits 5…8 in fifths (68672 = 6.4).
+pub fn prescaler_factor(p: i32) -> f64 {
+    if p & 0x1_0000 != 0 { f64::from((p >> 9) & 0x7F) + f64::from((p >> 5) & 0xF) / 5.0 } else { f64::from((p >> 5) & 0x7FF) / 16.0 }
+}
 /// No step for 2^20 clocks of 16 MHz: the standstill flag.
 pub const STANDSTILL_NS: u64 = 65_536_000;
 
@@ -49,16 +58,17 @@ impl Motor<'_> {
             || self.at.shutdown()
     }
 
-    /// AP 209: the encoder's count scaled by the prescaler (AP 210; the
-    /// manual's example 68672 is a factor of 6.4, and the factor is taken
-    /// as proportional: value / 10730), plus the offset SAP 209 set.
+    /// AP 209: the encoder's count scaled by the prescaler (AP 210,
+    /// [`prescaler_factor`], counting the other way with its bit 0), plus
+    /// the offset SAP 209 set.
     pub(crate) fn encoder_position(&self) -> i32 {
         let axis = self.axis;
         let Some(counts_per_rev) = self.world.encoder_counts else { return axis.encoder_offset as i32 };
         let microsteps_per_rev = self.world.fullsteps_per_rev * axis.microsteps();
         let counts = self.mechanical_position() / microsteps_per_rev * counts_per_rev;
-        let factor = f64::from(axis.params[ap::ENCODER_PRESCALER as usize]) / PRESCALER_UNIT;
-        ((counts * factor).round() as i64 + axis.encoder_offset) as i32
+        let p = axis.params[ap::ENCODER_PRESCALER as usize];
+        let sign = if p & PRESCALER_REVERSED != 0 { -1.0 } else { 1.0 };
+        ((counts * sign * prescaler_factor(p)).round() as i64 + axis.encoder_offset) as i32
     }
 
     /// AP 208.
@@ -204,17 +214,21 @@ impl MotorMut<'_> {
             // Stop on stall (AP 181): above that speed, a reading of 0 stops the motor.
             if moving && stall_speed > 0 && self.view().actual_speed().abs() >= stall_speed && self.axis.driver.load_value == 0 {
                 self.axis.stop_now();
-                self.axis.params[ap::EXTENDED_ERROR_FLAGS as usize] = 1;
+                self.axis.params[ap::EXTENDED_ERROR_FLAGS as usize] |= features.error_flags.stall;
                 alarms.stall = true;
             }
         } else if features.stall_detection == StallDetection::Tmc249 {
             // TMC249 load indicator (TMCM-351): 0…7, higher is more load;
-            // a reading above AP 205 (not 0) stops the motor.
+            // a reading above AP 205 (not 0) stops the motor, but not while
+            // it accelerates or decelerates (docs/behaviour.md rule 78).
             if moving {
                 self.axis.driver.load_value = round_in(7.0 * (1.0 - margin), 7.0);
             }
-            if moving && threshold > 0 && self.axis.driver.load_value > threshold {
+            let cruising = self.axis.motion.a == 0.0;
+            if moving && cruising && threshold > 0 && self.axis.driver.load_value > threshold {
                 self.axis.stop_now();
+                self.axis.params[ap::EXTENDED_ERROR_FLAGS as usize] |= features.error_flags.stall;
+                alarms.stall = true;
             }
         }
         // The carriage follows the motor unless it cannot.
@@ -235,6 +249,7 @@ impl MotorMut<'_> {
             let deviation = (i64::from(view.actual_position()) - i64::from(view.encoder_position())).abs();
             if deviation > i64::from(limit) {
                 self.axis.stop_now();
+                self.axis.params[ap::EXTENDED_ERROR_FLAGS as usize] |= features.error_flags.deviation;
                 alarms.deviation = true;
             }
         }
@@ -296,7 +311,42 @@ fn round_in(x: f64, max: f64) -> i32 {
 
 #[cfg(test)]
 mod tests {
-    use super::round_in;
+    use super::{prescaler_factor, round_in};
+
+    #[test]
+    fn prescaler_values_of_the_351_manual() {
+        // TMCM-351 V4.45 §7.2 (p.77): value, prescaler, steps per rotation
+        // of a 400-line (1600 count) encoder.
+        let table = [
+            (64, 0.125, 200),
+            (128, 0.25, 400),
+            (256, 0.5, 800),
+            (512, 1.0, 1600),
+            (800, 1.5625, 2500),
+            (66144, 1.6, 2560),
+            (1024, 2.0, 3200),
+            (1600, 3.125, 5000),
+            (67104, 3.2, 5120),
+            (2048, 4.0, 6400),
+            (3200, 6.25, 10000),
+            (68672, 6.4, 10240),
+            (4096, 8.0, 12800),
+            (6400, 12.5, 20000),
+            (71808, 12.8, 20480),
+            (8192, 16.0, 25600),
+            (78432, 25.6, 40960),
+            (16384, 32.0, 51200),
+            (32768, 64.0, 102400),
+        ];
+        for (p, factor, steps) in table {
+            assert!((prescaler_factor(p) - factor).abs() < 1e-9, "{p}: {} ≠ {factor}", prescaler_factor(p));
+            assert_eq!((1600.0 * prescaler_factor(p)).round() as i32, steps, "{p}");
+        }
+        // The special functions (bits 0…4) leave the factor alone: the
+        // manual's example 2048 + 16 = 2064 is still 4.
+        assert_eq!(prescaler_factor(2064), 4.0);
+        assert_eq!(prescaler_factor(68672 + 1), 6.4);
+    }
 
     #[test]
     fn round_in_is_round_then_clamp() {

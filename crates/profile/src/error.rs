@@ -126,6 +126,20 @@ pub enum FeatureProblem {
     NoClock,
     /// `encoder_deviation_stop` on a module without an encoder.
     DeviationStopWithoutEncoder,
+    /// `version_text` is not 8 ASCII characters.
+    VersionText {
+        /// The text as the profile gives it.
+        text: String,
+    },
+    /// A port row's `span` or `full_scale_volts` does not fit the port.
+    PortScale {
+        /// The port's bank.
+        bank: u8,
+        /// The port's number.
+        number: u8,
+        /// Which rule, in words.
+        problem: &'static str,
+    },
 }
 
 impl fmt::Display for ProfileError {
@@ -177,6 +191,10 @@ impl fmt::Display for FeatureProblem {
             FeatureProblem::DeviationStopWithoutEncoder => {
                 f.write_str("features.encoder_deviation_stop needs an encoder (features.encoder is \"none\")")
             }
+            FeatureProblem::VersionText { text } => {
+                write!(f, "module.version_text \"{text}\" must be 8 ASCII characters (the 136 type 0 reply)")
+            }
+            FeatureProblem::PortScale { bank, number, problem } => write!(f, "port {number} of bank {bank}: {problem}"),
         }
     }
 }

@@ -99,6 +99,27 @@ pub struct EepromMagic {
     pub value: i32,
 }
 
+/// The bits of AP 207 (extended error flags) and what clears them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ErrorFlags {
+    /// The bit value set when the motor was stopped for a stall.
+    pub stall: i32,
+    /// The bit value set when the motor was stopped for an encoder
+    /// deviation (AP 212).
+    pub deviation: i32,
+    /// Reading AP 207 clears it (it is always cleared by the next motion
+    /// command).
+    pub cleared_by_read: bool,
+}
+
+impl Default for ErrorFlags {
+    /// The TMCM-1141's: 1 after a stall stop, cleared by reading.
+    fn default() -> ErrorFlags {
+        ErrorFlags { stall: 1, deviation: 2, cleared_by_read: true }
+    }
+}
+
 /// What tells one module from another, beyond its parameter tables.
 #[derive(Clone, Debug, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -140,6 +161,9 @@ pub struct Features {
     /// address (GP 76) as identifiers.
     #[serde(default)]
     pub can: Option<CanIds>,
+    /// AP 207's bits. Absent: stall 1, deviation 2, cleared by reading.
+    #[serde(default)]
+    pub error_flags: ErrorFlags,
     /// Bits per second, indexed by the GP 65 code.
     pub baud_rates: Vec<u32>,
     /// The motor current (mA RMS) that AP 6 = 255 (100 %) means.
@@ -200,6 +224,15 @@ impl Features {
                     ),
                     None => "no".to_string(),
                 },
+            ),
+            (
+                "error_flags",
+                format!(
+                    "AP 207: stall {}, deviation {}, cleared by {}",
+                    self.error_flags.stall,
+                    self.error_flags.deviation,
+                    if self.error_flags.cleared_by_read { "reading it or a motion command" } else { "the next motion command" }
+                ),
             ),
             ("shutdown_pin", gp_or_none(self.shutdown_pin)),
             ("eeprom_lock", gp_or_none(self.eeprom_lock)),

@@ -13,7 +13,7 @@ mod error;
 mod features;
 
 pub use error::{FeatureProblem, ParameterProblem, ProfileError};
-pub use features::{CanIds, EepromMagic, Encoder, Features, ReferenceSearchFamily, StallDetection};
+pub use features::{CanIds, EepromMagic, Encoder, ErrorFlags, Features, ReferenceSearchFamily, StallDetection};
 
 use serde::Deserialize;
 use std::sync::Arc;
@@ -164,16 +164,24 @@ pub enum PortDirection {
     Input,
     /// An output (SIO, GIO bank 2).
     Output,
-    /// The switch inputs' pull-up resistors (SIO bank 0).
+    /// The pull-up resistors of inputs (SIO bank 0): with range 0…1 one
+    /// switch for all, with a wider range a bit mask, one bit an input.
     Pullup,
+    /// The range of the analog inputs marked `ranged` (SIO): each value
+    /// selects the full-scale voltage `full_scale_volts` lists for it.
+    #[serde(rename = "input_range")]
+    InputRange,
 }
 
 /// What an input channel measures, where that is more than a pin.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum PortRole {
-    /// The supply voltage, in 0.1 V.
+    /// The supply voltage: in 0.1 V, or with `span` the ADC reading of
+    /// it.
     Supply,
+    /// The module's temperature, as the ADC reading `span` describes.
+    Temperature,
 }
 
 /// An I/O port of the module (SIO/GIO), from the profile's `[[port]]` rows.
@@ -201,6 +209,17 @@ pub struct Port {
     /// What the channel measures (`None`: a plain digital or analog input).
     #[serde(default)]
     pub role: Option<PortRole>,
+    /// For a `role` read by an ADC: the measured quantity (volts, °C) at
+    /// the readings `min` and `max`, in between linear.
+    #[serde(default)]
+    pub span: Option<[f64; 2]>,
+    /// For an `input_range` port: the full-scale voltage that each value
+    /// (from `min`) selects.
+    #[serde(default)]
+    pub full_scale_volts: Vec<f64>,
+    /// An analog input whose full scale follows the `input_range` port.
+    #[serde(default)]
+    pub ranged: bool,
     /// Where a value or rule comes from, or what is special about it.
     #[serde(default)]
     pub note: Option<String>,
@@ -245,6 +264,10 @@ pub struct ModuleInfo {
     pub user_variables_stored: u16,
     /// Number of coordinates per motor (SCO, GCO, CCO).
     pub coordinates: u8,
+    /// The 8 characters of the 136 type 0 reply, when the manual prints
+    /// another form than `1141V146` (type number, `V`, version digits).
+    #[serde(default)]
+    pub version_text: Option<String>,
     /// The instruction numbers the module has.
     pub opcodes: Vec<u8>,
     /// The instruction numbers it executes in ASCII mode.
@@ -545,8 +568,14 @@ impl Profile {
         self.axis_parameters().find(|p| p.name.eq_ignore_ascii_case(name))
     }
 
-    /// `1141V146` style version text for 136 type 0.
+    /// The 136 type 0 text: the profile's `version_text`, or the
+    /// `1141V146` form (type number, `V`, version digits).
     pub fn version_text(&self) -> [u8; 8] {
+        if let Some(text) = &self.module.version_text
+            && let Ok(bytes) = <[u8; 8]>::try_from(text.as_bytes())
+        {
+            return bytes;
+        }
         let s = format!("{:04}V{}{:02}", self.module.type_number % 10000, self.module.firmware[0] % 10, self.module.firmware[1] % 100);
         let mut out = [b'0'; 8];
         out.copy_from_slice(&s.as_bytes()[..8]);
@@ -667,6 +696,34 @@ fn check_features(profile: &Profile) -> Result<(), FeatureProblem> {
     }
     if f.encoder_deviation_stop && f.encoder == Encoder::None {
         return Err(FeatureProblem::DeviationStopWithoutEncoder);
+    }
+    if let Some(text) = &profile.module.version_text
+        && (text.len() != 8 || !text.is_ascii())
+    {
+        return Err(FeatureProblem::VersionText { text: text.clone() });
+    }
+    for p in &profile.ports {
+        let problem = |problem| Err(FeatureProblem::PortScale { bank: p.bank, number: p.number, problem });
+        if let Some([lo, hi]) = p.span
+            && (p.role.is_none() || !(lo.is_finite() && hi.is_finite()) || lo == hi)
+        {
+            return problem("span needs a role and two different finite values");
+        }
+        if p.role == Some(PortRole::Temperature) && p.span.is_none() {
+            return problem("a temperature port needs a span");
+        }
+        let choices = usize::try_from(p.max - p.min + 1).unwrap_or(0);
+        if p.direction == PortDirection::InputRange
+            && (p.full_scale_volts.len() != choices || p.full_scale_volts.iter().any(|v| !(v.is_finite() && *v > 0.0)))
+        {
+            return problem("an input_range port needs one positive full_scale_volts for each value from min to max");
+        }
+        if p.direction != PortDirection::InputRange && !p.full_scale_volts.is_empty() {
+            return problem("full_scale_volts belongs to an input_range port");
+        }
+        if p.ranged && !profile.ports.iter().any(|r| r.direction == PortDirection::InputRange) {
+            return problem("a ranged input needs an input_range port");
+        }
     }
     Ok(())
 }

@@ -127,7 +127,10 @@ impl Module {
                 let v = self.io.read_port(&self.profile, &self.world, port, bank)?;
                 self.loaded(v, origin)
             }
-            Sac { bus, count, value } => self.io.spi_transfer(bus, count, value)?,
+            Sac { bus, count, value } => {
+                let v = self.io.spi_transfer(bus, count, value, accumulator)?;
+                self.loaded(v, origin)
+            }
 
             // ----- coordinates (commands/coordinates.rs) -----------------
             Sco { coordinate, motor, value } => self.set_coordinate(coordinate, motor, value).map(|_| echo)?,

@@ -339,14 +339,13 @@ impl Module {
         }
         self.program.download_pointer = self.program.length() as u16;
         self.program.next_ns = self.now_ns;
-        let pullups = profile.ports.iter().find(|p| p.direction == tmclsim_profile::PortDirection::Pullup).is_none_or(|p| p.default != 0);
         let switches = (0..self.axes.len())
             .map(|m| {
                 let (l, r, _) = self.switches(m);
                 (l, r)
             })
             .collect();
-        self.io.power_on(pullups, self.world.digital_inputs, switches);
+        self.io.power_on(&profile, self.world.digital_inputs, switches);
         for m in 0..self.axes.len() {
             self.motor_view_mut(m).closed_loop_power_on();
         }

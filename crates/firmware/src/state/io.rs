@@ -13,7 +13,12 @@ use tmclsim_protocol::Status;
 pub struct Io {
     /// Bit n = OUTn.
     outputs: u32,
-    pullups: bool,
+    /// The pull-ups that are on, one bit an input (all bits for a module
+    /// whose pull-ups switch together).
+    pullups: u32,
+    /// The value of the `input_range` port (SIO), selecting the ranged
+    /// analog inputs' full scale.
+    input_range: i32,
     /// Digital inputs and stop switches at the last look.
     last_inputs: u32,
     last_switches: Vec<(bool, bool)>,
@@ -23,7 +28,7 @@ pub struct Io {
 
 impl Default for Io {
     fn default() -> Io {
-        Io { outputs: 0, pullups: true, last_inputs: 0, last_switches: Vec::new(), spi: [0; 3] }
+        Io { outputs: 0, pullups: u32::MAX, input_range: 0, last_inputs: 0, last_switches: Vec::new(), spi: [0; 3] }
     }
 }
 
@@ -43,18 +48,22 @@ impl Io {
     }
 
     /// SIO: sets an output, the outputs of a bank (port 255, with -1 the
-    /// accumulator's bits) or, on a bank of pull-ups, the pull-ups.
+    /// accumulator's bits), the pull-ups or the analog input range.
     pub fn set_port(&mut self, profile: &Profile, port: u8, bank: u8, value: i32, accumulator: i32) -> Result<(), Status> {
         let has = |d: PortDirection| profile.ports.iter().any(|p| p.direction == d && p.bank == bank);
-        if has(PortDirection::Pullup) {
-            if profile.port(PortDirection::Pullup, bank, port).is_none() {
-                return Err(Status::WrongType);
-            }
-            if !(0..=1).contains(&value) {
+        let setting = |d: PortDirection| profile.port(d, bank, port).map(|p| (d, p));
+        if let Some((direction, p)) = setting(PortDirection::Pullup).or_else(|| setting(PortDirection::InputRange)) {
+            if !(p.min..=p.max).contains(&i64::from(value)) {
                 return Err(Status::InvalidValue);
             }
-            self.pullups = value == 1;
+            match direction {
+                PortDirection::Pullup => self.pullups = pullup_bits(p.max, value),
+                _ => self.input_range = value,
+            }
             return Ok(());
+        }
+        if has(PortDirection::Pullup) || has(PortDirection::InputRange) {
+            return Err(Status::WrongType);
         }
         if !has(PortDirection::Output) {
             return Err(Status::InvalidValue);
@@ -81,7 +90,8 @@ impl Io {
     /// the supply; port 255 reads a bank's outputs or digital inputs as
     /// bits.
     pub fn read_port(&self, profile: &Profile, world: &World, port: u8, bank: u8) -> Result<i32, Status> {
-        let mut in_bank = profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup);
+        let mut in_bank =
+            profile.ports.iter().filter(|p| p.bank == bank && matches!(p.direction, PortDirection::Input | PortDirection::Output));
         let Some(first) = in_bank.clone().next() else {
             return Err(Status::InvalidValue);
         };
@@ -96,16 +106,39 @@ impl Io {
         Ok(match p.direction {
             PortDirection::Output => (self.outputs >> port & 1) as i32,
             _ if p.max == 1 => i32::from(world.digital(port)),
-            // The supply voltage channel is the one with a 0.1 V unit.
+            // A measured quantity that an ADC reads over the port's span.
+            _ if p.role.is_some() && p.span.is_some() => {
+                let quantity = match p.role {
+                    Some(PortRole::Temperature) => world.temperature,
+                    _ => f64::from(world.supply_decivolts) / 10.0,
+                };
+                adc_reading(p, quantity)
+            }
+            // Otherwise the supply voltage channel reads 0.1 V.
             _ if p.role == Some(PortRole::Supply) => i32::from(world.supply_decivolts),
             _ => {
                 let v = i64::from(world.analog_inputs.get(port as usize).copied().unwrap_or(0));
                 // The world's ADC values are 12 bit (0…4095). A plain analog
                 // input (no unit) with a coarser ADC reads them at its own
                 // resolution: range 0…1023 reads a quarter.
-                if p.unit.is_none() && (1..4095).contains(&p.max) { (v * (p.max + 1) / 4096) as i32 } else { v as i32 }
+                let v = if p.unit.is_none() && (1..4095).contains(&p.max) { v * (p.max + 1) / 4096 } else { v };
+                // A ranged input: the world's value is the pin's voltage as
+                // a share of the widest range; a narrower one reads it larger,
+                // up to the port's maximum (docs/behaviour.md rule 54).
+                match self.full_scale(profile) {
+                    Some((selected, widest)) if p.ranged => ((v as f64 * widest / selected) as i64).min(p.max) as i32,
+                    _ => v as i32,
+                }
             }
         })
+    }
+
+    /// The ranged inputs' selected and widest full-scale voltages.
+    fn full_scale(&self, profile: &Profile) -> Option<(f64, f64)> {
+        let p = profile.ports.iter().find(|p| p.direction == PortDirection::InputRange)?;
+        let selected = *p.full_scale_volts.get(usize::try_from(i64::from(self.input_range) - p.min).ok()?)?;
+        let widest = p.full_scale_volts.iter().copied().fold(0.0, f64::max);
+        Some((selected, widest))
     }
 
     /// The states of the digital outputs, bit n = OUTn.
@@ -113,15 +146,18 @@ impl Io {
         self.outputs
     }
 
-    pub fn pullups(&self) -> bool {
+    /// The pull-ups that are on, one bit an input.
+    pub fn pullups(&self) -> u32 {
         self.pullups
     }
 
-    /// Power-up: outputs off, pull-ups as the profile's default, the inputs
-    /// and switches as they are now.
-    pub fn power_on(&mut self, pullups: bool, inputs: u32, switches: Vec<(bool, bool)>) {
+    /// Power-up: outputs off, pull-ups and input range as the profile's
+    /// defaults, the inputs and switches as they are now.
+    pub fn power_on(&mut self, profile: &Profile, inputs: u32, switches: Vec<(bool, bool)>) {
         self.outputs = 0;
-        self.pullups = pullups;
+        let default = |d: PortDirection| profile.ports.iter().find(|p| p.direction == d);
+        self.pullups = default(PortDirection::Pullup).map_or(u32::MAX, |p| pullup_bits(p.max, p.default as i32));
+        self.input_range = default(PortDirection::InputRange).map_or(0, |p| p.default as i32);
         self.last_inputs = inputs;
         self.last_switches = switches;
     }
@@ -153,11 +189,20 @@ impl Io {
         std::mem::replace(&mut self.last_switches[m], now)
     }
 
-    /// SAC: an SPI transfer of `count` bytes on chip select `bus`. The
-    /// simulated device on each bus is a shift register: it answers with
-    /// what the previous transfer sent.
-    pub fn spi_transfer(&mut self, bus: u8, count: u8, value: i32) -> Result<i32, Status> {
-        let slot = self.spi.get_mut(bus as usize).ok_or(Status::WrongType)?;
+    /// SAC: an SPI transfer of `count` bytes on the chip select of bus
+    /// number `bus`: 0, 2 and 3 select SPI_SEL0…2 (bus 1 is no chip
+    /// select of the connector); with bit 7 set the accumulator is sent
+    /// instead of `value`. The simulated device on each chip select is a
+    /// shift register: it answers with what the previous transfer sent.
+    pub fn spi_transfer(&mut self, bus: u8, count: u8, value: i32, accumulator: i32) -> Result<i32, Status> {
+        let value = if bus & 0x80 != 0 { accumulator } else { value };
+        let select = match bus & 0x7F {
+            0 => 0,
+            2 => 1,
+            3 => 2,
+            _ => return Err(Status::WrongType),
+        };
+        let slot = &mut self.spi[select];
         if !(1..=4).contains(&count) {
             return Err(Status::InvalidValue);
         }
@@ -166,6 +211,23 @@ impl Io {
         *slot = value as u32 & mask;
         Ok(answer as i32)
     }
+}
+
+/// The pull-up bits a value sets: a port of range 0…1 switches them all.
+fn pullup_bits(max: i64, value: i32) -> u32 {
+    match (max, value) {
+        (1, 0) => 0,
+        (1, _) => u32::MAX,
+        (_, v) => v as u32,
+    }
+}
+
+/// The reading of an ADC port of `p.min…p.max` over the quantity's span,
+/// clamped to the port's range.
+fn adc_reading(p: &tmclsim_profile::Port, quantity: f64) -> i32 {
+    let [lo, hi] = p.span.unwrap_or([0.0, 1.0]);
+    let share = (quantity - lo) / (hi - lo);
+    (p.min as f64 + share * (p.max - p.min) as f64).round().clamp(p.min as f64, p.max as f64) as i32
 }
 
 /// The outputs of a bank, as bits.
@@ -190,20 +252,24 @@ mod tests {
         assert_eq!(io.outputs, 0b1);
         io.set_outputs(0xF0, 0xAB);
         assert_eq!(io.outputs, 0xA1, "bits outside the mask stay");
-        assert!(io.pullups, "pull-ups are on by default");
+        assert_eq!(io.pullups, u32::MAX, "pull-ups are on by default");
     }
 
     #[test]
     fn spi_devices_are_shift_registers() {
         let mut io = Io::default();
-        assert_eq!(io.spi_transfer(1, 2, 0x1234), Ok(0));
-        assert_eq!(io.spi_transfer(1, 2, 0x5678), Ok(0x1234));
-        assert_eq!(io.spi_transfer(1, 1, 0x1FF), Ok(0x78), "one byte of the last word");
-        assert_eq!(io.spi_transfer(1, 4, -1), Ok(0xFF));
-        assert_eq!(io.spi_transfer(1, 4, 0), Ok(-1));
-        assert_eq!(io.spi_transfer(0, 2, 7), Ok(0), "each chip select has its own");
-        assert_eq!(io.spi_transfer(3, 1, 0), Err(Status::WrongType));
-        assert_eq!(io.spi_transfer(2, 0, 0), Err(Status::InvalidValue));
-        assert_eq!(io.spi_transfer(2, 5, 0), Err(Status::InvalidValue));
+        assert_eq!(io.spi_transfer(2, 2, 0x1234, 0), Ok(0));
+        assert_eq!(io.spi_transfer(2, 2, 0x5678, 0), Ok(0x1234));
+        assert_eq!(io.spi_transfer(2, 1, 0x1FF, 0), Ok(0x78), "one byte of the last word");
+        assert_eq!(io.spi_transfer(2, 4, -1, 0), Ok(0xFF));
+        assert_eq!(io.spi_transfer(2, 4, 0, 0), Ok(-1));
+        assert_eq!(io.spi_transfer(0, 2, 7, 0), Ok(0), "each chip select has its own");
+        assert_eq!(io.spi_transfer(3, 2, 7, 0), Ok(0));
+        assert_eq!(io.spi_transfer(131, 2, 0, 0x0BEE), Ok(7), "bus 131: SPI_SEL2, sending the accumulator");
+        assert_eq!(io.spi_transfer(3, 2, 0, 0), Ok(0x0BEE));
+        assert_eq!(io.spi_transfer(1, 1, 0, 0), Err(Status::WrongType), "bus 1 is no chip select");
+        assert_eq!(io.spi_transfer(4, 1, 0, 0), Err(Status::WrongType));
+        assert_eq!(io.spi_transfer(2, 0, 0, 0), Err(Status::InvalidValue));
+        assert_eq!(io.spi_transfer(2, 5, 0, 0), Err(Status::InvalidValue));
     }
 }

@@ -201,13 +201,26 @@ fn eeprom_lock_and_magic() {
 
 #[test]
 fn sac_talks_to_a_shift_register() {
+    // V4.45 §4.6.24 (p.49): bus numbers 0, 2 and 3 are SPI_SEL0…2 with the
+    // value sent; 128, 130 and 131 send the accumulator; 1…4 bytes.
     let mut m = module();
     assert_eq!(send(&mut m, "SAC 0, 2, 4660"), 0);
     assert_eq!(send(&mut m, "SAC 0, 2, 0"), 4660);
-    assert_eq!(send(&mut m, "SAC 1, 1, 511"), 0);
-    assert_eq!(send(&mut m, "SAC 1, 1, 0"), 255, "one byte");
-    assert_eq!(reply(&mut m, "SAC 3, 1, 0").status, 3, "three chip selects");
+    assert_eq!(send(&mut m, "SAC 2, 1, 511"), 0);
+    assert_eq!(send(&mut m, "SAC 2, 1, 0"), 255, "one byte");
+    assert_eq!(send(&mut m, "SAC 3, 4, -1"), 0, "SPI_SEL2 is a device of its own");
+    assert_eq!(send(&mut m, "SAC 3, 4, 0"), -1);
+    assert_eq!(reply(&mut m, "SAC 1, 1, 0").status, 3, "bus 1 is not in the manual's table");
+    assert_eq!(reply(&mut m, "SAC 4, 1, 0").status, 3);
     assert_eq!(reply(&mut m, "SAC 0, 5, 0").status, 4);
+    assert_eq!(reply(&mut m, "SAC 0, 0, 0").status, 4);
+    // In a program, bus 128 sends the accumulator and the answer lands in it.
+    let words = ["CALC LOAD, 4242", "SAC 128, 2, 0", "STOP"].map(|l| parse_line(l).unwrap());
+    m.load_program(&words).unwrap();
+    send(&mut m, "#129 1 0 0");
+    m.advance(10 * MS);
+    assert_eq!(m.registers().accumulator, 0, "the device answered what the last direct transfer sent (0)");
+    assert_eq!(send(&mut m, "SAC 0, 2, 0"), 4242, "and kept the accumulator's 4242");
 }
 
 #[test]

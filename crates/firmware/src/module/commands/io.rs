@@ -10,9 +10,15 @@ impl Module {
         self.io.outputs()
     }
 
-    /// True when the inputs' pull-up resistors are on (they are at
-    /// power-up).
+    /// True when the inputs' pull-up resistors are on (all of them, as
+    /// at power-up on a module whose pull-ups switch together).
     pub fn pullups(&self) -> bool {
+        self.io.pullups() == u32::MAX
+    }
+
+    /// The pull-ups that are on, one bit an input (all bits on a module
+    /// whose pull-ups switch together).
+    pub fn pullup_mask(&self) -> u32 {
         self.io.pullups()
     }
 }
@@ -75,7 +81,9 @@ mod tests {
         let mut m = module("tmcm-351");
         assert_eq!(direct(&mut m, "SAC 0, 2, 4660"), (Status::Ok, 0));
         assert_eq!(ok(&mut m, "SAC 0, 2, 0"), 0x1234);
-        assert_eq!(status(&mut m, "SAC 3, 1, 0"), Status::WrongType);
+        assert_eq!(status(&mut m, "SAC 1, 1, 0"), Status::WrongType, "bus 1 is no chip select (V4.45 §4.6.24 p.49)");
+        assert_eq!(in_program(&mut m, "SAC 0, 2, 0"), Ok(0));
+        assert_eq!(m.registers.accumulator, 0, "a program's SAC loads the accumulator");
         assert_eq!(status(&mut m, "SAC 0, 5, 0"), Status::InvalidValue);
         let mut m = module("tmcm-1141");
         assert_eq!(status(&mut m, "SAC 0, 1, 0"), Status::InvalidCommand, "the TMCM-1141 has no SAC");

@@ -106,10 +106,11 @@ impl Module {
     }
 
     /// Reads a parameter, computing the measured ones, with the effects of
-    /// a read (AP 207 is cleared by reading, docs/behaviour.md rule 52).
+    /// a read (AP 207 is cleared by reading where the module's features
+    /// say so, docs/behaviour.md rule 52).
     pub(crate) fn read_axis_parameter(&mut self, m: usize, param: u8) -> i32 {
         let v = self.axis_parameter_value(m, param);
-        if param == ap::EXTENDED_ERROR_FLAGS {
+        if param == ap::EXTENDED_ERROR_FLAGS && self.profile.features.error_flags.cleared_by_read {
             self.axes[m].params[param as usize] = 0;
         }
         v
