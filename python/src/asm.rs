@@ -12,7 +12,8 @@ use tmclsim_firmware::Profile;
 use tmclsim_server::sources::FileResolver;
 
 /// An assembled TMCL program: its instructions (one per program memory
-/// word, from address 0), its labels and its constants.
+/// word, from address 0; assembled from source, they end with a STOP), its
+/// labels and its constants.
 ///
 /// ``Program(instructions=(), symbols=None)`` makes one from instructions
 /// (``Instruction`` objects, command lines or 4-tuples).
@@ -115,10 +116,19 @@ impl Program {
     }
 
     /// The source of every instruction, same index as `instructions`:
-    /// (file, line, column, text); empty for a program not assembled here.
+    /// (file, line, column, text); none for the STOP the assembler appends
+    /// (docs/behaviour.md rule 93); empty for a program not assembled here.
     #[getter]
     fn source_map(&self) -> Vec<(String, u32, u32, String)> {
         self.inner.source_map.iter().map(|s| (s.file.to_string(), s.line, s.column, s.text.clone())).collect()
+    }
+
+    /// Whether the last instruction is the STOP the assembler appended
+    /// after the source's last instruction (the source does not end in
+    /// STOP; docs/behaviour.md rule 93).
+    #[getter]
+    fn appended_stop(&self) -> bool {
+        self.inner.appended_stop
     }
 
     /// to_binary() -> bytes

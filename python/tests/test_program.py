@@ -147,7 +147,9 @@ def test_failed_commands_show_in_the_trace(module):
 
 def test_assemble_disassemble_round_trip():
     program = tmclsim.assemble(MOVER, file_name="mover.tmc")
-    assert len(program) == 6 and program[-1] == Instruction.parse("JA 1")
+    # Six instructions and the STOP appended after JA (docs/behaviour.md rule 93).
+    assert len(program) == 7 and program[-2] == Instruction.parse("JA 1")
+    assert program[-1] == Instruction.parse("STOP") and program.to_binary()[-8:] == bytes.fromhex("1C000000000000 1C")
     source = program.disassemble()
     assert "Back:" in source
     again = tmclsim.assemble(source)
@@ -168,7 +170,8 @@ def test_raw_words_survive_disassembly():
     words = [Instruction(4, 0, 0, 100), Instruction(24, 0, 0, 7), Instruction(200, 1, 2, 3)]
     text = tmclsim.disassemble(words)
     assert "#db 24, 0, 0, 7" in text
-    assert tmclsim.assemble(text, profile=None).instructions == words
+    # The words do not end in STOP: the assembler appends one (rule 93).
+    assert tmclsim.assemble(text, profile=None).instructions == words + [Instruction.parse("STOP")]
 
 
 def test_assembly_errors_carry_diagnostics():
@@ -192,11 +195,14 @@ def test_includes(tmp_path):
     with pytest.raises(AssemblyError, match="cannot find include file"):
         tmclsim.assemble_file(main)
     program = tmclsim.assemble_file(main, include_path=[tmp_path / "lib"])
-    assert program.instructions == [Instruction.parse("SAP 4, 0, 2000")]
+    assert program.instructions == [Instruction.parse("SAP 4, 0, 2000"), Instruction.parse("STOP")]
     assert program.constants["FAST"] == 2000
-    # The source map names the line each instruction comes from.
+    # The source map names the line each instruction comes from; the
+    # appended STOP comes from none.
     assert program.source_map == [(str(main), 2, 5, "SAP 4, 0, FAST")]
+    assert program.appended_stop
     assert tmclsim.Program.from_binary(program.to_binary()).source_map == []
+    assert not tmclsim.Program.from_binary(program.to_binary()).appended_stop
 
 
 def test_instructions():

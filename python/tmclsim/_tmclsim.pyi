@@ -124,7 +124,10 @@ class Program:
     def constants(self) -> Dict[str, int]: ...
     @property
     def source_map(self) -> List[Tuple[str, int, int, str]]:
-        """(file, line, column, text) of every instruction; empty when not assembled from source."""
+        """(file, line, column, text) of every instruction of the source (the appended STOP has none); empty when not assembled from source."""
+    @property
+    def appended_stop(self) -> bool:
+        """Whether the last instruction is the STOP the assembler appended (the source does not end in STOP)."""
     def to_binary(self) -> bytes:
         """The binary image: 8 bytes per instruction."""
     def symbol_file(self) -> str:

@@ -192,7 +192,9 @@ def test_a_program_is_fixed_downloaded_and_stops_at_a_breakpoint(served, page):
     page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
     assert page.locator("[data-testid=diagnostic]").count() == 0
     progress = page.locator("[data-testid=prog-progress]")
-    assert progress.get_attribute("max") == progress.evaluate("p => String(p.value)") == "8"
+    # Four words and the STOP appended after JA (docs/behaviour.md rule
+    # 93): five written, five read back.
+    assert progress.get_attribute("max") == progress.evaluate("p => String(p.value)") == "10"
     # A breakpoint on line 4 (WAIT TICKS), by a click on its line number.
     page.locator(".CodeMirror-linenumber").get_by_text("4", exact=True).click()
     page.locator("[data-testid=breakpoint]").wait_for()
@@ -554,7 +556,7 @@ def test_a_link_is_scanned_a_program_read_back_and_the_version_shown(page, start
     page.locator("[data-testid=scan-item]").nth(1).wait_for()
     items = page.locator("[data-testid=scan-item]").all_inner_texts()
     assert "TMCM-1141 · address 1" in items[0] and "1141V146" in items[0]
-    assert "TMCM-351 · address 7" in items[1] and "0351V445" in items[1] and "not listed" in items[1]
+    assert "TMCM-351 · address 7" in items[1] and "351V.445" in items[1] and "not listed" in items[1]
     page.fill("[data-testid=direct-input]", "#136 0 0 0")
     page.press("[data-testid=direct-input]", "Enter")
     page.locator("[data-testid=direct-reply]").wait_for()
@@ -565,7 +567,8 @@ def test_a_link_is_scanned_a_program_read_back_and_the_version_shown(page, start
     page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.includes('verified')")
     page.evaluate("() => window.tmclEditor.setValue('')")
     page.click("[data-testid=prog-read]")
-    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.startsWith('read 4 words')")
+    # The four words and the STOP appended after JA (docs/behaviour.md rule 93).
+    page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.startsWith('read 5 words')")
     text = page.evaluate("() => window.tmclEditor.getValue()")
     assert "CALC ADD, 1" in text and "WAIT TICKS, 0, 50" in text and "JA " in text
 

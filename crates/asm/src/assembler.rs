@@ -11,6 +11,7 @@ use std::rc::Rc;
 use tmclsim_profile::Profile;
 use tmclsim_protocol::{Instruction, opcode as op};
 
+use crate::binary;
 use crate::check::check;
 use crate::diagnostic::{Diagnostic, Loc, Reporter};
 use crate::encoder::{encode, encode_raw};
@@ -205,6 +206,8 @@ struct Writer<'a, 's> {
     /// kept: it would not be returned).
     instructions: Vec<Instruction>,
     source_map: Vec<SourceLine>,
+    /// Where the last instruction stands, and its column.
+    last: Option<(Loc, usize)>,
 }
 
 impl Writer<'_, '_> {
@@ -274,6 +277,7 @@ impl Writer<'_, '_> {
             }
         }
         self.words += 1;
+        self.last = Some((loc, first_column(body)));
         if !self.reporter.is_empty() {
             self.instructions = Vec::new();
             self.source_map = Vec::new();
@@ -316,7 +320,7 @@ pub fn assemble(
 
     evaluator.evaluate_constants(&mut reporter);
     // From here on only a program without errors is kept, in vectors of
-    // its exact size.
+    // its exact size (and room for the STOP that may be appended).
     let words = if reporter.is_empty() {
         evaluator.finish_definitions();
         address as usize
@@ -332,18 +336,39 @@ pub fn assemble(
         seq: 0,
         statements,
         words: 0,
-        instructions: Vec::with_capacity(words),
+        instructions: Vec::with_capacity(words + 1),
         source_map: Vec::with_capacity(words),
+        last: None,
     };
     if let Some(main) = main {
         writer.walk(main);
     }
-    let Writer { reporter, evaluator, instructions, source_map, .. } = writer;
+    let Writer { mut reporter, evaluator, mut instructions, source_map, last, .. } = writer;
+    // A program that does not end in STOP gets one after its last
+    // instruction, as TMCL-IDE writes it (docs/behaviour.md rule 93); it
+    // must fit the program memory too.
+    let appended_stop = reporter.is_empty() && binary::needs_end_stop(&instructions);
+    if appended_stop
+        && let (Some(profile), Some((loc, column))) = (profile, last)
+        && instructions.len() >= profile.module.program_memory as usize
+    {
+        let capacity = profile.module.program_memory;
+        let message = format!(
+            "the program has {capacity} instructions and does not end in STOP: the STOP appended after its last one \
+             makes {}, and the program memory of the {} holds {capacity}",
+            instructions.len() + 1,
+            profile.module.name
+        );
+        reporter.error(loc, column, message);
+    }
     if !reporter.is_empty() {
         return Err(reporter.finish());
     }
+    if appended_stop {
+        instructions.push(binary::END_STOP);
+    }
     let (symbols, constants) = evaluator.into_maps();
-    Ok(Program { instructions, symbols, constants, source_map })
+    Ok(Program { instructions, symbols, constants, source_map, appended_stop })
 }
 
 fn first_column(body: &Body) -> usize {

@@ -2,13 +2,30 @@
 //! motor/bank, value (4 bytes, MSB first) and a checksum, the 8-bit sum of
 //! the seven bytes before it. It is a TMCL request frame without the
 //! address byte, so a host can download it word by word.
+//!
+//! A program assembled from source ends with a STOP: when its last
+//! instruction is not one, the assembler appends [`END_STOP`], as TMCL-IDE
+//! does in the binary files it writes (docs/behaviour.md rule 93).
 
-use tmclsim_protocol::{Instruction, checksum};
+use tmclsim_protocol::{Instruction, checksum, opcode};
 
 /// Bytes per instruction in a binary file.
 pub const WORD_LEN: usize = 8;
 
-/// The binary image of a list of instructions.
+/// The STOP the assembler appends to a program whose last instruction is
+/// not a STOP: type, motor and value 0, in a binary image the word
+/// `1C 00 00 00 00 00 00 1C` (docs/behaviour.md rule 93).
+pub const END_STOP: Instruction = Instruction::new(opcode::STOP, 0, 0, 0);
+
+/// Whether a program assembled from these instructions gets [`END_STOP`]
+/// after them: it is empty, or its last word is not a STOP (opcode 28,
+/// whatever its other fields).
+pub fn needs_end_stop(instructions: &[Instruction]) -> bool {
+    instructions.last().is_none_or(|w| w.opcode != opcode::STOP)
+}
+
+/// The binary image of a list of instructions, word for word (a program
+/// assembled from source has its STOP already).
 pub fn encode(instructions: &[Instruction]) -> Vec<u8> {
     let mut out = Vec::with_capacity(instructions.len() * WORD_LEN);
     for ins in instructions {
@@ -89,6 +106,16 @@ mod tests {
         let bytes = encode(&[Instruction::new(1, 0, 0, 1000), Instruction::new(4, 1, 0, -10000)]);
         assert_eq!(bytes, [0x01, 0x00, 0x00, 0x00, 0x00, 0x03, 0xE8, 0xEC, 0x04, 0x01, 0x00, 0xFF, 0xFF, 0xD8, 0xF0, 0xCB]);
         assert_eq!(decode(&bytes).unwrap()[1].value, -10000);
+    }
+
+    #[test]
+    fn the_end_stop_is_the_word_tmcl_ide_appends() {
+        assert_eq!(encode(&[END_STOP]), [0x1C, 0, 0, 0, 0, 0, 0, 0x1C]);
+        assert!(needs_end_stop(&[]));
+        assert!(needs_end_stop(&[Instruction::new(opcode::JA, 0, 0, 0)]));
+        assert!(!needs_end_stop(&[Instruction::new(opcode::JA, 0, 0, 0), END_STOP]));
+        assert!(!needs_end_stop(&[Instruction::new(opcode::STOP, 1, 0, 0)]), "a STOP is a STOP whatever its type");
+        assert!(needs_end_stop(&[END_STOP, Instruction::new(opcode::JA, 0, 0, 0)]), "only the last word counts");
     }
 
     #[test]

@@ -1,5 +1,7 @@
 //! The disassembler: instructions back into source text that assembles to
-//! the same bytes.
+//! the same bytes (words that do not end in STOP come back with the STOP
+//! the assembler appends, docs/behaviour.md rule 93; every program the
+//! assembler made ends in STOP already).
 //!
 //! Every jump target inside the program gets a label: the name from the
 //! symbol table when one is given, otherwise `L<address>`. Symbolic

@@ -4,7 +4,9 @@
 //! manuals: labels, constants, expressions, `#include`) into a [`Program`];
 //! [`disassemble`] turns instructions back into source that assembles to
 //! the same bytes. [`Program::to_binary`] and [`Program::symbol_file`] write
-//! the binary image and the label table. With a module [`Profile`], the
+//! the binary image and the label table. As in the binary TMCL-IDE writes,
+//! a program that does not end in STOP gets one after its last instruction
+//! ([`binary::END_STOP`], docs/behaviour.md rule 93). With a module [`Profile`], the
 //! assembler also checks that the module has every instruction, parameter,
 //! motor, bank, port, coordinate and interrupt the program uses.
 //!

@@ -62,6 +62,9 @@ pub fn asm(args: AsmArgs) -> Result<ExitCode, String> {
             let source = match program.source_of(a as u32) {
                 Some(s) if Some(&*s.file) == main => format!("{:>5}  {}", s.line, s.text),
                 Some(s) => format!("{:>5}  {}  ({}:{})", s.line, s.text, s.file, s.line),
+                None if program.appended_stop_address() == Some(a as u32) => {
+                    format!("       {}  (appended: the program does not end in STOP)", tmclsim_protocol::mnemonic::format(*ins))
+                }
                 None => format!("       {}", tmclsim_protocol::mnemonic::format(*ins)),
             };
             println!("{a:5}  {}  {source}", crate::client::hex(&b));
@@ -72,7 +75,8 @@ pub fn asm(args: AsmArgs) -> Result<ExitCode, String> {
     std::fs::write(&out, program.to_binary()).map_err(|e| format!("{}: {e}", out.display()))?;
     let sym = out.with_extension("sym");
     std::fs::write(&sym, program.symbol_file()).map_err(|e| format!("{}: {e}", sym.display()))?;
-    println!("{}: {} instructions → {} and {}", args.source.display(), program.instructions.len(), out.display(), sym.display());
+    let note = if program.appended_stop { " (the last one a STOP appended after the program's last instruction)" } else { "" };
+    println!("{}: {} instructions{note} → {} and {}", args.source.display(), program.instructions.len(), out.display(), sym.display());
     Ok(ExitCode::SUCCESS)
 }
 

@@ -1,5 +1,6 @@
 //! `tmclsim upload`: download a program to any TMCL module, real or
-//! virtual, verify it by reading it back with 134, optionally start it.
+//! virtual, as TMCL-IDE does (132, the words, a NOP, 133: docs/behaviour.md
+//! rule 94), verify it by reading it back with 134, optionally start it.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -61,12 +62,15 @@ pub fn run(args: UploadArgs) -> Result<ExitCode, String> {
 }
 
 fn upload(args: UploadArgs) -> Result<(), Stop> {
-    let words: Vec<Instruction> = if args.program.extension().is_some_and(|e| e == "bin") {
+    // A binary is downloaded word for word; a source as the assembler
+    // writes it, with the STOP it appends (docs/behaviour.md rule 93).
+    let (words, appended): (Vec<Instruction>, bool) = if args.program.extension().is_some_and(|e| e == "bin") {
         use tmclsim_server::files::{MAX_BINARY_BYTES, read_limited};
         let bytes = read_limited(&args.program, MAX_BINARY_BYTES, "a program binary").map_err(String::from)?;
-        Program::from_binary(&bytes).map_err(String::from)?
+        (Program::from_binary(&bytes).map_err(String::from)?, false)
     } else {
-        crate::asm::assemble(&args.program, &args.module)?.0.instructions
+        let program = crate::asm::assemble(&args.program, &args.module)?.0;
+        (program.instructions, program.appended_stop)
     };
     let mut c = args.link.open(crate::millis(args.timeout))?;
     let ok = |r: tmclsim_protocol::Reply, what: &str| -> Result<(), Stop> {
@@ -84,7 +88,8 @@ fn upload(args: UploadArgs) -> Result<(), Stop> {
         e => Stop::Failed(e.to_string()),
     })?;
     progress.finish();
-    println!("uploaded and verified {} instructions", words.len());
+    let note = if appended { " (the last one the STOP appended after the program's last instruction)" } else { "" };
+    println!("uploaded and verified {} instructions{note}", words.len());
     if args.autostart {
         ok(c.request(Instruction::new(opcode::SGP, 77, 0, 1))?, "autostart (GP 77)")?;
         println!("autostart on");

@@ -1,11 +1,19 @@
 //! A program's download and its verification, over any way of sending a
-//! request (docs/behaviour.md rules 15, 16 and 29): 128 stops the program,
-//! 132 enters download mode, every word must be answered with status 101
-//! (stored), 133 leaves download mode, and 134 reads every word back, which
-//! must be the word sent. `tmclsim upload` and the IDE both download
-//! through here.
+//! request (docs/behaviour.md rules 15, 16, 29 and 94): 128 stops the
+//! program, 132 enters download mode, every word must be answered with
+//! status 101 (stored), then the NOP that TMCL-IDE sends after the last
+//! word ([`TRAILER`]), 133 leaves download mode, and 134 reads every word
+//! back, which must be the word sent. `tmclsim upload` and the IDE both
+//! download through here.
 
 use tmclsim_protocol::{FRAME_LEN, Instruction, Status, mnemonic, opcode};
+
+/// The word TMCL-IDE sends after a program's last word and before 133: a
+/// NOP, opcode 0 and every field 0 (docs/behaviour.md rule 94). The module
+/// stores it like any word (status 101) at the address after the program;
+/// when the program fills the memory it lands past the end and is answered
+/// with status 4 (rule 14), which ends nothing: the words are all stored.
+pub const TRAILER: Instruction = Instruction::new(0, 0, 0, 0);
 
 /// Why a download stopped.
 #[derive(Debug, PartialEq, Eq)]
@@ -71,9 +79,9 @@ fn status_words(status: u8) -> String {
 }
 
 /// Downloads `words` from address 0 through `request` (one request to the
-/// module at `address`, its raw reply) and reads them back. `progress`
-/// hears how many of the `2 × words` steps are done (each word sent, each
-/// word read back), after every step.
+/// module at `address`, its raw reply), then [`TRAILER`], and reads the
+/// words back. `progress` hears how many of the `2 × words` steps are done
+/// (each word sent, each word read back), after every step.
 pub fn download_and_verify<E>(
     request: &mut dyn FnMut(Instruction) -> Result<[u8; FRAME_LEN], E>,
     address: u8,
@@ -89,6 +97,11 @@ pub fn download_and_verify<E>(
             return Err(DownloadError::NotStored { address: a, word: *w, status: raw[2] });
         }
         progress(a + 1);
+    }
+    let raw = request(TRAILER).map_err(DownloadError::Link)?;
+    if raw[2] != Status::Loaded.code() && raw[2] != Status::InvalidValue.code() {
+        let _ = request(Instruction::new(opcode::EXIT_DOWNLOAD, 0, 0, 0));
+        return Err(DownloadError::NotStored { address: words.len(), word: TRAILER, status: raw[2] });
     }
     control(request, opcode::EXIT_DOWNLOAD, "exit download mode")?;
     for (a, w) in words.iter().enumerate() {
@@ -127,14 +140,42 @@ mod tests {
         let mut m = Module::built_in("tmcm-1141").unwrap();
         let program = words(&["MVP ABS, 0, 51200", "WAIT POS, 0, 0", "STOP"]);
         let mut sent = Vec::new();
+        let mut replies = Vec::new();
         let mut request = |ins: Instruction| -> Result<[u8; FRAME_LEN], &str> {
-            sent.push(ins.opcode);
-            m.handle_frame(&Request::new(1, ins).encode()).ok_or("no reply")
+            sent.push(ins);
+            let raw = m.handle_frame(&Request::new(1, ins).encode()).ok_or("no reply")?;
+            replies.push(raw[2]);
+            Ok(raw)
         };
         let mut done = Vec::new();
         assert_eq!(download_and_verify(&mut request, 1, &program, &mut |n| done.push(n)), Ok(()));
-        assert_eq!(sent, [128, 132, 4, 27, 28, 133, 134, 134, 134]);
+        // The words, then the NOP TMCL-IDE sends before 133 (rule 94).
+        let opcodes: Vec<u8> = sent.iter().map(|i| i.opcode).collect();
+        assert_eq!(opcodes, [128, 132, 4, 27, 28, 0, 133, 134, 134, 134]);
+        assert_eq!(sent[5], Instruction::new(0, 0, 0, 0));
+        // Every word in download mode, the NOP too, is answered 101.
+        assert_eq!(replies[2..6], [101; 4]);
         assert_eq!(done, [1, 2, 3, 4, 5, 6]);
+        // The NOP is stored after the program: 135 type 0 points past it.
+        let pointer = m.handle_frame(&Request::new(1, Instruction::new(135, 0, 0, 0)).encode()).unwrap();
+        assert_eq!(i32::from_be_bytes(pointer[4..8].try_into().unwrap()), 4);
+    }
+
+    #[test]
+    fn a_program_that_fills_the_memory_has_its_nop_refused_and_is_still_good() {
+        // Rule 14: the NOP past the last word answers 4; the words are all
+        // stored and read back.
+        let mut m = Module::built_in("tmcm-1141").unwrap();
+        let mut statuses = Vec::new();
+        let mut request = |ins: Instruction| -> Result<[u8; FRAME_LEN], &str> {
+            let raw = m.handle_frame(&Request::new(1, ins).encode()).ok_or("no reply")?;
+            statuses.push((ins.opcode, raw[2]));
+            Ok(raw)
+        };
+        let full = [vec![parse_line("MST 0").unwrap(); 1023], words(&["STOP"])].concat();
+        assert_eq!(download_and_verify(&mut request, 1, &full, &mut |_| ()), Ok(()));
+        assert_eq!(statuses[1026], (0, 4), "the NOP after word 1023");
+        assert_eq!(statuses[1027], (133, 100));
     }
 
     #[test]

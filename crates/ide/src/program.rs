@@ -1,7 +1,8 @@
 //! Programs: assembling with diagnostics and the source map, the download
-//! with progress and verification (132, the words, 133, then 134 for every
-//! word), reading a program back, and the program's state (135, user
-//! variables, and what only a virtual module can add).
+//! with progress and verification (132, the words, the NOP TMCL-IDE sends
+//! after them, 133, then 134 for every word), reading a program back, and
+//! the program's state (135, user variables, and what only a virtual
+//! module can add).
 
 use crate::answers::entry;
 use crate::download::DownloadError;
@@ -48,8 +49,9 @@ pub fn assemble(source: &str, profile: Option<&Profile>) -> Result<Program, Valu
     })
 }
 
-/// An assembled program as the app shows it: its size, the source map, the
-/// labels and a listing.
+/// An assembled program as the app shows it: its size (the STOP the
+/// assembler appends included, docs/behaviour.md rule 93), the source map
+/// (which has no line for that STOP), the labels and a listing.
 pub fn program_json(p: &Program) -> Value {
     let map: Vec<Value> = p
         .source_map
@@ -57,9 +59,20 @@ pub fn program_json(p: &Program) -> Value {
         .enumerate()
         .map(|(a, s)| json!({"address": a, "file": &*s.file, "line": s.line, "column": s.column, "text": s.text}))
         .collect();
-    let listing: String =
-        p.instructions.iter().enumerate().map(|(a, w)| format!("{a:5}  {}\n", tmclsim_protocol::mnemonic::format(*w))).collect();
-    json!({"ok": true, "words": p.instructions.len(), "diagnostics": [], "source_map": map, "symbols": p.symbols, "listing": listing})
+    let appended = p.appended_stop_address().map(|a| a as usize);
+    let listing: String = p
+        .instructions
+        .iter()
+        .enumerate()
+        .map(|(a, w)| {
+            let note = if Some(a) == appended { "  // appended: the program does not end in STOP" } else { "" };
+            format!("{a:5}  {}{note}\n", tmclsim_protocol::mnemonic::format(*w))
+        })
+        .collect();
+    json!({
+        "ok": true, "words": p.instructions.len(), "appended_stop": p.appended_stop, "diagnostics": [],
+        "source_map": map, "symbols": p.symbols, "listing": listing,
+    })
 }
 
 /// The answer to an assembly: the program or its diagnostics.

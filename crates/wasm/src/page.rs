@@ -451,7 +451,8 @@ mod tests {
         let source = "Loop: CALC ADD, 1\n      JA Loop\n";
         let lines = post(&mut p, "/api/modules/0/program/download", json!({"source": source}));
         let end = lines.as_array().unwrap().last().unwrap();
-        assert_eq!((end["done"].as_bool(), end["verified"].as_bool(), end["words"].as_u64()), (Some(true), Some(true), Some(2)), "{lines}");
+        // The two words and the STOP appended after JA (docs/behaviour.md rule 93).
+        assert_eq!((end["done"].as_bool(), end["verified"].as_bool(), end["words"].as_u64()), (Some(true), Some(true), Some(3)), "{lines}");
         let st = post(&mut p, "/api/modules/0/program/breakpoints", json!({"addresses": [1]}));
         assert_eq!(st["breakpoints"], json!([1]));
         post(&mut p, "/api/modules/0/program/run", json!({}));
@@ -460,6 +461,6 @@ mod tests {
         assert_eq!((st["mode"].as_str(), st["pc"].as_u64(), st["breakpoint"].as_u64()), (Some("step"), Some(1), Some(1)), "{st}");
         assert_eq!(st["accumulator"], 1);
         let read = p.request("GET", "/api/modules/0/program/source", "");
-        assert_eq!(read["words"], 2);
+        assert_eq!(read["words"], 3);
     }
 }

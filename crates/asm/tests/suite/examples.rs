@@ -22,7 +22,8 @@ fn every_manual_example_assembles_for_the_tmcm_1141() {
 fn first_steps_program_binary_checked_by_hand() {
     let program = assemble_path(common::programs_dir().join("first_steps_2_4.tmc"), Some(&tmcm_1141())).unwrap();
     let bin = program.to_binary();
-    assert_eq!(bin.len(), 13 * 8);
+    // Thirteen instructions, the last JA Loop, and the STOP appended.
+    assert_eq!(bin.len(), 14 * 8);
     let words: Vec<&[u8]> = bin.chunks(8).collect();
     // ROL 0, 1000: opcode 2, value 0x3E8; checksum 02+03+E8 = ED.
     assert_eq!(words[0], [0x02, 0x00, 0x00, 0x00, 0x00, 0x03, 0xE8, 0xED]);
@@ -43,6 +44,11 @@ fn first_steps_program_binary_checked_by_hand() {
     assert_eq!(words[10], [0x04, 0x00, 0x00, 0xFF, 0xF8, 0x30, 0x00, 0x2B]);
     // JA Loop, Loop = 8: 16+08 = 1E.
     assert_eq!(words[12], [0x16, 0x00, 0x00, 0x00, 0x00, 0x00, 0x08, 0x1E]);
+    // The program ends in JA: a STOP follows it, as in the binary TMCL-IDE
+    // writes (docs/behaviour.md rule 93): 1C, six zero bytes, checksum 1C.
+    assert_eq!(words[13], [0x1C, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1C]);
+    assert!(program.appended_stop);
+    assert_eq!(program.appended_stop_address(), Some(13));
     assert_eq!(program.symbols["Loop"], 8);
     // The label, then the source map: "Loop:" stands alone on line 11, so
     // address 8 is the MVP of line 12; the text loses its comment.
@@ -51,8 +57,11 @@ fn first_steps_program_binary_checked_by_hand() {
     let name = common::programs_dir().join("first_steps_2_4.tmc").display().to_string();
     assert!(symbols.contains(&format!("\n@0\t{name}\t2\t1\tROL 0, 1000\n")), "{symbols}");
     assert!(symbols.contains(&format!("\n@8\t{name}\t12\t1\tMVP ABS, 0, 512000\n")), "{symbols}");
-    assert_eq!(program.source_map.len(), program.instructions.len());
+    // The appended STOP comes from no line: the map ends with JA Loop.
+    assert_eq!(program.source_map.len(), program.instructions.len() - 1);
     assert_eq!(program.source_of(12).map(|s| (s.line, s.text.as_str())), Some((16, "JA Loop")));
+    assert_eq!(program.source_of(13), None);
+    assert!(symbols.ends_with(&format!("\n@12\t{name}\t16\t1\tJA Loop\n")), "{symbols}");
 }
 
 #[test]
@@ -76,7 +85,8 @@ fn every_example_round_trips_through_the_disassembler() {
 fn disassembly_is_readable() {
     let program = assemble_path(common::programs_dir().join("call_3_7_44.tmc"), Some(&tmcm_1141())).unwrap();
     let text = program.disassemble();
-    assert!(text.starts_with("// TMCL program disassembled by tmclsim-asm: 16 instruction(s)."), "{text}");
+    // 16 instructions and the STOP appended after the last one, RSUB.
+    assert!(text.starts_with("// TMCL program disassembled by tmclsim-asm: 17 instruction(s)."), "{text}");
     for line in ["Loop:", "    CALL LT, RunLeft", "    CALL ZE, MotorStop", "    CALC SUB, 512", "RunRight:", "    JC ZE, MotorIsStopped"] {
         assert!(text.lines().any(|l| l.starts_with(line)), "{line}\n{text}");
     }
@@ -139,6 +149,7 @@ fn the_manuals_misprints_are_reported() {
     // Without the include file, the symbolic names are unknown.
     let e = assemble("VECT TI_TIMER0, 5\n", "prog.tmc", &MemoryResolver::new(), None).unwrap_err();
     assert_eq!(e[0].to_string(), "prog.tmc:1:6: error: unknown constant or label 'TI_TIMER0'");
-    // Numbers without a program: every one-line example also assembles alone.
-    assert_eq!(asm("CALCVV SUB, 65, 42").instructions.len(), 1);
+    // Numbers without a program: every one-line example also assembles
+    // alone (with the STOP appended after it).
+    assert_eq!(asm("CALCVV SUB, 65, 42").instructions.len(), 2);
 }

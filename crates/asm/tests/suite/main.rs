@@ -2,6 +2,7 @@
 //! the shared helpers built once.
 
 mod common;
+mod end_stop;
 mod errors;
 mod examples;
 mod fuzz;

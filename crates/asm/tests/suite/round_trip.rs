@@ -1,15 +1,27 @@
 //! assemble → disassemble → assemble gives the same binary, for random
 //! instructions (valid ones and arbitrary bytes), with and without a
-//! symbol table; and the binary and symbol formats read back what they
-//! wrote.
+//! symbol table (words that do not end in STOP come back with the STOP the
+//! assembler appends, docs/behaviour.md rule 93); and the binary and
+//! symbol formats read back what they wrote.
 
 use crate::common;
 
 use std::collections::BTreeMap;
 
 use common::Rng;
+use tmclsim_asm::binary::{END_STOP, needs_end_stop};
 use tmclsim_asm::{Instruction, NoIncludes, Program, assemble, disassemble, render};
 use tmclsim_protocol::{mnemonic, opcode};
+
+/// The words as the assembler gives them back: with the STOP it appends
+/// when the last word is not one.
+fn ended(words: &[Instruction]) -> Vec<Instruction> {
+    let mut out = words.to_vec();
+    if needs_end_stop(words) {
+        out.push(END_STOP);
+    }
+    out
+}
 
 fn reassemble(instructions: &[Instruction], symbols: Option<&BTreeMap<String, u32>>) -> Program {
     let text = disassemble(instructions, symbols);
@@ -48,14 +60,14 @@ fn random_valid_programs_round_trip() {
         let len = rng.below(40) as usize + 1;
         let program: Vec<Instruction> = (0..len).map(|_| random_mnemonic_instruction(&mut rng, len)).collect();
         let again = reassemble(&program, None);
-        assert_eq!(again.instructions, program);
+        assert_eq!(again.instructions, ended(&program));
         // With a symbol table naming some addresses (one past the end too).
         let mut symbols = BTreeMap::new();
         for i in 0..rng.below(5) {
             symbols.insert(format!("Sym{i}"), rng.below(len as u64 + 1) as u32);
         }
         let again = reassemble(&program, Some(&symbols));
-        assert_eq!(again.instructions, program);
+        assert_eq!(again.instructions, ended(&program));
         assert_eq!(again.symbols.iter().filter(|(n, _)| n.starts_with("Sym")).count(), symbols.len());
         for (name, address) in &symbols {
             assert_eq!(again.symbols[name], *address);
@@ -69,7 +81,9 @@ fn arbitrary_words_round_trip() {
     for _ in 0..300 {
         let len = rng.below(30) as usize;
         let program: Vec<Instruction> = (0..len).map(|_| Instruction::from_bytes(&std::array::from_fn(|_| rng.byte()))).collect();
-        assert_eq!(reassemble(&program, None).instructions, program);
+        assert_eq!(reassemble(&program, None).instructions, ended(&program));
+        // Once ended, the disassembly assembles to exactly the same words.
+        assert_eq!(reassemble(&ended(&program), None).instructions, ended(&program));
         let binary = tmclsim_asm::binary::encode(&program);
         assert_eq!(Program::from_binary(&binary).unwrap(), program);
     }
@@ -88,7 +102,7 @@ fn unusual_words_use_the_raw_form() {
     for line in ["    #db 0, 0, 0, 0", "    #db 136, 1, 0, 0", "    #db 24, 0, 0, 7", "    #db 19, 11, 0, 5", "    #db 22, 0, 3, 0"] {
         assert!(text.contains(line), "{line}\n{text}");
     }
-    assert_eq!(reassemble(&program, None).instructions, program);
+    assert_eq!(reassemble(&program, None).instructions, ended(&program));
 }
 
 #[test]
@@ -106,9 +120,12 @@ fn binary_and_symbol_files_read_back() {
     let source = "Start: ROL 0, 1000\nWAIT TICKS, 0, 500\nMiddle: MST 0\nJA Start\nEnd:\n";
     let program = assemble(source, "p.tmc", &NoIncludes, None).unwrap();
     let binary = program.to_binary();
-    assert_eq!(binary.len(), 32);
+    // Four instructions and the STOP appended after JA, which End labels.
+    assert_eq!(binary.len(), 40);
+    assert_eq!(binary[32..], [0x1C, 0, 0, 0, 0, 0, 0, 0x1C]);
     assert_eq!(Program::from_binary(&binary).unwrap(), program.instructions);
     assert!(program.symbol_file().starts_with("Start 0\nMiddle 2\nEnd 4\n// source map"));
+    // The source map ends with the last line: the appended STOP has none.
     assert!(program.symbol_file().ends_with("\n@2\tp.tmc\t3\t9\tMiddle: MST 0\n@3\tp.tmc\t4\t1\tJA Start\n"));
     assert_eq!(Program::parse_symbol_file(&program.symbol_file()).unwrap(), program.symbols);
     let mut bad = binary.clone();

@@ -214,7 +214,8 @@ fn the_debugger_speaks_in_source_lines_and_names() {
         "unknown command 'stp' (did you mean 'step'?)",
         "no axis parameter 'actul position' (did you mean 'Actual position'?)",
         "'Lop' is neither a label of the program, an address nor FILE:LINE (did you mean 'Loop'?)",
-        "address 99 is outside the program (0…4)",
+        // Five instructions and the STOP appended after DJNZ (rule 93).
+        "address 99 is outside the program (0…5)",
         "no watch 3",
         "a[dvance] TIME",
     ] {
@@ -238,6 +239,8 @@ fn asm_list_shows_the_source_beside_the_bytes() {
     let t = text(&o);
     assert!(t.contains("Loop:\n    1  04 01 00 00 00 C8 00      6  MVP REL, 0, 51200\n"), "{t}");
     assert!(t.contains("    4  31 2A 00 00 00 00 01      9  DJNZ 42, Loop\n"), "{t}");
+    // The STOP appended after DJNZ (docs/behaviour.md rule 93): no line.
+    assert!(t.ends_with("    5  1C 00 00 00 00 00 00         STOP  (appended: the program does not end in STOP)\n"), "{t}");
 }
 
 #[test]
@@ -261,7 +264,9 @@ fn upload_over_tcp_and_pty_verifies_and_runs() {
     let prog = example("djnz_3_7_43.tmc");
     let o = tmclsim(&["upload", prog.to_str().unwrap(), "--tcp", &tcp, "--run"]);
     assert!(o.status.success(), "{}", text(&o));
-    assert!(text(&o).contains("uploaded and verified 5 instructions"), "{}", text(&o));
+    // Five instructions, the last DJNZ, and the STOP the assembler appends
+    // (docs/behaviour.md rule 93).
+    assert!(text(&o).contains("uploaded and verified 6 instructions (the last one the STOP appended"), "{}", text(&o));
     let o = tmclsim(&["send", "--tcp", &tcp, "GGP", "128,", "0"]);
     assert!(text(&o).contains("value 1"), "running: {}", text(&o));
     // Over the pty, a binary this time, with autostart.
@@ -275,6 +280,67 @@ fn upload_over_tcp_and_pty_verifies_and_runs() {
     assert!(text(&o).contains("memory:  GIO 0, 1"), "{}", text(&o));
     server.kill().unwrap();
     server.wait().unwrap();
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// What `tmclsim upload` sends over a real link and what the module
+/// answers, recorded by `tmclsim trace record` between them
+/// (docs/behaviour.md rules 93, 94, 15, 17): 128, 132, the program's
+/// words, the STOP appended after its last instruction, the NOP TMCL-IDE
+/// sends after the last word, 133, then 134 for every word; every word in
+/// download mode, the NOP too, answered with status 101; 135 then points
+/// past the NOP.
+#[test]
+fn upload_sends_the_words_the_appended_stop_and_the_nop_as_tmcl_ide_does() {
+    use tmclsim_host::trace::Dir;
+    use tmclsim_protocol::{Instruction, Request, opcode};
+    let d = dir("upload-as-tmcl-ide");
+    let source = d.join("shuttle.tmc");
+    std::fs::write(&source, "Loop: MVP ABS, 0, 1000\n  WAIT POS, 0, 0\n  MVP ABS, 0, 0\n  WAIT POS, 0, 0\n  JA Loop\n").unwrap();
+    let (mut server, tcp) = common::serve(&[], Stdio::inherit());
+    let trace = d.join("upload.jsonl");
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tmclsim"));
+    c.args(["trace", "record", "--listen", "127.0.0.1:0", "--tcp", &tcp, "--out", trace.to_str().unwrap()]);
+    c.stdout(Stdio::piped()).stderr(Stdio::piped());
+    let mut rec = common::Server::spawn(c);
+    let listen = rec.printed("listen");
+    let o = tmclsim(&["upload", source.to_str().unwrap(), "--tcp", &listen]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("uploaded and verified 6 instructions"), "{}", text(&o));
+    // 135 type 0 on the module's own link: stopped (0 in the high byte),
+    // not waiting, the download pointer after the NOP: address 7.
+    let mut s = std::net::TcpStream::connect(&tcp).unwrap();
+    s.set_read_timeout(Some(std::time::Duration::from_secs(5))).unwrap();
+    let status = common::ask(&mut s, "#135 0 0 0").expect("a reply to 135");
+    assert_eq!((status.status, status.value), (100, 7));
+    // SAFETY: signalling the child this test started.
+    unsafe {
+        libc::kill(rec.child.id() as i32, libc::SIGTERM);
+    }
+    assert_eq!(rec.exit_code_within(std::time::Duration::from_secs(10)), Some(0));
+    server.kill().unwrap();
+    server.wait().unwrap();
+
+    let entries = tmclsim_host::trace::read(std::fs::File::open(&trace).unwrap(), "upload.jsonl").unwrap();
+    let sent: Vec<[u8; 9]> = entries.iter().filter(|e| e.dir == Dir::Host).map(|e| e.frame).collect();
+    let answered: Vec<[u8; 9]> = entries.iter().filter(|e| e.dir == Dir::Module).map(|e| e.frame).collect();
+    assert_eq!(sent.len(), answered.len(), "a reply to every request");
+    let opcodes: Vec<u8> = sent.iter().map(|f| f[1]).collect();
+    assert_eq!(opcodes, [128, 132, 4, 27, 4, 27, 22, 28, 0, 133, 134, 134, 134, 134, 134, 134]);
+    // The last two words exactly: the STOP (1C …) and the NOP, each
+    // followed by its checksum; the address byte 1 leads both.
+    let frame = |ins| Request::new(1, ins).encode();
+    assert_eq!(sent[7], frame(Instruction::new(opcode::STOP, 0, 0, 0)));
+    assert_eq!(sent[7], [0x01, 0x1C, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1D]);
+    assert_eq!(sent[8], [0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x01]);
+    // In download mode every word, the NOP too, is answered with status
+    // 101, its own opcode and value; 132 and 133 with 100.
+    for (request, reply) in sent[2..=8].iter().zip(&answered[2..=8]) {
+        assert_eq!((reply[2], reply[3], &reply[4..8]), (101, request[1], &request[4..8]), "{request:02X?} → {reply:02X?}");
+    }
+    assert_eq!((answered[1][2], answered[9][2]), (100, 100));
+    // 134 reads the STOP back at address 5.
+    assert_eq!(answered[15][1..8], [0x1C, 0, 0, 0, 0, 0, 0]);
     std::fs::remove_dir_all(&d).unwrap();
 }
 

@@ -365,6 +365,37 @@ fn code_protection() {
     assert_eq!(reply(&mut m, "#132 0 0 0").status, 5, "protected against overwriting");
 }
 
+/// A download as TMCL-IDE makes it (docs/behaviour.md rules 93, 94): the
+/// words, the STOP it appends after a program's last instruction, then a
+/// NOP before 133. Every word in download mode, the NOP too, is stored at
+/// the next address and answered with status 101; 135 type 0 then points
+/// after the NOP; the NOP, if a program ever runs it, is skipped with
+/// status 2 as any command the module does not have (rule 21).
+#[test]
+fn the_nop_tmcl_ide_sends_after_the_last_word_is_stored_and_skipped_when_run() {
+    for profile in ["tmcm-1141", "tmcm-351", "tmcm-1310"] {
+        let mut m = BusOfOne::built_in(profile);
+        m.set_trace(true);
+        assert_eq!(reply(&mut m, "#132 0 0 0").status, 100);
+        for line in ["CALCV ADD, 1, 1", "JA 0", "STOP", "#0 0 0 0"] {
+            let r = reply(&mut m, line);
+            let sent = parse_line(line).unwrap();
+            assert_eq!((r.status, r.opcode, r.value), (101, sent.opcode, sent.value), "{profile}: {line}");
+        }
+        assert_eq!(reply(&mut m, "#133 0 0 0").status, 100);
+        // Stopped (the mode in the high byte), the download pointer at 4.
+        assert_eq!(send(&mut m, "#135 0 0 0"), 4, "{profile}");
+        let f = raw(&mut m, Instruction::new(134, 0, 0, 3));
+        assert_eq!(f[1..8], [0; 7], "{profile}: the NOP is stored at address 3");
+        // Run from the NOP: skipped with status 2, the program goes on.
+        assert_eq!(reply(&mut m, "#129 1 0 3").status, 100);
+        m.advance(MS);
+        let trace = m.take_trace();
+        assert_eq!((trace[0].pc, trace[0].failed), (3, Some(2)), "{profile}");
+        assert_eq!(trace[1].pc, 4, "{profile}");
+    }
+}
+
 #[test]
 fn failed_commands_are_skipped_and_traced() {
     let mut m = module();

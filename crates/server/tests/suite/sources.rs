@@ -23,7 +23,10 @@ fn relative_includes_on_disk_and_include_once() {
     assert_eq!(program.symbols["Start"], 4);
     assert_eq!(program.constants["Home"], 0);
     assert_eq!(program.constants["TI_GLOBAL"], 255);
-    assert_eq!(program.instructions.len(), 8);
+    // Eight words of source and the STOP the assembler appends after a last
+    // word that is none (docs/behaviour.md rule 93).
+    assert_eq!(program.instructions.len(), 9);
+    assert_eq!(program.appended_stop_address(), Some(8));
     assert_eq!(program.instructions[0], tmclsim_asm::Instruction::new(22, 0, 0, 4));
     assert_eq!(program.instructions[4], tmclsim_asm::Instruction::new(5, 4, 0, 1000));
 }

@@ -104,9 +104,12 @@ fn assembling_reports_errors_at_line_and_column_and_maps_addresses_to_lines() {
     assert_eq!((d["line"].as_u64(), d["column"].as_u64()), (Some(2), Some(6)));
     assert!(d["message"].as_str().unwrap().contains("did you mean 'Loop'"));
     let (_, r) = post(&s.url("/api/assemble"), json!({"source": COUNTER}));
-    assert_eq!(r["words"], 4);
+    // Four instructions and the STOP appended after JA Loop
+    // (docs/behaviour.md rule 93), which no line of the source map names.
+    assert_eq!((r["words"].as_u64(), r["appended_stop"].as_bool()), (Some(5), Some(true)));
     let lines: Vec<u64> = r["source_map"].as_array().unwrap().iter().map(|e| e["line"].as_u64().unwrap()).collect();
     assert_eq!(lines, [1, 2, 3, 4]);
+    assert!(r["listing"].as_str().unwrap().ends_with("    4  STOP  // appended: the program does not end in STOP\n"), "{r}");
     assert_eq!(r["symbols"]["Loop"], 1);
 }
 
@@ -122,15 +125,26 @@ fn download_verifies_every_word_and_the_host_reads_them_back() {
     let s = Served::new();
     let lines = download(&s, COUNTER);
     let last = lines.last().unwrap();
-    assert_eq!((last["done"].as_bool(), last["verified"].as_bool(), last["words"].as_u64()), (Some(true), Some(true), Some(4)));
+    // The four words of the source and the STOP appended after JA Loop.
+    assert_eq!((last["done"].as_bool(), last["verified"].as_bool(), last["words"].as_u64()), (Some(true), Some(true), Some(5)));
     assert_eq!(lines[lines.len() - 2]["progress"], lines[lines.len() - 2]["total"]);
-    // 134 on the host's link reads the stored CALC ADD, 1 at address 1.
+    // 134 on the host's link reads the stored CALC ADD, 1 at address 1,
+    // the STOP at 4 and, at 5, the NOP sent after it before 133
+    // (docs/behaviour.md rule 94), stored as the module stores every word.
     let mut host = s.host();
     use std::io::{Read, Write};
-    host.write_all(&tmclsim_protocol::Request::new(1, tmclsim_protocol::Instruction::new(134, 0, 0, 1)).encode()).unwrap();
-    let mut raw = [0u8; 9];
-    host.read_exact(&mut raw).unwrap();
-    assert_eq!(&raw[1..4], &[19, 0, 0], "CALC (19) ADD (0)");
+    let mut read = |op: u8, value: i32| {
+        host.write_all(&tmclsim_protocol::Request::new(1, tmclsim_protocol::Instruction::new(op, 0, 0, value)).encode()).unwrap();
+        let mut raw = [0u8; 9];
+        host.read_exact(&mut raw).unwrap();
+        raw
+    };
+    assert_eq!(&read(134, 1)[1..4], &[19, 0, 0], "CALC (19) ADD (0)");
+    assert_eq!(&read(134, 4)[1..8], &[28, 0, 0, 0, 0, 0, 0], "STOP");
+    assert_eq!(&read(134, 5)[1..8], &[0; 7], "the NOP");
+    // 135 type 0: stopped, the download pointer after the NOP.
+    let status = read(135, 0);
+    assert_eq!((status[2], i32::from_be_bytes(status[4..8].try_into().unwrap())), (100, 6));
     // An error in the source: no download, the diagnostics.
     let lines = download(&s, "JA Nowhere\n");
     assert_eq!(lines[0]["ok"], false);

@@ -45,6 +45,65 @@ fn a_served_module_over_tcp_lists_answers_and_stops_at_breakpoints() {
     post(&url("/api/modules/0/program/stop"), json!({}));
 }
 
+/// The frames a proxy saw: the host's, and the module's.
+type Frames = std::sync::Arc<std::sync::Mutex<(Vec<[u8; 9]>, Vec<[u8; 9]>)>>;
+
+/// Frames a host sends through a TCP proxy to `to`, and the module's
+/// answers, nine bytes each, in order; the proxy's address.
+fn recording_proxy(to: std::net::SocketAddr) -> (String, Frames) {
+    use std::io::{Read, Write};
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = listener.local_addr().unwrap().to_string();
+    let log = std::sync::Arc::new(std::sync::Mutex::new((Vec::new(), Vec::new())));
+    let frames = log.clone();
+    std::thread::spawn(move || {
+        let (host, _) = listener.accept().unwrap();
+        let module = std::net::TcpStream::connect(to).unwrap();
+        let pipe = |mut from: std::net::TcpStream, mut into: std::net::TcpStream, requests: bool| {
+            let log = frames.clone();
+            std::thread::spawn(move || {
+                let mut f = [0u8; 9];
+                while from.read_exact(&mut f).is_ok() {
+                    let mut l = log.lock().unwrap();
+                    let side = if requests { &mut l.0 } else { &mut l.1 };
+                    side.push(f);
+                    drop(l);
+                    if into.write_all(&f).is_err() {
+                        break;
+                    }
+                }
+            })
+        };
+        pipe(host.try_clone().unwrap(), module.try_clone().unwrap(), true);
+        pipe(module, host, false);
+    });
+    (addr, log)
+}
+
+/// The IDE's Download over a link sends what TMCL-IDE sends
+/// (docs/behaviour.md rules 93, 94): 132, the words, the STOP appended
+/// after the source's last instruction, a NOP, 133; every word, the NOP
+/// too, answered with status 101.
+#[test]
+fn a_download_over_a_link_ends_with_the_stop_and_the_nop_before_133() {
+    let s = Served::new();
+    let (proxy, log) = recording_proxy(s.tcp());
+    let web = app_over_tcp(&proxy);
+    let url = |p: &str| format!("http://{}{p}", web.addr());
+    let last = post_text(&url("/api/modules/0/program/download"), json!({"source": "Loop: ROR 0, 100\n  WAIT TICKS, 0, 10\n  JA Loop\n"}));
+    assert!(last.contains("\"verified\":true") && last.contains("\"words\":4"), "{last}");
+    let (sent, answered) = log.lock().unwrap().clone();
+    let start = sent.iter().position(|f| f[1] == 132).expect("132");
+    let opcodes: Vec<u8> = sent[start..].iter().map(|f| f[1]).take(7).collect();
+    assert_eq!(opcodes, [132, 1, 27, 22, 28, 0, 133], "{sent:02X?}");
+    assert_eq!(sent[start + 4], [0x01, 0x1C, 0, 0, 0, 0, 0, 0, 0x1D], "the STOP");
+    assert_eq!(sent[start + 5], [0x01, 0, 0, 0, 0, 0, 0, 0, 0x01], "the NOP");
+    let statuses: Vec<u8> = answered[start..start + 7].iter().map(|f| f[2]).collect();
+    assert_eq!(statuses, [100, 101, 101, 101, 101, 101, 100], "{answered:02X?}");
+    // Then 134 reads the four words back.
+    assert_eq!(sent[start + 7..].iter().filter(|f| f[1] == 134).count(), 4);
+}
+
 #[test]
 fn an_address_that_does_not_answer_is_named_and_left_out() {
     let s = Served::new();
@@ -107,11 +166,14 @@ fn stops_every_time(url: &dyn Fn(&str) -> String) {
             assert!(st["breakpoint"].is_null() || at_the_next_hit, "{st}");
         }
     }
-    // The program read back (134) up to its end, disassembled.
+    // The program read back (134) up to its end, disassembled: the four
+    // words and the STOP appended after JA (docs/behaviour.md rule 93); the
+    // NOP after it (rule 94) is an empty word, not part of the program.
     let (status, back) = get(&url("/api/modules/0/program/source"));
-    assert_eq!((status, back["words"].as_u64()), (200, Some(4)), "{back}");
+    assert_eq!((status, back["words"].as_u64()), (200, Some(5)), "{back}");
     let text = back["source"].as_str().unwrap();
     assert!(text.contains("CALC ADD, 1") && text.contains("WAIT TICKS, 0, 2") && text.contains("JA "), "{text}");
+    assert!(text.contains("    STOP"), "{text}");
     // Run starts over at address 0: the last hit is not reported there.
     let (_, st) = post(&url("/api/modules/0/program/run"), json!({}));
     assert!(st["breakpoint"].is_null() || st["pc"] == 2, "{st}");
