@@ -109,7 +109,7 @@ def test_op_and_process_data_moves(ethercat):
     f = inputs(s)
     assert f[0] == 51200 and f[2] == 51200, "target and virtual position"
     assert f[7] & 0b1001 == 0b1001, "status word: target reached, position mode"
-    # Velocity mode: set-point 500 (internal units).
+    # Velocity mode: set-point 500 (pps).
     s.output = struct.pack("<Ii", 2, 500)
     cycle_until(m, lambda: inputs(s)[5] == 500)
     assert inputs(s)[4] == 500
@@ -124,7 +124,7 @@ def test_tmcl_over_the_mailbox(ethercat):
     s = m.slaves[0]
     assert tmcl(s, 5, 4, 0, 1234) == (100, 1234)  # SAP 4
     assert tmcl(s, 6, 4, 0, 0) == (100, 1234)  # GAP 4
-    assert tmcl(s, 5, 4, 0, 5000)[0] == 4  # out of range
+    assert tmcl(s, 5, 4, 0, 327680000)[0] == 4  # out of range (1…327679999 pps)
     assert tmcl(s, 6, 99, 0, 0)[0] == 3  # no such parameter
     assert tmcl(s, 200, 0, 0, 0)[0] == 2  # no such command
     assert tmcl(s, 9, 66, 0, 5)[0] == 8  # SGP 66: password protected

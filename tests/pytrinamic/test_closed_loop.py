@@ -17,7 +17,7 @@ def test_closed_loop_move_over_the_pty(serve):
         motor = module.motors[0]
         motor.set_axis_parameter(motor.AP.ClosedLoopMode, 1)
         motor.set_axis_parameter(motor.AP.CLCurrentScaleMaximum, 100)
-        motor.set_axis_parameter(4, 2047)  # maximum positioning speed (TMC429 units)
+        motor.set_axis_parameter(motor.AP.MaxVelocity, 51200)  # pps: one turn a second
         served.world("load 0 60")
         interface.move_to(0, 51200)
         deadline = time.monotonic() + 10

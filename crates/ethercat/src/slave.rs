@@ -165,7 +165,11 @@ impl Slave {
         self.applied = Some((mode, setpoint));
         let command = match mode {
             1 => Command::Mvp { mode: tmclsim_protocol::MoveMode::Absolute, motor: 0, value: setpoint },
-            2 => Command::Ror { motor: 0, velocity: setpoint.clamp(-2047, 2047) },
+            2 => {
+                // A velocity set-point within the speeds ROR takes (AP 2's range).
+                let limit = m.profile().axis_parameter(2).map_or(2047, |p| p.max.min(i64::from(i32::MAX)) as i32);
+                Command::Ror { motor: 0, velocity: setpoint.clamp(-limit, limit) }
+            }
             3 => Command::Sap { param: 14, motor: 0, value: setpoint },
             _ => return,
         };

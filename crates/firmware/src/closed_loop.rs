@@ -4,7 +4,7 @@
 //! steps. In open loop the rotor loses steps under overload as on the
 //! TMCM-1141. Position, velocity and torque mode. (docs/closed-loop.md)
 //!
-//! The model, in the units of the module (TMC429 velocity units, µsteps):
+//! The model, in the units of the module (its velocity units, µsteps):
 //! - Rotor = virtual position − lag. In closed loop the current scale
 //!   (AP 123, %) is what the load needs plus a reserve, between AP 113 and
 //!   AP 114 (or AP 114 when regulation is off, AP 122 = 0); the lag grows
@@ -20,7 +20,7 @@
 //! - Torque mode (SAP 14, mA): the driver sets that current; the motor runs
 //!   at the speed where its torque equals the load.
 
-use crate::motion::{self, RampMode};
+use crate::motion::RampMode;
 use crate::motor::{Motor, MotorMut};
 use crate::parameter_numbers::ap;
 
@@ -119,8 +119,8 @@ impl Motor<'_> {
         scale_percent * (1.0 - fullsteps / crate::driver::CORNER_FULLSTEPS).max(0.0)
     }
 
-    /// The velocity (internal units) at which the motor's torque at the
-    /// torque-mode current equals the load.
+    /// The velocity (the module's units) at which the motor's torque at
+    /// the torque-mode current equals the load.
     pub(crate) fn torque_mode_velocity(&self) -> f64 {
         let p = &self.axis.params;
         let target = f64::from(p[cl::TORQUE_TARGET as usize]);
@@ -131,8 +131,8 @@ impl Motor<'_> {
         }
         let fullsteps = crate::driver::CORNER_FULLSTEPS * (1.0 - load / percent);
         let pps = fullsteps * self.axis.microsteps();
-        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        (motion::velocity_internal(pps, pd).min(2047.0)) * target.signum()
+        let units = self.units();
+        units.velocity_value(pps).min(f64::from(units.max_value())) * target.signum()
     }
 
     /// Reads of the closed-loop parameters; `None` for the others.
@@ -142,7 +142,6 @@ impl Motor<'_> {
         }
         let axis = self.axis;
         let p = &axis.params;
-        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         let torque_ma = if axis.closed_loop.torque_mode {
             f64::from(p[cl::TORQUE_TARGET as usize]).clamp(-self.full_scale_ma(), self.full_scale_ma())
         } else {
@@ -162,7 +161,7 @@ impl Motor<'_> {
                     axis.closed_loop.scale.round() as i32
                 }
             }
-            cl::MEASURED_VELOCITY => motion::velocity_internal(axis.closed_loop.rotor_velocity, pd).round() as i32,
+            cl::MEASURED_VELOCITY => self.units().velocity_value(axis.closed_loop.rotor_velocity).round() as i32,
             cl::INIT_FLAG => i32::from(self.closed_loop_on()),
             ap::ENCODER_POSITION => self.closed_loop_encoder(),
             cl::GAMMA => {
@@ -243,6 +242,7 @@ impl MotorMut<'_> {
     /// could not follow. True when a deviation is to be reported.
     pub(crate) fn closed_loop_step(&mut self, moved: f64, dt: f64, open_loop_slips: bool) -> bool {
         let p = self.axis.params;
+        let units = self.view().units();
         let load = self.view().load();
         let sign = self.at.shaft_sign();
         let before = self.view().mechanical_position() - moved * sign;
@@ -266,8 +266,7 @@ impl MotorMut<'_> {
             } else {
                 // Correct the error at up to the correction velocity.
                 let lag = (axis.closed_loop.sync_offset - axis.mech_offset) * sign;
-                let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-                let v_corr = motion::velocity_pps(f64::from(p[cl::MAX_CORRECTION_VELOCITY as usize].clamp(0, 2047)), pd);
+                let v_corr = units.velocity_pps(f64::from(p[cl::MAX_CORRECTION_VELOCITY as usize].clamp(0, units.max_value())));
                 let step = (v_corr * dt).min(lag.abs());
                 if load <= torque {
                     axis.mech_offset += step * lag.signum() * sign;

@@ -2,7 +2,9 @@
 //!
 //! Units and formulas follow docs/behaviour.md rules 23–25:
 //! `v_pps = fclk·v / 2^(pulse_div+16)`,
-//! `a_pps = fclk²·a / 2^(ramp_div+pulse_div+29)`, fclk = 16 MHz.
+//! `a_pps = fclk²·a / 2^(ramp_div+pulse_div+29)`, fclk = 16 MHz; on a
+//! module whose profile says `motion_units = "pps"` the values are
+//! microsteps per second (per second²) as written ([`Units`]).
 //!
 //! The profile is planned piecewise: every phase has a constant
 //! acceleration (or, in soft mode, an exponential approach) and an end time
@@ -50,6 +52,75 @@ pub fn positioning_accel(a: u32, ramp_div: u32, pulse_div: u32) -> f64 {
     let lower = pow2(e - 1);
     let upper = (pow2(e + 12) - 1.0).min(2047.0);
     f64::from(a).clamp(lower.min(upper), upper)
+}
+
+/// How an axis's velocity and acceleration values (AP 2–5, 130, 131, 135,
+/// 181, 182, 194, 195 and the closed-loop velocities) turn into
+/// microsteps per second and per second²: the profile's `motion_units`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Units {
+    /// The TMC429's internal units with the axis's pulse and ramp divisors
+    /// (AP 154, AP 153; rules 23 and 24).
+    Tmc429 {
+        /// AP 154.
+        pulse_div: u32,
+        /// AP 153.
+        ramp_div: u32,
+    },
+    /// Microsteps per second (per second²), as written.
+    Pps,
+}
+
+impl Units {
+    /// The largest velocity (and acceleration) value the motion controller
+    /// holds: the TMC429's 11 bits, or any positive 32-bit value.
+    pub fn max_value(self) -> i32 {
+        match self {
+            Units::Tmc429 { .. } => 2047,
+            Units::Pps => i32::MAX,
+        }
+    }
+
+    /// Microsteps per second of a velocity value.
+    pub fn velocity_pps(self, v: f64) -> f64 {
+        match self {
+            Units::Tmc429 { pulse_div, .. } => velocity_pps(v, pulse_div),
+            Units::Pps => v,
+        }
+    }
+
+    /// The velocity value of a step rate.
+    pub fn velocity_value(self, pps: f64) -> f64 {
+        match self {
+            Units::Tmc429 { pulse_div, .. } => velocity_internal(pps, pulse_div),
+            Units::Pps => pps,
+        }
+    }
+
+    /// Microsteps per second² of an acceleration value.
+    pub fn accel_pps2(self, a: f64) -> f64 {
+        match self {
+            Units::Tmc429 { pulse_div, ramp_div } => accel_pps2(a, ramp_div, pulse_div),
+            Units::Pps => a,
+        }
+    }
+
+    /// The acceleration value of an acceleration in µsteps/s².
+    pub fn accel_value(self, pps2: f64) -> f64 {
+        match self {
+            Units::Tmc429 { pulse_div, ramp_div } => accel_internal(pps2, ramp_div, pulse_div),
+            Units::Pps => pps2,
+        }
+    }
+
+    /// AP 5 as positioning ramps use it, in µsteps/s²: clamped by the
+    /// TMC429 (rule 24), as is in pps.
+    pub fn positioning_accel_pps2(self, a: u32) -> f64 {
+        match self {
+            Units::Tmc429 { pulse_div, ramp_div } => accel_pps2(positioning_accel(a, ramp_div, pulse_div), ramp_div, pulse_div),
+            Units::Pps => f64::from(a),
+        }
+    }
 }
 
 /// `x.floor() as i64` without a call into the maths library: the
@@ -597,6 +668,21 @@ mod tests {
         assert!((velocity_pps(1678.0, 3) - 51208.5).abs() < 0.1);
         // 6.1.2: a = 100, ramp_div = 7, pulse_div = 3 → about 46566 pps².
         assert!((accel_pps2(100.0, 7, 3) - 46566.1).abs() < 0.5);
+    }
+
+    #[test]
+    fn pps_units_are_the_values_as_written() {
+        let tmc429 = Units::Tmc429 { pulse_div: 3, ramp_div: 7 };
+        assert_eq!(tmc429.velocity_pps(1000.0), velocity_pps(1000.0, 3));
+        assert_eq!(tmc429.accel_pps2(100.0), accel_pps2(100.0, 7, 3));
+        assert_eq!(tmc429.positioning_accel_pps2(1), accel_pps2(8.0, 7, 3), "clamped");
+        assert_eq!(tmc429.velocity_value(tmc429.velocity_pps(1234.0)), 1234.0);
+        assert_eq!(tmc429.max_value(), 2047);
+        let pps = Units::Pps;
+        assert_eq!((pps.velocity_pps(20_000.0), pps.velocity_value(20_000.0)), (20_000.0, 20_000.0));
+        assert_eq!((pps.accel_pps2(40_000.0), pps.accel_value(40_000.0)), (40_000.0, 40_000.0));
+        assert_eq!(pps.positioning_accel_pps2(1), 1.0, "no clamp");
+        assert_eq!(pps.max_value(), i32::MAX);
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! the per-axis state of the reference search, the driver and the closed
 //! loop.
 
-use crate::motion::{self, Motion, Ramp, RampMode};
+use crate::motion::{self, Motion, Ramp, RampMode, Units};
 use crate::parameter_numbers::ap;
 use crate::reference_search::ReferenceSearch;
 use std::cell::Cell;
@@ -37,6 +37,9 @@ pub struct Axis {
     /// The closed-loop controller's state (modules with an encoder and
     /// closed-loop mode).
     pub closed_loop: ClosedLoop,
+    /// The largest speed ROR and ROL take: the range of AP 2 (2047 on
+    /// TMC429 modules).
+    pub speed_limit: i32,
     /// The plain ramp last worked out and the parameter words it came
     /// from (`Module::ramp`).
     pub(crate) ramp_cache: Cell<Option<(RampKey, Ramp)>>,
@@ -61,6 +64,7 @@ impl Axis {
             ramp_override: None,
             encoder_offset: 0,
             closed_loop: Default::default(),
+            speed_limit: 2047,
             ramp_cache: Cell::new(None),
         }
     }
@@ -80,10 +84,11 @@ impl Axis {
         self.notify_on_arrival = false;
     }
 
-    /// ROR, ROL (`sign` 1, −1) with a speed of −2047…2047 (else status 4):
-    /// the motion errors are cleared and the axis runs at `velocity · sign`.
+    /// ROR, ROL (`sign` 1, −1) with a speed within ±`speed_limit` (else
+    /// status 4): the motion errors are cleared and the axis runs at
+    /// `velocity · sign`.
     pub fn rotate(&mut self, velocity: i32, sign: i32) -> Result<(), Status> {
-        if !(-2047..=2047).contains(&velocity) {
+        if !(-self.speed_limit..=self.speed_limit).contains(&velocity) {
             return Err(Status::InvalidValue);
         }
         self.clear_motion_errors();
@@ -128,35 +133,36 @@ impl Axis {
         r
     }
 
-    /// Works the ramp out from the axis parameters in µsteps and seconds:
-    /// the target speed is `torque_velocity` in torque mode (internal
-    /// units), the reference search's while one runs.
-    pub(crate) fn work_out_ramp(&self, torque_velocity: Option<f64>) -> Ramp {
+    /// Works the ramp out from the axis parameters in µsteps and seconds,
+    /// their values read in `units`: the target speed is
+    /// `torque_velocity` in torque mode (in `units`), the reference
+    /// search's while one runs.
+    pub(crate) fn work_out_ramp(&self, units: Units, torque_velocity: Option<f64>) -> Ramp {
         let p = &self.params;
-        let pd = p[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        let rd = p[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
-        let a = p[ap::MAX_ACCELERATION as usize].clamp(0, 2047) as u32;
-        let mut vmax = f64::from(p[ap::MAX_SPEED as usize].clamp(0, 2047));
+        let max = units.max_value();
+        let value = |n: u8| f64::from(p[n as usize].clamp(0, max));
+        let a = p[ap::MAX_ACCELERATION as usize].clamp(0, max) as u32;
+        let mut vmax = value(ap::MAX_SPEED);
         let mut target_velocity = f64::from(p[ap::TARGET_SPEED as usize]);
         if let Some(v) = torque_velocity {
             target_velocity = v;
         }
         if let Some(rfs) = &self.rfs {
-            let slow = f64::from(p[ap::REFERENCE_SWITCH_SPEED as usize].clamp(0, 2047));
+            let slow = value(ap::REFERENCE_SWITCH_SPEED);
             match rfs.current() {
                 Some(seek) => {
-                    let fast = f64::from(p[ap::REFERENCE_SEARCH_SPEED as usize].clamp(0, 2047));
+                    let fast = value(ap::REFERENCE_SEARCH_SPEED);
                     target_velocity = seek.dir * if seek.fast { fast } else { slow };
                 }
                 None => vmax = slow.max(1.0),
             }
         }
         Ramp {
-            vmax: motion::velocity_pps(vmax, pd),
-            vmin: motion::velocity_pps(f64::from(p[ap::MIN_SPEED as usize].clamp(0, 2047)), pd),
-            accel_position: motion::accel_pps2(motion::positioning_accel(a.max(1), rd, pd), rd, pd),
-            accel_velocity: motion::accel_pps2(f64::from(a.max(1)), rd, pd),
-            target_velocity: motion::velocity_pps(target_velocity, pd),
+            vmax: units.velocity_pps(vmax),
+            vmin: units.velocity_pps(value(ap::MIN_SPEED)),
+            accel_position: units.positioning_accel_pps2(a.max(1)),
+            accel_velocity: units.accel_pps2(f64::from(a.max(1))),
+            target_velocity: units.velocity_pps(target_velocity),
         }
     }
 

@@ -1,10 +1,10 @@
 //! The TMCM-1310: closed loop against open loop under load, torque mode,
-//! the status word, the deviation interrupt, ABN and SSI encoders and a
-//! lost encoder signal.
+//! the status word, the deviation interrupt, ABN and SSI encoders, a lost
+//! encoder signal, and its motion parameters in pps (docs/modules.md).
 
 use crate::common;
 
-use common::{BusOfOne, MS, load, reply, send};
+use common::{BusOfOne, MS, load, reply, send, status};
 
 use tmclsim_firmware::{Eeprom, Module, Profile, World};
 use tmclsim_protocol::mnemonic::parse_line;
@@ -20,7 +20,7 @@ fn setup(m: &mut BusOfOne, closed: bool) {
     send(m, "SAP 113, 0, 10");
     send(m, "SAP 114, 0, 100");
     send(m, "SAP 122, 0, 1");
-    send(m, "SAP 126, 0, 500");
+    send(m, "SAP 126, 0, 15000"); // correct at up to 15000 pps
     send(m, "SAP 210, 0, 4000");
     send(m, "SAP 202, 0, 200");
 }
@@ -189,4 +189,63 @@ fn commands_the_1310_lacks() {
         assert_eq!(reply(&mut m, line).status, 2, "{line}");
     }
     assert_eq!(send(&mut m, "EI 21"), 0, "deviation interrupt exists");
+}
+
+#[test]
+fn motion_parameters_take_pps_in_the_sibling_s_range() {
+    // PyTrinamic's TMCM-1311 examples: AP 4 = 20000, AP 5 = 40000, ROR 20000.
+    let mut m = module();
+    for line in ["SAP 4, 0, 20000", "SAP 5, 0, 40000", "ROR 0, 20000", "ROL 0, 20000"] {
+        assert_eq!(status(&mut m, line), 100, "{line}");
+    }
+    assert_eq!(send(&mut m, "GAP 4, 0"), 20000);
+    assert_eq!(send(&mut m, "GAP 5, 0"), 40000);
+    send(&mut m, "MST 0");
+    // The TMCM-1311 manual V1.11 gives velocities up to 327 679 999 pps.
+    for (n, lo) in [(2, -327_679_999), (4, 1), (108, 0), (109, 0), (130, 1), (194, 0), (195, 0)] {
+        assert_eq!(status(&mut m, &format!("SAP {n}, 0, 327679999")), 100, "AP {n}");
+        assert_eq!(status(&mut m, &format!("SAP {n}, 0, 327680000")), 4, "AP {n}: just above the range");
+        assert_eq!(status(&mut m, &format!("SAP {n}, 0, {}", lo - 1)), 4, "AP {n}: just below the range");
+    }
+    assert_eq!(status(&mut m, "ROR 0, 327679999"), 100);
+    assert_eq!(status(&mut m, "ROR 0, 327680000"), 4, "ROR takes AP 2's range");
+    assert_eq!(status(&mut m, "ROL 0, 327680000"), 4);
+    assert_eq!(status(&mut m, "SAP 5, 0, 2147483647"), 100, "any positive acceleration");
+    assert_eq!(status(&mut m, "SAP 5, 0, 0"), 4);
+    // No pulse or ramp divisor in pps units.
+    assert_eq!(status(&mut m, "GAP 153, 0"), 3);
+    assert_eq!(status(&mut m, "SAP 154, 0, 3"), 3);
+}
+
+#[test]
+fn a_velocity_in_pps_covers_its_distance_in_virtual_time() {
+    let mut m = module();
+    setup(&mut m, true);
+    // Velocity mode: 25600 pps reached with 51200 pps² in 0.5 s (6400
+    // µsteps), then 25600 µsteps every second.
+    send(&mut m, "SAP 5, 0, 51200");
+    send(&mut m, "ROR 0, 25600");
+    m.advance(2500 * MS);
+    assert_eq!(send(&mut m, "GAP 3, 0"), 25600);
+    assert_eq!(send(&mut m, "GAP 233, 0"), 6400 + 2 * 25600);
+    assert_eq!(send(&mut m, "GAP 1, 0"), 6400 + 2 * 25600);
+    // Over a stretch at constant speed the encoder measures the same speed.
+    m.advance(100 * MS);
+    assert_eq!(send(&mut m, "GAP 1, 0"), 6400 + 2 * 25600 + 2560);
+    assert_eq!(send(&mut m, "GAP 131, 0"), 25600);
+    send(&mut m, "MST 0");
+    m.advance(1000 * MS);
+    // Position mode: 51200 µsteps at 25600 pps and 51200 pps² take
+    // 0.5 s up, 1.5 s at speed and 0.5 s down (to the stop speed, 1 pps).
+    send(&mut m, "SAP 1, 0, 0");
+    send(&mut m, "SAP 4, 0, 25600");
+    send(&mut m, "MVP ABS, 0, 51200");
+    m.advance(2480 * MS);
+    assert_eq!(send(&mut m, "GAP 8, 0"), 0, "not yet");
+    let before = send(&mut m, "GAP 1, 0");
+    assert!((51_150..51_200).contains(&before), "{before}");
+    m.advance(40 * MS);
+    assert_eq!(send(&mut m, "GAP 8, 0"), 1);
+    assert_eq!(send(&mut m, "GAP 1, 0"), 51200);
+    assert_eq!(send(&mut m, "GAP 3, 0"), 0);
 }
