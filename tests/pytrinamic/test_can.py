@@ -12,20 +12,20 @@ from pytrinamic.modules import TMCM1141
 def test_two_modules_on_one_can_bus(serve, tmp_path):
     slcan = tmp_path / "slcan"
     serve("--bus", "tmcm-1141@1,tmcm-351@3", "--slcan", str(slcan))
-    for module_id, version in [(1, "1141V146"), (3, "0351V445")]:
+    for module_id, version in [(1, "1141V146"), (3, "351V.445")]:
         args = f"--interface slcan_tmcl --port {slcan} --data-rate 1000000 --module-id {module_id} --timeout 2"
         with ConnectionManager(args.split()).connect() as interface:
             assert interface.get_version_string() == version
             interface.set_axis_parameter(4, 0, 1000 + module_id)
             assert interface.get_axis_parameter(4, 0) == 1000 + module_id
             if module_id == 3:
-                # The TMCM-351 has three axes and 24-bit positions. The
+                # The TMCM-351 has three axes and 32-bit positions. The
                 # motor is stopped first (MST: velocity mode at 0), as the
                 # manual asks before AP 1 is overwritten: in position mode
                 # it would head for the target at once.
                 interface.stop(2)
-                interface.set_axis_parameter(1, 2, -8388608)
-                assert interface.get_axis_parameter(1, 2, signed=True) == -8388608
+                interface.set_axis_parameter(1, 2, -2147483648)
+                assert interface.get_axis_parameter(1, 2, signed=True) == -2147483648
 
 
 def test_python_can_sees_only_addressed_replies(serve, tmp_path):

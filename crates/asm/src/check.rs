@@ -260,13 +260,19 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// SIO: a pull-up switch, an output, or 255 (all outputs of the bank).
+    /// SIO: a setting (the pull-ups, the analog input range), an output,
+    /// or 255 (all outputs of the bank).
     fn output(&mut self, port: u8, bank: u8, value: i32) {
         let ports = &self.profile.ports;
         let has = |d: PortDirection| ports.iter().any(|p| p.direction == d && p.bank == bank);
         let exists = |d: PortDirection| ports.iter().any(|p| p.direction == d && p.bank == bank && p.number == port);
-        let (port_ok, range) = if has(PortDirection::Pullup) {
-            (exists(PortDirection::Pullup), (0, 1))
+        let setting = ports
+            .iter()
+            .find(|p| matches!(p.direction, PortDirection::Pullup | PortDirection::InputRange) && p.bank == bank && p.number == port);
+        let (port_ok, range) = if let Some(p) = setting {
+            (true, (p.min as i32, p.max as i32))
+        } else if has(PortDirection::Pullup) || has(PortDirection::InputRange) {
+            (false, (0, 1))
         } else if has(PortDirection::Output) {
             if port == 255 { (true, (0, 255)) } else { (exists(PortDirection::Output), (0, 1)) }
         } else {
@@ -298,8 +304,13 @@ impl<'a> Checker<'a> {
 
     /// GIO: an input, an output read back, or 255 (all lines of the bank).
     fn input(&mut self, port: u8, bank: u8) {
-        let in_bank: Vec<u8> =
-            self.profile.ports.iter().filter(|p| p.bank == bank && p.direction != PortDirection::Pullup).map(|p| p.number).collect();
+        let in_bank: Vec<u8> = self
+            .profile
+            .ports
+            .iter()
+            .filter(|p| p.bank == bank && matches!(p.direction, PortDirection::Input | PortDirection::Output))
+            .map(|p| p.number)
+            .collect();
         if in_bank.is_empty() {
             let message = format!("bank {bank} has no inputs or outputs on the {}", self.module());
             self.report(self.e.motor_column, message);

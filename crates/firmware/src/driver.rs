@@ -146,11 +146,13 @@ impl Motor<'_> {
         }
         let Some(since) = axis.standstill_since else { return run };
         let still_ms = (self.at.now_ns().saturating_sub(since)) / 1_000_000;
-        let freewheel = p[ap::FREEWHEELING as usize].max(0) as u64 * 10;
+        // Freewheeling and the power down delay count in their rows' units
+        // (the TMCM-1141: both 10 ms; the TMCM-351: ms and 10 ms).
+        let freewheel = p[ap::FREEWHEELING as usize].max(0) as u64 * self.at.ms_per_unit(ap::FREEWHEELING);
         if freewheel > 0 && still_ms >= freewheel {
             return 0;
         }
-        let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * 10;
+        let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * self.at.ms_per_unit(ap::POWER_DOWN_DELAY);
         if still_ms >= delay { standby } else { run }
     }
 
@@ -247,8 +249,13 @@ impl MotorMut<'_> {
         if limit > 0 && moving && features.encoder_deviation_stop {
             let view = self.view();
             let deviation = (i64::from(view.actual_position()) - i64::from(view.encoder_position())).abs();
-            if deviation > i64::from(limit) {
-                self.axis.stop_now();
+            // It stops with its deceleration (a soft stop, firmware 4.33 of
+            // the TMCM-351), once, and the stop ends a reference search
+            // (4.28); docs/behaviour.md rule 79.
+            let stopping = self.axis.motion.mode == crate::motion::RampMode::Velocity && self.axis.params[ap::TARGET_SPEED as usize] == 0;
+            if deviation > i64::from(limit) && !stopping {
+                self.axis.run_at(0);
+                self.axis.rfs = None;
                 self.axis.params[ap::EXTENDED_ERROR_FLAGS as usize] |= features.error_flags.deviation;
                 alarms.deviation = true;
             }

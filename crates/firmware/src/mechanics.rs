@@ -1,12 +1,14 @@
 //! An axis in the world: the position counter and speed (AP 1, AP 3) in
 //! the module's counter width, motor ↔ carriage coordinates (GP 90), the
 //! switches the carriage presses (GP 79, AP 12/13) and the ramp the axis
-//! runs with (AP 4/5/130/153/154, reference search speeds, torque mode).
+//! runs with (AP 4/5/130, in TMC429 units with AP 153/154 or in pps;
+//! reference search speeds, torque mode).
 
 use crate::motion::{self, RampMode};
 use crate::motor::{Motor, MotorMut};
 use crate::parameter_numbers::ap;
 use crate::reference_search::{SearchAxis, Switch};
+use tmclsim_profile::MotionUnits;
 
 impl Motor<'_> {
     /// AP 1: the position counter.
@@ -14,11 +16,23 @@ impl Motor<'_> {
         self.wrap_position(self.axis.motion.position())
     }
 
-    /// AP 3: the actual speed in internal units.
+    /// The units of the axis's velocities and accelerations: the
+    /// profile's `motion_units`, with the divisors AP 154/153 in TMC429
+    /// units.
+    pub(crate) fn units(&self) -> motion::Units {
+        match self.at.features().motion_units {
+            MotionUnits::Tmc429 => motion::Units::Tmc429 {
+                pulse_div: self.axis.params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32,
+                ramp_div: self.axis.params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32,
+            },
+            MotionUnits::Pps => motion::Units::Pps,
+        }
+    }
+
+    /// AP 3: the actual speed in the module's velocity units.
     pub(crate) fn actual_speed(&self) -> i32 {
-        let pd = self.axis.params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
         // `as` truncates towards zero (and saturates), as the register does.
-        motion::velocity_internal(self.axis.motion.v, pd) as i32
+        self.units().velocity_value(self.axis.motion.v) as i32
     }
 
     /// Sign-extends to the module's position width (32 or 24 bits).
@@ -77,10 +91,11 @@ impl Motor<'_> {
         if let Some(r) = axis.ramp_override {
             return r;
         }
+        let units = self.units();
         if axis.closed_loop.torque_mode || axis.rfs.is_some() {
-            return axis.work_out_ramp(axis.closed_loop.torque_mode.then(|| self.torque_mode_velocity()));
+            return axis.work_out_ramp(units, axis.closed_loop.torque_mode.then(|| self.torque_mode_velocity()));
         }
-        axis.plain_ramp(|| axis.work_out_ramp(None))
+        axis.plain_ramp(|| axis.work_out_ramp(units, None))
     }
 
     /// An axis parameter as a read finds it: the measured ones (position,
@@ -92,17 +107,26 @@ impl Motor<'_> {
             return v;
         }
         let axis = self.axis;
-        let pd = axis.params[ap::PULSE_DIVISOR as usize].clamp(0, 13) as u32;
-        let rd = axis.params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32;
+        let units = self.units();
         let motion = &axis.motion;
         match param {
             ap::TARGET_POSITION => axis.target_word,
             ap::ACTUAL_POSITION => self.actual_position(),
             ap::ACTUAL_SPEED => self.actual_speed(),
-            ap::ACTUAL_ACCELERATION => motion::accel_internal(motion.a, rd, pd).round().clamp(-2047.0, 2047.0) as i32,
+            ap::ACTUAL_ACCELERATION => {
+                let max = f64::from(units.max_value());
+                units.accel_value(motion.a).round().clamp(-max, max) as i32
+            }
             ap::POSITION_REACHED => i32::from(self.actual_position() == axis.target_word),
             ap::LEFT_SWITCH => i32::from(self.switches().0),
             ap::RIGHT_SWITCH => i32::from(self.switches().1),
+            // On a TMC428 module (the TMCM-351) AP 9 is the STOP_L input: the
+            // reference switch in series with the left limit switch, so
+            // either one reads (V4.45 §5 p.68, §7.1; docs/behaviour.md rule 77).
+            ap::HOME_SWITCH if self.at.features().reference_search == tmclsim_profile::ReferenceSearchFamily::Tmc428 => {
+                let (left, _, home) = self.switches();
+                i32::from(left || home)
+            }
             ap::HOME_SWITCH => i32::from(self.switches().2),
             ap::ACTUAL_CURRENT => self.current_scale().round() as i32,
             ap::LOAD_VALUE => axis.driver.load_value,

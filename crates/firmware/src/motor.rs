@@ -35,6 +35,12 @@ impl<'a> Surroundings<'a> {
         &self.profile.features
     }
 
+    /// Milliseconds per unit of a duration axis parameter, as its row's
+    /// unit says (10 ms when it says none).
+    pub(crate) fn ms_per_unit(&self, param: u8) -> u64 {
+        self.profile.axis_parameter(param).and_then(tmclsim_profile::Parameter::ms_per_unit).unwrap_or(10)
+    }
+
     /// The position counter's width: 24 or 32 bits.
     pub(crate) fn position_bits(&self) -> u32 {
         self.profile.position_bits()

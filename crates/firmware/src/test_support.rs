@@ -14,6 +14,14 @@ pub fn module(profile: &str) -> Module {
     Module::built_in(profile).unwrap()
 }
 
+/// A module with 24-bit position counters (TMC428 counters, as the
+/// TMCM-351 had before its firmware 4.37): the TMCM-351 so changed.
+pub fn module_24_bit() -> Module {
+    let (_, text) = tmclsim_profile::BUILT_IN.iter().find(|(n, _)| *n == "tmcm-351").unwrap();
+    let text = text.replace("position_bits = 32", "position_bits = 24");
+    Module::new(std::sync::Arc::new(tmclsim_profile::Profile::from_toml(&text).unwrap()))
+}
+
 fn instruction(line: &str) -> Instruction {
     parse_line(line).unwrap_or_else(|e| panic!("{line}: {e}"))
 }

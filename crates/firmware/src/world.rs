@@ -152,6 +152,10 @@ pub struct World {
     pub digital_inputs: u32,
     /// ADC readings (0…4095) by analog input number.
     pub analog_inputs: Vec<u16>,
+    /// Bit n: analog input n is a line of its own, not digital input n
+    /// read through the ADC (the profile's `own_line` ports; the module
+    /// sets it from its profile).
+    pub own_analog_lines: u32,
     /// Supply voltage in 0.1 V.
     pub supply_decivolts: u16,
     /// Driver temperature in °C.
@@ -169,6 +173,7 @@ impl World {
             axes: vec![axis; axes],
             digital_inputs: 0,
             analog_inputs: vec![0; 8],
+            own_analog_lines: 0,
             supply_decivolts: 240,
             temperature: 40.0,
             shutdown_input: false,
@@ -198,6 +203,11 @@ impl World {
         n < 32 && self.digital_inputs & (1 << n) != 0
     }
 
+    /// True when digital input `n` and analog input `n` are one line.
+    fn one_line(&self, n: u8) -> bool {
+        n < 32 && self.own_analog_lines & (1 << n) == 0
+    }
+
     /// Drives a digital input; an input that is also analog follows
     /// (low = 0, high = 4095).
     pub fn set_digital(&mut self, n: u8, high: bool) {
@@ -207,6 +217,9 @@ impl World {
             } else {
                 self.digital_inputs &= !(1 << n);
             }
+        }
+        if !self.one_line(n) {
+            return;
         }
         if let Some(a) = self.analog_inputs.get_mut(n as usize) {
             *a = if high { 4095 } else { 0 };
@@ -219,7 +232,7 @@ impl World {
         if let Some(a) = self.analog_inputs.get_mut(n as usize) {
             *a = value.min(4095);
         }
-        if n < 32 {
+        if self.one_line(n) {
             if value >= 2048 {
                 self.digital_inputs |= 1 << n;
             } else {

@@ -126,6 +126,14 @@ pub enum FeatureProblem {
     NoClock,
     /// `encoder_deviation_stop` on a module without an encoder.
     DeviationStopWithoutEncoder,
+    /// A row marked `quantity` (TMC429 units) on a module whose velocities
+    /// and accelerations are in pps (`motion_units = "pps"`).
+    QuantityInPps {
+        /// The row's parameter number.
+        number: u8,
+        /// The row's name.
+        name: String,
+    },
     /// `version_text` is not 8 ASCII characters.
     VersionText {
         /// The text as the profile gives it.
@@ -190,6 +198,9 @@ impl fmt::Display for FeatureProblem {
             FeatureProblem::NoClock => f.write_str("features.motion_clock_hz is 0"),
             FeatureProblem::DeviationStopWithoutEncoder => {
                 f.write_str("features.encoder_deviation_stop needs an encoder (features.encoder is \"none\")")
+            }
+            FeatureProblem::QuantityInPps { number, name } => {
+                write!(f, "axis parameter {number} ({name}) has a `quantity` (TMC429 units), but features.motion_units is \"pps\"")
             }
             FeatureProblem::VersionText { text } => {
                 write!(f, "module.version_text \"{text}\" must be 8 ASCII characters (the 136 type 0 reply)")

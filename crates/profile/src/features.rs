@@ -4,7 +4,8 @@
 //!
 //! Every key is required except the ones that name a global parameter a
 //! module may lack (`shutdown_pin`, `eeprom_lock`, `eeprom_magic`,
-//! `[features.can]`): absent, the module has no such thing. The schema is in
+//! `[features.can]`): absent, the module has no such thing; and the ones
+//! with a default (`error_flags`, `motion_units`). The schema is in
 //! `profiles/README.md`.
 
 use serde::Deserialize;
@@ -58,6 +59,20 @@ pub enum Encoder {
     /// An incremental a/b/n or an absolute SSI encoder, chosen by AP 201
     /// (closed-loop modules).
     AbnSsi,
+}
+
+/// The units of a module's velocity and acceleration parameters (AP 2…5,
+/// 130, 181, 182, 194, 195 and the closed-loop velocities).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotionUnits {
+    /// The TMC429's internal units: a value becomes microsteps per second
+    /// (per second²) with the pulse and ramp divisors (AP 154, 153) and
+    /// `motion_clock_hz` (docs/behaviour.md rule 23).
+    #[default]
+    Tmc429,
+    /// Microsteps per second and per second², as written: no divisors.
+    Pps,
 }
 
 /// The global parameters (bank 0) holding a module's own CAN identifiers.
@@ -172,6 +187,9 @@ pub struct Features {
     /// turn velocity and acceleration values into microsteps per second
     /// (docs/behaviour.md rule 23).
     pub motion_clock_hz: u32,
+    /// The units of velocities and accelerations. Absent: the TMC429's.
+    #[serde(default)]
+    pub motion_units: MotionUnits,
 }
 
 fn yes_no(b: bool) -> String {
@@ -253,6 +271,14 @@ impl Features {
             }),
             ("full_scale_current_ma", format!("{} mA RMS", self.full_scale_current_ma)),
             ("motion_clock_hz", format!("{} Hz", self.motion_clock_hz)),
+            (
+                "motion_units",
+                match self.motion_units {
+                    MotionUnits::Tmc429 => "TMC429 internal units (pulse and ramp divisors, AP 154/153)",
+                    MotionUnits::Pps => "pps and pps² (microsteps per second, per second²)",
+                }
+                .to_string(),
+            ),
         ]
     }
 }

@@ -13,7 +13,7 @@ mod error;
 mod features;
 
 pub use error::{FeatureProblem, ParameterProblem, ProfileError};
-pub use features::{CanIds, EepromMagic, Encoder, ErrorFlags, Features, ReferenceSearchFamily, StallDetection};
+pub use features::{CanIds, EepromMagic, Encoder, ErrorFlags, Features, MotionUnits, ReferenceSearchFamily, StallDetection};
 
 use serde::Deserialize;
 use std::sync::Arc;
@@ -111,7 +111,8 @@ pub struct Parameter {
     /// ones, as inclusive ranges (e.g. AP 193's modes 1–8, 65–68, 133–136).
     pub ranges: Vec<(i64, i64)>,
     /// What the value measures when it is a velocity or an acceleration in
-    /// the motion controller's units (docs/behaviour.md rule 23).
+    /// the motion controller's units (docs/behaviour.md rule 23); only on
+    /// modules whose `motion_units` are the TMC429's.
     pub quantity: Option<Quantity>,
 }
 
@@ -153,6 +154,16 @@ impl Parameter {
     /// The default as the 32-bit word the module holds.
     pub fn default_word(&self) -> i32 {
         self.default as i32
+    }
+
+    /// For a duration: the milliseconds one unit of the value stands for,
+    /// read from the row's unit (`ms` 1, `10ms` or `10 ms` 10, `s` 1000);
+    /// `None` when the unit is no duration.
+    pub fn ms_per_unit(&self) -> Option<u64> {
+        let unit: String = self.unit.as_deref()?.chars().filter(|c| !c.is_whitespace()).collect();
+        let (count, scale) = if let Some(n) = unit.strip_suffix("ms") { (n, 1) } else { (unit.strip_suffix('s')?, 1000) };
+        let count = if count.is_empty() { 1 } else { count.parse::<u64>().ok()? };
+        Some(count * scale)
     }
 }
 
@@ -220,6 +231,10 @@ pub struct Port {
     /// An analog input whose full scale follows the `input_range` port.
     #[serde(default)]
     pub ranged: bool,
+    /// An analog input on a pin of its own: not the digital input of the
+    /// same number read through the ADC (docs/behaviour.md rule 55).
+    #[serde(default)]
+    pub own_line: bool,
     /// Where a value or rule comes from, or what is special about it.
     #[serde(default)]
     pub note: Option<String>,
@@ -697,6 +712,11 @@ fn check_features(profile: &Profile) -> Result<(), FeatureProblem> {
     if f.encoder_deviation_stop && f.encoder == Encoder::None {
         return Err(FeatureProblem::DeviationStopWithoutEncoder);
     }
+    if f.motion_units == MotionUnits::Pps
+        && let Some(p) = profile.axis_parameters().find(|p| p.quantity.is_some())
+    {
+        return Err(FeatureProblem::QuantityInPps { number: p.number, name: p.name.clone() });
+    }
     if let Some(text) = &profile.module.version_text
         && (text.len() != 8 || !text.is_ascii())
     {
@@ -984,9 +1004,37 @@ mod feature_tests {
         assert_eq!(f.reference_search, ReferenceSearchFamily::Tmc429);
         assert_eq!(f.can, None);
         assert_eq!(f.full_scale_current_ma, 3000);
+        assert_eq!(f.motion_units, MotionUnits::Pps);
         // No GP 65: every code gives the one rate.
         assert_eq!(p.baud_rate(0), 9600);
         assert_eq!(p.baud_rate(5), 9600);
+    }
+
+    #[test]
+    fn motion_units_are_the_tmc429_s_unless_the_profile_says_pps() {
+        for name in Profile::names() {
+            let p = Profile::built_in(name).unwrap();
+            let pps = p.features.motion_units == MotionUnits::Pps;
+            assert_eq!(pps, name == "tmcm-1310", "{name}");
+            // TMC429 modules mark their velocity rows; a pps module has no
+            // such row: its values are microsteps per second as written.
+            assert_eq!(p.axis_parameter(4).unwrap().quantity.is_some(), !pps, "{name}");
+        }
+        let e = Profile::from_toml(&with_features("tmcm-1141", "motion_units = \"pps\"")).unwrap_err().to_string();
+        assert!(e.contains("axis parameter 2 (") && e.contains("motion_units"), "{e}");
+        let e = Profile::from_toml(&with_features("tmcm-1141", "motion_units = \"rpm\"")).unwrap_err().to_string();
+        assert!(e.contains("rpm"), "{e}");
+        // The TMCM-1310's velocity rows: pps, in the range its closed-loop
+        // sibling TMCM-1311 gives its velocities (manual V1.11, AP 108/109).
+        let p = Profile::built_in("tmcm-1310").unwrap();
+        for n in [4, 108, 109, 130, 194, 195] {
+            let row = p.axis_parameter(n).unwrap();
+            assert_eq!((row.max, row.unit.as_deref()), (327_679_999, Some("pps")), "AP {n}");
+        }
+        assert!(p.axis_parameter(4).unwrap().accepts(20_000), "PyTrinamic's TMCM-1311 examples");
+        assert!(!p.axis_parameter(4).unwrap().accepts(327_680_000));
+        assert_eq!(p.axis_parameter(5).unwrap().unit.as_deref(), Some("pps²"));
+        assert!(p.axis_parameter(153).is_none() && p.axis_parameter(154).is_none(), "no divisors");
     }
 
     #[test]
@@ -1005,8 +1053,29 @@ mod feature_tests {
             assert_eq!(p.port(PortDirection::Input, bank, number).unwrap().role, Some(PortRole::Supply), "{name}");
             assert_eq!(p.ports.iter().filter(|q| q.role == Some(PortRole::Supply)).count(), 1, "{name}");
         }
-        // The TMCM-351's profile has no supply channel.
-        assert!(Profile::built_in("tmcm-351").unwrap().ports.iter().all(|q| q.role.is_none()));
+        // The TMCM-351 reads its supply and temperature on GIO 4, 1 and
+        // 5, 1 with its 10-bit ADC (V4.45 §4.6.15 p.40), through a span.
+        let p = Profile::built_in("tmcm-351").unwrap();
+        let supply = p.port(PortDirection::Input, 1, 4).unwrap();
+        assert_eq!((supply.role, supply.max, supply.span.is_some()), (Some(PortRole::Supply), 1023, true));
+        let temperature = p.port(PortDirection::Input, 1, 5).unwrap();
+        assert_eq!((temperature.role, temperature.max, temperature.span.is_some()), (Some(PortRole::Temperature), 1023, true));
+    }
+
+    #[test]
+    fn port_scales_are_checked() {
+        let e = Profile::from_toml(&replacing("tmcm-351", "span = [-50.0, 280.0]\n", "")).unwrap_err().to_string();
+        assert!(e.contains("port 5 of bank 1") && e.contains("temperature port needs a span"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-351", "span = [0.0, 36.3]", "span = [3.0, 3.0]")).unwrap_err().to_string();
+        assert!(e.contains("port 4 of bank 1") && e.contains("two different finite values"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-351", "full_scale_volts = [3.3, 10.0]", "full_scale_volts = [3.3]"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("port 8 of bank 0") && e.contains("one positive full_scale_volts"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-351", "version_text = \"351V.445\"", "version_text = \"351V4.45x\""))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("8 ASCII characters"), "{e}");
     }
 
     #[test]
@@ -1055,13 +1124,26 @@ mod feature_tests {
     }
 
     #[test]
+    fn durations_follow_the_rows_unit() {
+        let p1141 = Profile::built_in("tmcm-1141").unwrap();
+        let p351 = Profile::built_in("tmcm-351").unwrap();
+        let ms = |p: &Profile, n| p.axis_parameter(n).unwrap().ms_per_unit();
+        assert_eq!(ms(&p1141, 204), Some(10), "TMCM-1141 freewheeling: 10 ms");
+        assert_eq!(ms(&p1141, 214), Some(10));
+        assert_eq!(ms(&p351, 204), Some(1), "TMCM-351 freewheeling: ms (V4.45 §5 p.69)");
+        assert_eq!(ms(&p351, 214), Some(10), "TMCM-351 power down delay: 10 ms (p.70)");
+        assert_eq!(ms(&p351, 4), None, "a velocity is no duration");
+    }
+
+    #[test]
     fn every_listed_feature_is_documented() {
         let readme = include_str!("../../../profiles/README.md");
         let p = Profile::built_in("tmcm-351").unwrap();
         let list = p.features.list();
-        assert_eq!(list.len(), 16);
+        assert_eq!(list.len(), 18);
         for (key, value) in &list {
-            let row = if matches!(*key, "can" | "ethercat") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };
+            let row =
+                if matches!(*key, "can" | "ethercat" | "error_flags") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };
             assert!(readme.contains(&row), "{key} has no row in the README's features table");
             assert!(!value.is_empty(), "{key}");
         }
@@ -1069,6 +1151,7 @@ mod feature_tests {
         assert_eq!(get("eeprom_magic"), "GP 64 = 0xE4");
         assert_eq!(get("full_scale_current_ma"), "2800 mA RMS");
         assert_eq!(get("motion_clock_hz"), "16000000 Hz");
+        assert!(get("motion_units").starts_with("TMC429"));
         assert!(get("baud_rates").contains("codes 0…11"));
     }
 }

@@ -221,3 +221,21 @@ fn range_errors_point_at_the_start_of_the_operand() {
     );
     assert_eq!(one("SAP 4, 0, 1 + 2 / (3 - 3)", false), "prog.tmc:1:17: error: division by zero");
 }
+
+/// The TMCM-351's settings on SIO bank 0 (V4.45 §4.6.14 p.37): the pull-up
+/// mask 0…255 on port 0 and the analog input range 0/1 on port 8.
+#[test]
+fn sio_settings_of_the_351() {
+    let p = tmclsim_profile::Profile::built_in("tmcm-351").unwrap();
+    let check = |source: &str| assemble(source, "prog.tmc", &MemoryResolver::new(), Some(&p)).map_err(|d| d[0].to_string());
+    for valid in ["SIO 0, 0, 63", "SIO 0, 0, 255", "SIO 8, 0, 0", "SIO 8, 0, 1", "SIO 255, 2, -1", "GIO 5, 1", "GIO 255, 0"] {
+        assert!(check(valid).is_ok(), "{valid}: {:?}", check(valid).err());
+    }
+    assert_eq!(check("SIO 0, 0, 256").unwrap_err(), "prog.tmc:1:11: error: SIO value 256 is out of range 0...255");
+    assert_eq!(check("SIO 8, 0, 2").unwrap_err(), "prog.tmc:1:11: error: SIO value 2 is out of range 0...1");
+    assert_eq!(check("SIO 1, 0, 1").unwrap_err(), "prog.tmc:1:5: error: SIO port 1 does not exist in bank 0 of the TMCM-351 (ports: 0, 8)");
+    assert_eq!(
+        check("GIO 8, 0").unwrap_err(),
+        "prog.tmc:1:5: error: GIO port 8 does not exist in bank 0 of the TMCM-351 (ports: 0, 1, 2, 3, 4, 5, 6, 7, 255)"
+    );
+}

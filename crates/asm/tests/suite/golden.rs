@@ -1,5 +1,5 @@
-//! The golden frames of the TMCM-1141 firmware manual: each
-//! mnemonic assembles to the frame's seven instruction bytes, and its
+//! The golden frames of the firmware manuals (tests/golden/manual_frames.rs):
+//! each mnemonic assembles to the frame's seven instruction bytes, and its
 //! binary word carries the frame checksum minus the address byte (01).
 
 use crate::common;
@@ -40,11 +40,12 @@ fn with_label_at(first: &str, label: &str, address: usize) -> String {
 /// Every request frame of the manual, those it prints wrong as corrected.
 #[test]
 fn frames_of_the_manual() {
-    for (line, frame, _) in manual_frames::TMCM_1141_FRAMES {
-        assert_eq!(first_word(line), word_of_frame(frame), "{line}");
+    for g in manual_frames::FRAMES {
+        assert_eq!(first_word(g.line), word_of_frame(g.frame), "{} {}: {}", g.module, g.manual, g.line);
     }
-    let corrected = manual_frames::TMCM_1141_FRAMES.iter().filter(|f| f.2 == manual_frames::Printed::Corrected).count();
-    assert_eq!(corrected, 9, "the frames the reference notes correct");
+    let corrected = |module| manual_frames::frames_of(module).filter(|g| g.printed == manual_frames::Printed::Corrected).count();
+    assert_eq!(corrected("tmcm-1141"), 9, "the frames the reference notes correct");
+    assert_eq!(corrected("tmcm-351"), 6, "V4.45: MVP ABS, SAP 6, RSAP 6, RETI; rev. 1.03: ROR 2, RSGP 66");
 }
 
 /// The manual's "binary form of … assuming the label at address N".

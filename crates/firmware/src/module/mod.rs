@@ -78,6 +78,7 @@ impl Module {
     pub fn with_world(profile: Arc<Profile>, eeprom: Eeprom, mut world: World) -> Module {
         let template = World::free(1).axes[0].clone();
         world.axes.resize(profile.module.axes as usize, template);
+        world.own_analog_lines = profile.ports.iter().filter(|p| p.own_line && p.number < 32).fold(0, |m, p| m | 1 << p.number);
         let mut m = Module {
             initial_world: world.clone(),
             world,
@@ -317,7 +318,12 @@ impl Module {
             // The carriage stays where it is; the position counter restarts at 0.
             let sign = self.surroundings().shaft_sign();
             let mech = old_axes.get(motor as usize).map_or(self.world.axes[motor as usize].start, |a| a.motion.x * sign + a.mech_offset);
-            self.axes.push(Axis::new(params, coordinates, mech, self.now_ns));
+            let mut axis = Axis::new(params, coordinates, mech, self.now_ns);
+            // ROR and ROL take the speeds AP 2 (target speed) takes.
+            if let Some(p) = profile.axis_parameter(crate::parameter_numbers::ap::TARGET_SPEED) {
+                axis.speed_limit = p.max.min(i64::from(i32::MAX)) as i32;
+            }
+            self.axes.push(axis);
         }
         self.persistence.restored = restored;
         self.registers = Registers::default();

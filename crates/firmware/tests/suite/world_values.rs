@@ -86,7 +86,7 @@ fn the_inputs_are_the_profiles() {
     assert_eq!(say(&mut bus, "input 7 1"), Ok(String::new()));
     assert_eq!(say(&mut bus, "analog 3 100"), Ok(String::new()));
     assert_eq!(say(&mut bus, "input 8 1").unwrap_err(), "digital input 8 does not exist on the TMCM-351 (digital inputs: 0…7)");
-    assert_eq!(say(&mut bus, "analog 4 1").unwrap_err(), "analog input 4 does not exist on the TMCM-351 (analog inputs: 0…3)");
+    assert_eq!(say(&mut bus, "analog 4 1").unwrap_err(), "analog input 4 does not exist on the TMCM-351 (analog inputs: 0, 1, 2, 3, 6, 7)");
 }
 
 #[test]

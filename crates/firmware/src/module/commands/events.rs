@@ -88,7 +88,8 @@ mod tests {
         assert_eq!(status(&mut m, "#138 0 0 -1"), Status::InvalidValue);
         assert_eq!(m.interrupts.event_arm(), Some((true, 1)), "a refused arming changes nothing");
         let mut m = module("tmcm-351");
-        assert_eq!(status(&mut m, "#138 0 0 1"), Status::InvalidCommand, "the TMCM-351 lacks 138");
+        assert_eq!(status(&mut m, "#138 0 0 4"), Status::Ok, "three motors: bits 0…2");
+        assert_eq!(status(&mut m, "#138 0 0 8"), Status::InvalidValue);
     }
 
     #[test]

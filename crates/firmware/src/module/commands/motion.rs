@@ -246,7 +246,7 @@ mod tests {
 
     #[test]
     fn relative_moves_wrap_in_24_bits() {
-        let mut m = module("tmcm-351");
+        let mut m = crate::test_support::module_24_bit();
         ok(&mut m, "SAP 1, 0, 8388607");
         ok(&mut m, "MVP REL, 0, 1");
         assert_eq!(ok(&mut m, "GAP 0, 0"), -8388608);

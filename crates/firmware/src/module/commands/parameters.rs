@@ -327,7 +327,7 @@ mod tests {
 
     #[test]
     fn positions_wrap_in_the_counter_width() {
-        let m = module("tmcm-351");
+        let m = crate::test_support::module_24_bit();
         assert_eq!(m.wrap_position(8_388_608), -8_388_608, "24 bits");
         assert_eq!(m.wrap_position(-8_388_609), 8_388_607);
         let m = module("tmcm-1141");
