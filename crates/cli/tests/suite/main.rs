@@ -11,6 +11,7 @@ mod hostile_eeprom;
 mod hostile_links;
 mod hostile_network;
 mod hostile_world;
+mod profile_table;
 mod program_tools;
 mod shell;
 mod trace;
