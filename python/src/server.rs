@@ -18,6 +18,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
+use tmclsim_firmware::Speed;
 use tmclsim_host::{LinkFaults, SharedBus};
 use tmclsim_server::{Endpoints, ServerConfig, ServerHandle};
 
@@ -71,7 +72,7 @@ fn pty_path(endpoint: Endpoint, module_name: &str) -> Option<PathBuf> {
 /// Modules served on loopback TCP and/or a pty, in a background thread.
 ///
 /// ``Server(target, tcp=True, pty=None, control=True, stepped=False,
-/// wire_timing=False)`` (``tmclsim.serve`` makes one):
+/// wire_timing=False, speed=1)`` (``tmclsim.serve`` makes one):
 ///
 /// - ``target``: a ``Module`` or a ``Bus``; its modules move into the server
 ///   until it stops, and the ``Module`` objects reach them through it.
@@ -87,6 +88,10 @@ fn pty_path(endpoint: Endpoint, module_name: &str) -> Option<PathBuf> {
 ///   the wall clock).
 /// - ``wire_timing``: replies take as long as the bytes take at the
 ///   module's baud rate (GP 65).
+/// - ``speed``: virtual time runs this many times as fast as the wall
+///   clock while it is paced by it (a positive number; ``.speed`` reads
+///   and sets it while served); ``tmclsim.clock`` puts the host's own
+///   clocks on the same scale.
 ///
 /// Stops with ``stop()``, at the end of a ``with`` block, or when garbage
 /// collected.
@@ -103,11 +108,13 @@ impl Server {
         if self.handle.is_some() { Ok(&self.shared) } else { Err(PyRuntimeError::new_err("the server is stopped")) }
     }
 
-    /// Stops serving; the modules are in process again, in stepped time.
+    /// Stops serving; the modules are in process again, in stepped time
+    /// at the wall clock's own speed.
     fn shutdown(&mut self, py: Python<'_>) {
         let Some(handle) = self.handle.take() else { return };
         handle.stop();
         self.shared.set_stepped(true);
+        self.shared.with_bus(|b| b.set_speed(Speed::REAL_TIME));
         for m in &self.modules {
             if let Ok(mut m) = m.bind(py).try_borrow_mut() {
                 m.served = false;
@@ -127,7 +134,8 @@ impl Drop for Server {
 #[pymethods]
 impl Server {
     #[new]
-    #[pyo3(signature = (target, tcp=Endpoint::On, pty=Endpoint::Off, control=Endpoint::On, stepped=false, wire_timing=false))]
+    #[pyo3(signature = (target, tcp=Endpoint::On, pty=Endpoint::Off, control=Endpoint::On, stepped=false, wire_timing=false, speed=1.0))]
+    #[allow(clippy::too_many_arguments)]
     fn py_new(
         py: Python<'_>,
         target: &Bound<'_, PyAny>,
@@ -136,7 +144,9 @@ impl Server {
         control: Endpoint,
         stepped: bool,
         wire_timing: bool,
+        speed: f64,
     ) -> PyResult<Server> {
+        let speed = Speed::new(speed).map_err(|e| value_error(e.to_string()))?;
         let (shared, modules): (Arc<SharedBus>, Vec<Py<Module>>) = if let Ok(m) = target.cast::<Module>() {
             let shared = m.borrow().shared.clone();
             if shared.len() != 1 {
@@ -169,7 +179,10 @@ impl Server {
             warn_exposure: false,
             ..ServerConfig::default()
         };
-        shared.with_bus(|b| b.set_wire_timing(wire_timing));
+        shared.with_bus(|b| {
+            b.set_wire_timing(wire_timing);
+            b.set_speed(speed);
+        });
         let handle = tmclsim_server::start_shared(shared.clone(), config).map_err(|e| os_error(format!("cannot serve: {e}")))?;
         // An address other machines reach: say so (a warnings filter that
         // turns warnings into errors stops the server again).
@@ -254,6 +267,21 @@ impl Server {
     #[setter]
     fn set_stepped(&self, stepped: bool) -> PyResult<()> {
         self.live()?.set_stepped(stepped);
+        Ok(())
+    }
+
+    /// How many times as fast as the wall clock virtual time runs while it
+    /// is paced by the wall clock (a positive number; settable while
+    /// served, from the modules' now on).
+    #[getter]
+    fn speed(&self) -> f64 {
+        self.shared.with_bus(|b| b.speed().factor())
+    }
+
+    #[setter]
+    fn set_speed(&self, speed: f64) -> PyResult<()> {
+        let speed = Speed::new(speed).map_err(|e| value_error(e.to_string()))?;
+        self.live()?.with_bus(|b| b.set_speed(speed));
         Ok(())
     }
 

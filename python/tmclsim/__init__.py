@@ -187,6 +187,7 @@ def serve(
     control: Union[str, bool, None] = True,
     stepped: bool = False,
     wire_timing: bool = False,
+    speed: float = 1,
 ) -> Server:
     """Serves a module (or a bus of modules) in a background thread.
 
@@ -199,6 +200,9 @@ def serve(
       instead of with the wall clock.
     - ``wire_timing``: replies take as long as their bytes at the module's
       baud rate (GP 65).
+    - ``speed``: virtual time runs this many times as fast as the wall
+      clock (a positive number); ``tmclsim.clock`` puts the host's own
+      clocks on the same scale (docs/host-software.md).
 
     Returns a ``Server`` with the endpoints (``.tcp``, ``.pty``,
     ``.control``, ``.pytrinamic_args``), ``.connect()``, ``.world()``,
@@ -206,5 +210,5 @@ def serve(
     a context manager and stops when garbage collected. While served, the
     ``Module`` objects reach their modules through the server.
     """
-    return Server(target, tcp=tcp, pty=pty, control=control, stepped=stepped, wire_timing=wire_timing)
+    return Server(target, tcp=tcp, pty=pty, control=control, stepped=stepped, wire_timing=wire_timing, speed=speed)
 

@@ -6,6 +6,8 @@
 //!
 //! ```toml
 //! world = "stage"                # default world: stage, free or a file
+//! speed = 50                     # optional: virtual time 50 × the wall clock
+//!                                # (each link may say its own; --speed otherwise)
 //! [[link]]
 //! tcp = "127.0.0.1:20000"        # or pty = "/tmp/tmclsim-bus"
 //! count = 1000                   # 1000 such links, ports 20000, 20001, …
@@ -21,7 +23,7 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
-use tmclsim_firmware::{Eeprom, Module, Profile};
+use tmclsim_firmware::{Eeprom, Module, Profile, Speed};
 use tmclsim_server::{LinkSpec, ServerConfig};
 
 #[derive(Debug, Deserialize)]
@@ -29,6 +31,8 @@ use tmclsim_server::{LinkSpec, ServerConfig};
 pub struct FleetFile {
     #[serde(default = "stage")]
     world: String,
+    /// Every link's speed (`--speed` otherwise).
+    speed: Option<f64>,
     link: Vec<LinkFile>,
 }
 
@@ -50,6 +54,8 @@ struct LinkFile {
     world: Option<String>,
     #[serde(default)]
     wire_timing: bool,
+    /// This link's speed (the file's otherwise).
+    speed: Option<f64>,
 }
 
 fn one() -> usize {
@@ -64,6 +70,8 @@ pub struct Link {
     pub modules: Vec<(String, u8)>,
     pub world: String,
     pub wire_timing: bool,
+    /// The link's speed, when the file gives one.
+    pub speed: Option<Speed>,
 }
 
 /// Most modules one fleet serves (about 32 KiB each).
@@ -77,6 +85,7 @@ pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
     let mut out = Vec::new();
     for (i, l) in f.link.iter().enumerate() {
         let what = || format!("{}: link {}", path.display(), i + 1);
+        let speed = l.speed.or(f.speed).map(Speed::new).transpose().map_err(|e| format!("{}: {e}", what()))?;
         let mut modules = Vec::new();
         for m in &l.modules {
             let (p, a) = m.split_once('@').ok_or_else(|| format!("{}: '{m}': write PROFILE@ADDRESS", what()))?;
@@ -121,6 +130,7 @@ pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
                 modules: modules.clone(),
                 world: l.world.clone().unwrap_or_else(|| f.world.clone()),
                 wire_timing: l.wire_timing,
+                speed,
             });
         }
     }
@@ -157,6 +167,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
             max_connections: args.max_connections,
             bad_frame_limit: args.bad_frame_limit,
             wire_timing: l.wire_timing,
+            speed: l.speed.unwrap_or(args.speed),
             log_frames: args.log_frames,
             ..ServerConfig::default()
         };

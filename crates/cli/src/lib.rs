@@ -183,6 +183,13 @@ pub struct ServeArgs {
     /// timeouts behave as on a real RS485 bus.
     #[arg(long)]
     pub wire_timing: bool,
+    /// Run the modules' virtual time N times as fast as the wall clock
+    /// (a positive number; 0.5 is half as fast): ramps, WAIT, timers,
+    /// events, reply delays and wire timing all follow it. Host code waits
+    /// on its own clock: `tmclsim clock --speed N -- python SCRIPT` puts a
+    /// Python program on the same scale (docs/host-software.md).
+    #[arg(long, value_name = "N", default_value = "1", value_parser = speed)]
+    pub speed: tmclsim_firmware::Speed,
     /// Address of the control socket that changes the world while the
     /// module is served (`tmclsim world`); loopback, any free port by default.
     #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:0", value_parser = socket_address)]
@@ -412,6 +419,11 @@ pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::Wo
 
 /// `HOST:PORT` with a host name or an IP address (IPv4 first when a name
 /// has both).
+/// A `--speed` value: a positive number.
+pub(crate) fn speed(text: &str) -> Result<tmclsim_firmware::Speed, String> {
+    text.parse()
+}
+
 pub(crate) fn socket_address(text: &str) -> Result<SocketAddr, String> {
     use std::net::ToSocketAddrs;
     if let Ok(a) = text.parse() {

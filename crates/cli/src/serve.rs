@@ -137,7 +137,8 @@ fn ethercat(iface: &str, args: &ServeArgs) -> Result<ExitCode, String> {
             Ok(Module::with_world(profile.clone(), image, world))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let segment = tmclsim_ethercat::Segment::new(modules)?;
+    let mut segment = tmclsim_ethercat::Segment::new(modules)?;
+    segment.bus.set_speed(args.speed);
     let signals = crate::signal::Signals::install()?;
     let handle = tmclsim_server::ethercat::serve(iface, segment, eeproms).map_err(|e| format!("cannot serve EtherCAT on {iface}: {e}"))?;
     println!("tmclsim: {} virtual {} EtherCAT slave(s) on {iface}", args.slaves, profile.module.name);
@@ -188,6 +189,7 @@ fn serve(
         control: Some(args.control),
         control_token: if args.control_public { Some(control_token()?) } else { None },
         wire_timing: args.wire_timing,
+        speed: args.speed,
         slcan: args.slcan.clone(),
         log_frames: args.log_frames,
         ..ServerConfig::default()
@@ -210,6 +212,9 @@ fn serve(
         println!("  slcan: {} -> {}  (CAN adapter: python-can interface \"slcan\")", link.display(), device.display());
     }
     println!("  world: {}{}", args.world, if args.wire_timing { "; wire timing on" } else { "" });
+    if args.speed != tmclsim_firmware::Speed::REAL_TIME {
+        println!("  time: {} times as fast as the wall clock", args.speed.factor());
+    }
     match (ep.control, &token) {
         (Some(addr), None) => println!("  control: {addr}  (tmclsim world --control {addr} help)"),
         (Some(addr), Some(t)) => {

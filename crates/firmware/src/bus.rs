@@ -9,7 +9,7 @@
 //! must carry out (EEPROM images to persist, 138 events to send) it takes
 //! with [`Bus::take_effects`]; observers look at [`Bus::snapshot`].
 
-use crate::clock::Clock;
+use crate::clock::{Clock, Speed};
 use crate::module::Module;
 use crate::module::can::CanFrame;
 use crate::snapshot::ModuleSnapshot;
@@ -50,6 +50,8 @@ impl Effects {
 pub struct Bus {
     modules: Vec<Module>,
     clock: Clock,
+    /// How fast a wall clock runs (kept while the clock is stepped).
+    speed: Speed,
     /// The latest virtual time the bus was brought to. Modules a frame is
     /// not for may lag behind; they catch up when next looked at.
     now_ns: u64,
@@ -69,7 +71,7 @@ impl Bus {
             m.advance_to(now_ns);
         }
         let saved = modules.iter().map(Module::eeprom_generation).collect();
-        Bus { modules, clock: Clock::Stepped, now_ns, saved, wire_timing: false }
+        Bus { modules, clock: Clock::Stepped, speed: Speed::REAL_TIME, now_ns, saved, wire_timing: false }
     }
 
     /// A bus of one.
@@ -95,8 +97,24 @@ impl Bus {
             self.catch_up();
             self.clock = Clock::Stepped;
         } else if self.clock.is_stepped() {
-            self.clock = Clock::wall_from(self.now_ns);
+            self.clock = Clock::wall_from(self.now_ns, self.speed);
         }
+    }
+
+    /// How fast virtual time runs while the clock follows the wall clock.
+    pub fn speed(&self) -> Speed {
+        self.speed
+    }
+
+    /// Virtual time runs `speed` times as fast as the wall clock (from now
+    /// on; a stepped clock keeps standing still and runs at that speed
+    /// once it follows the wall clock again).
+    pub fn set_speed(&mut self, speed: Speed) {
+        if !self.clock.is_stepped() {
+            self.catch_up();
+            self.clock = Clock::wall_from(self.now_ns, speed);
+        }
+        self.speed = speed;
     }
 
     /// Virtual time now, by the clock.
@@ -124,7 +142,7 @@ impl Bus {
         let t = self.now_ns().saturating_add(dt_ns);
         self.advance_to(t);
         if !self.clock.is_stepped() {
-            self.clock = Clock::wall_from(self.now_ns);
+            self.clock = Clock::wall_from(self.now_ns, self.speed);
         }
     }
 
@@ -139,7 +157,7 @@ impl Bus {
         let now = self.modules[index].now_ns();
         self.advance_to(now);
         if !self.clock.is_stepped() {
-            self.clock = Clock::wall_from(self.now_ns);
+            self.clock = Clock::wall_from(self.now_ns, self.speed);
         }
         done
     }

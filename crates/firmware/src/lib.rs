@@ -34,7 +34,7 @@ mod world_help;
 pub mod world_rules;
 
 pub use bus::Bus;
-pub use clock::Clock;
+pub use clock::{Clock, Speed};
 pub use eeprom::Eeprom;
 pub use link_id::{IN_PROCESS, LinkId};
 pub use module::{Module, Outcome, Special};

@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tmclsim_firmware::can::CanFrame;
 use tmclsim_firmware::world_command::{Addressed, HELP, WorldCommand, on_off};
-use tmclsim_firmware::{Bus, Module, WorldError};
+use tmclsim_firmware::{Bus, Module, Speed, WorldError};
 use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Status};
 
 /// Where unsolicited frames (138 events) go: the link that spoke last.
@@ -90,11 +90,13 @@ impl SharedBus {
         shared
     }
 
-    /// Modules with their EEPROM files on one link, in wall-clock time.
-    pub fn wall(modules: Vec<(Module, Option<Arc<EepromFile>>)>, wire_timing: bool) -> SharedBus {
+    /// Modules with their EEPROM files on one link, in wall-clock time
+    /// running `speed` times as fast.
+    pub fn wall(modules: Vec<(Module, Option<Arc<EepromFile>>)>, wire_timing: bool, speed: Speed) -> SharedBus {
         let (modules, eeproms): (Vec<Module>, Vec<Option<Arc<EepromFile>>>) = modules.into_iter().unzip();
         let mut bus = Bus::new(modules);
         bus.set_wire_timing(wire_timing);
+        bus.set_speed(speed);
         bus.set_stepped(false);
         SharedBus::new(bus, eeproms)
     }
@@ -266,6 +268,9 @@ impl SharedBus {
         // their programs store is not taken for the request's.
         let before = Self::generations(&mut s, |bus| bus.catch_up_addressed(frame[0]));
         let mut answer = s.bus.handle_frame_from(link, frame);
+        // A reply's delay is the modules' time (GP 75, the wire): on the
+        // wall clock it is as much shorter as the clock runs faster.
+        let delay = s.bus.clock().wall_duration(answer.delay_ns);
         let written = Self::written_since(&s, before);
         let failed = self.after_request(s, link, sink, !answer.replies.is_empty());
         if written.iter().any(|i| failed.contains(i)) {
@@ -273,7 +278,7 @@ impl SharedBus {
                 *r = Self::not_stored(*r, frame[1]);
             }
         }
-        (answer.replies, Duration::from_nanos(answer.delay_ns))
+        (answer.replies, delay)
     }
 
     /// Handles a CAN frame: every module sees it, those it is for answer.

@@ -36,7 +36,7 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
-use tmclsim_firmware::Module;
+use tmclsim_firmware::{Module, Speed};
 use tokio::sync::watch;
 use tokio::task::JoinSet;
 
@@ -74,6 +74,9 @@ pub struct ServerConfig {
     pub warn_exposure: bool,
     /// Deliver bytes at the modules' baud rate (GP 65), as a real RS485 bus.
     pub wire_timing: bool,
+    /// How fast the link's virtual time runs against the wall clock
+    /// (`tmclsim serve --speed`): everything the modules time follows it.
+    pub speed: Speed,
     /// Path of the symlink to a pty that is a serial-line CAN adapter
     /// (SLCAN) with the modules on its CAN bus.
     pub slcan: Option<PathBuf>,
@@ -105,6 +108,7 @@ impl Default for ServerConfig {
             control_token: None,
             warn_exposure: true,
             wire_timing: false,
+            speed: Speed::REAL_TIME,
             slcan: None,
             log_frames: false,
             bad_frame_limit: BAD_FRAME_LIMIT,
@@ -371,7 +375,7 @@ pub fn start_fleet(links: Vec<LinkSpec>) -> std::io::Result<ServerHandle> {
     if links.is_empty() || links.iter().any(|l| l.modules.is_empty()) {
         return Err(std::io::Error::other("every link needs at least one module"));
     }
-    serve_buses(links.into_iter().map(|l| (Arc::new(SharedBus::wall(l.modules, l.config.wire_timing)), l.config)).collect())
+    serve_buses(links.into_iter().map(|l| (Arc::new(SharedBus::wall(l.modules, l.config.wire_timing, l.config.speed)), l.config)).collect())
 }
 
 /// Serves a bus that already exists (e.g. one the Python package holds):

@@ -14,5 +14,6 @@ mod hostile_world;
 mod profile_table;
 mod program_tools;
 mod shell;
+mod speed;
 mod trace;
 mod web;

@@ -1,0 +1,75 @@
+//! `tmclsim serve --speed N`: the served modules' virtual time runs N times
+//! as fast as the wall clock, and bad values are refused.
+
+use crate::common;
+
+use common::{Server, ask, text, tmclsim};
+use std::time::{Duration, Instant};
+
+/// GP 132 (the tick timer, virtual ms) of a served module.
+fn ticks(s: &mut std::net::TcpStream) -> i64 {
+    i64::from(ask(s, "GGP 132, 0").expect("a reply").value)
+}
+
+#[test]
+fn virtual_time_runs_n_times_as_fast() {
+    let server = Server::start(&["--speed", "50", "--world", "free"]);
+    assert_eq!(server.printed("time"), "50", "the banner says the speed");
+    let mut s = server.connect();
+    // The module's own clock against the wall clock, over at least 40
+    // virtual seconds; the wall time measured around the two reads is at
+    // least the true interval, so the ratio is at most 50.
+    let (v0, w0) = (ticks(&mut s), Instant::now());
+    let deadline = w0 + Duration::from_secs(60);
+    let mut v1 = v0;
+    while v1 - v0 < 40_000 && Instant::now() < deadline {
+        v1 = ticks(&mut s);
+    }
+    let wall = w0.elapsed().as_secs_f64();
+    let ratio = (v1 - v0) as f64 / 1000.0 / wall;
+    assert!((40.0..=50.5).contains(&ratio), "{} virtual ms in {wall} s: ratio {ratio}", v1 - v0);
+    // A move follows it: 51200 µsteps at the factory speed and acceleration
+    // of the TMCM-1141 take about 1.3 virtual seconds.
+    assert_eq!(ask(&mut s, "MVP ABS, 0, 51200").unwrap().status, 100);
+    let start = (ticks(&mut s), Instant::now());
+    while ask(&mut s, "GAP 8, 0").unwrap().value == 0 && start.1.elapsed() < Duration::from_secs(60) {}
+    let virtual_ms = ticks(&mut s) - start.0;
+    assert!(virtual_ms >= 1000, "the move took {virtual_ms} virtual ms");
+    assert!(start.1.elapsed() < Duration::from_millis(virtual_ms as u64), "faster than the wall clock");
+    server.stop();
+}
+
+#[test]
+fn a_speed_must_be_a_positive_number() {
+    for bad in ["0", "-2", "fast", "inf", "NaN"] {
+        let o = tmclsim(&["serve", &format!("--speed={bad}"), "--tcp", "127.0.0.1:0"]);
+        assert!(!o.status.success(), "--speed {bad} was taken");
+        let t = text(&o);
+        assert!(t.contains("--speed") && t.contains("positive") || t.contains("not a number"), "{bad}: {t}");
+    }
+}
+
+#[test]
+fn a_fleet_file_gives_the_speed_of_its_links() {
+    let dir = tempfile::tempdir().unwrap();
+    let fleet = dir.path().join("fleet.toml");
+    std::fs::write(&fleet, "speed = 0\n[[link]]\ntcp = \"127.0.0.1:0\"\nmodules = [\"tmcm-1141@1\"]\n").unwrap();
+    let o = tmclsim(&["serve", "--fleet", fleet.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("link 1: speed 0 is not a positive finite number"), "{}", text(&o));
+    std::fs::write(&fleet, "speed = 20\n[[link]]\ntcp = \"127.0.0.1:0\"\nmodules = [\"tmcm-1141@1\"]\n").unwrap();
+    let server = Server::start(&["--fleet", fleet.to_str().unwrap()]);
+    // The fleet's banner names its first link in the connect hint.
+    let hint = server.banner.iter().find(|l| l.starts_with("connect with:")).unwrap();
+    let port = hint.split("--port ").nth(1).unwrap().trim_end_matches(|c: char| !c.is_ascii_digit());
+    let mut s = std::net::TcpStream::connect(port).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    let (v0, w0) = (ticks(&mut s), Instant::now());
+    let mut v1 = v0;
+    while v1 - v0 < 10_000 && w0.elapsed() < Duration::from_secs(60) {
+        v1 = ticks(&mut s);
+    }
+    let ratio = (v1 - v0) as f64 / 1000.0 / w0.elapsed().as_secs_f64();
+    assert!((15.0..=20.5).contains(&ratio), "ratio {ratio}");
+    server.stop();
+}
