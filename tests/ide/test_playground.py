@@ -188,6 +188,28 @@ def test_an_example_opens_from_its_address(playground, page):
     assert "timeout" in text(page, "prog-message")
 
 
+def test_the_page_runs_at_the_speed_of_its_address(playground, page):
+    # ?speed=50: the header says it, and the modules' tick timer (GP 132)
+    # runs fifty times as fast as the page's clock.
+    open_app(page, playground.url + "?speed=50")
+    assert "time ×50" in text(page, "target")
+    shot(page, "playground-speed")
+    ticks = "() => JSON.parse(window.tmclsimPage.request('POST', '/api/modules/0/command', JSON.stringify({line: 'GGP 132, 0'}))).value"
+    start = page.evaluate(f"() => [({ticks})(), performance.now()]")
+    page.wait_for_function(f"() => ({ticks})() - {start[0]} >= 50000")
+    virtual_ms, wall_ms = page.evaluate(f"() => [({ticks})() - {start[0]}, performance.now() - {start[1]}]")
+    # Time moves in steps of the page's 10 ms timer (0.5 virtual seconds
+    # at this speed): 1 % of the 50 virtual seconds looked at.
+    assert 10 <= virtual_ms / wall_ms <= 51, (virtual_ms, wall_ms)
+    # A speed the binding refuses is said in the page; time keeps the wall
+    # clock's pace.
+    open_app(page, playground.url + "?speed=0")
+    page.locator("[data-testid=notice]").wait_for()
+    assert "?speed=0: speed 0 is not a positive finite number" in text(page, "notice")
+    shot(page, "playground-speed-refused")
+    assert "time ×" not in text(page, "target")
+
+
 def test_the_reference_search_tool_runs_in_the_page(playground, page):
     open_app(page, playground.url)
     # The left stop switch near the carriage, placed in the world panel.

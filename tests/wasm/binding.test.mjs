@@ -171,3 +171,21 @@ test("target reached events are kept until taken", () => {
     assert.equal(events[0][2], 128);
     assert.equal(m.takeEvents().length, 0);
 });
+
+test("the playground's speed: virtual time runs N times as fast as the page's clock", async () => {
+  const { Playground } = await import("../../target/wasm/tmclsim.js");
+  const p = new Playground();
+  const info = () => JSON.parse(p.request("GET", "/api/info", ""));
+  assert.equal(info().speed, 1);
+  p.request("POST", "/api/modules", JSON.stringify({ profile: "tmcm-1141" }));
+  const ticks = () => JSON.parse(p.request("POST", "/api/modules/0/command", JSON.stringify({ line: "GGP 132, 0" }))).value;
+  p.setSpeed(50);
+  assert.equal(info().speed, 50);
+  const before = ticks();
+  p.advanceWall(0.1);
+  assert.equal(ticks() - before, 5000, "0.1 s of the page's clock are 5 virtual seconds");
+  for (const bad of [0, -1, NaN, Infinity]) {
+    assert.throws(() => p.setSpeed(bad), /is not a positive finite number/, String(bad));
+  }
+  assert.equal(info().speed, 50, "a refused speed changes nothing");
+});

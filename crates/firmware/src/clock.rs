@@ -67,6 +67,13 @@ impl Speed {
     }
 }
 
+impl Default for Speed {
+    /// The wall clock's own pace.
+    fn default() -> Speed {
+        Speed::REAL_TIME
+    }
+}
+
 impl std::str::FromStr for Speed {
     type Err = String;
 

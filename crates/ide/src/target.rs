@@ -87,6 +87,11 @@ pub trait Target: Send + Sync + 'static {
     /// The module's clock in seconds: virtual time, or wall time since the
     /// target was opened.
     fn time(&self, id: usize) -> f64;
+    /// How many times as fast as the wall clock the modules' virtual time
+    /// runs (`serve --speed`); 1 on a link to real modules.
+    fn speed(&self) -> f64 {
+        1.0
+    }
     /// A typed picture of a virtual module.
     fn snapshot(&self, _id: usize) -> Option<ModuleSnapshot> {
         None

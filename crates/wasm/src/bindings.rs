@@ -196,6 +196,20 @@ impl JsPlayground {
     pub fn advance(&mut self, seconds: f64) -> Result<(), JsValue> {
         self.page.advance(seconds).map_err(error)
     }
+
+    /// Virtual time runs `factor` times as fast as the page's clock (a
+    /// positive number; an error says why another is refused).
+    #[wasm_bindgen(js_name = setSpeed)]
+    pub fn set_speed(&mut self, factor: f64) -> Result<(), JsValue> {
+        self.page.set_speed(factor).map_err(error)
+    }
+
+    /// Moves virtual time on by what `seconds` of the page's clock make at
+    /// the speed.
+    #[wasm_bindgen(js_name = advanceWall)]
+    pub fn advance_wall(&mut self, seconds: f64) -> Result<(), JsValue> {
+        self.page.advance_wall(seconds).map_err(error)
+    }
 }
 
 impl Default for JsPlayground {

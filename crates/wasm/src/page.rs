@@ -8,6 +8,7 @@ use serde::Deserialize;
 use serde::de::DeserializeOwned;
 use serde_json::{Value, json};
 use std::sync::{Mutex, MutexGuard};
+use tmclsim_firmware::Speed;
 use tmclsim_firmware::snapshot::ModuleSnapshot;
 use tmclsim_ide::answers::{self, Read, Write};
 use tmclsim_ide::live::{Subscription, sample};
@@ -26,6 +27,8 @@ const WHERE: &str = "in this page";
 /// The page's modules, each on a bus of its own.
 #[derive(Default)]
 pub struct PageTarget {
+    /// How fast virtual time runs against the page's clock.
+    speed: Speed,
     entries: Vec<ModuleEntry>,
     sims: Vec<Mutex<Sim>>,
 }
@@ -46,6 +49,10 @@ impl Target for PageTarget {
 
     fn describe(&self) -> String {
         WHERE.into()
+    }
+
+    fn speed(&self) -> f64 {
+        self.speed.factor()
     }
 
     fn modules(&self) -> &[ModuleEntry] {
@@ -251,6 +258,19 @@ impl Page {
         Ok(())
     }
 
+    /// Virtual time runs `factor` times as fast as the page's clock (a
+    /// positive number, as `tmclsim serve --speed`).
+    pub fn set_speed(&mut self, factor: f64) -> Result<(), Failure> {
+        self.target.speed = Speed::new(factor).map_err(|e| Failure::new(e.to_string()))?;
+        Ok(())
+    }
+
+    /// Moves virtual time on by what `seconds` of the page's clock make
+    /// at the speed.
+    pub fn advance_wall(&mut self, seconds: f64) -> Result<(), Failure> {
+        self.advance(seconds * self.target.speed.factor())
+    }
+
     /// One sample of the live stream of module `id` for a subscription (its
     /// JSON): `{"t", "values", "program"?}` or `{"error"}`.
     pub fn sample(&self, id: usize, subscription: &str) -> Value {
@@ -276,7 +296,7 @@ impl Page {
         let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
         let v = match (method, parts.as_slice()) {
             ("GET", ["api", "info"]) => json!({
-                "target": "virtual", "link": WHERE, "version": env!("CARGO_PKG_VERSION"),
+                "target": "virtual", "link": WHERE, "speed": t.speed.factor(), "version": env!("CARGO_PKG_VERSION"),
                 "playground": true, "profiles": Sim::profiles(),
             }),
             ("GET", ["api", "modules"]) => answers::modules_json(t),

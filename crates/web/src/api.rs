@@ -39,7 +39,10 @@ pub fn router(app: App) -> Router {
 }
 
 async fn info(State(app): State<App>) -> Json<Value> {
-    Json(json!({ "target": app.target.kind(), "link": app.target.describe(), "version": env!("CARGO_PKG_VERSION") }))
+    Json(json!({
+        "target": app.target.kind(), "link": app.target.describe(), "speed": app.target.speed(),
+        "version": env!("CARGO_PKG_VERSION"),
+    }))
 }
 
 async fn modules(State(app): State<App>) -> Json<Value> {

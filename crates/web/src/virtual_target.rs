@@ -79,6 +79,10 @@ impl Target for VirtualTarget {
         self.description.clone()
     }
 
+    fn speed(&self) -> f64 {
+        self.places.first().map_or(1.0, |p| p.bus.with_bus(|b| b.speed().factor()))
+    }
+
     fn modules(&self) -> &[ModuleEntry] {
         &self.entries
     }

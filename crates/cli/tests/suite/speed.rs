@@ -73,3 +73,11 @@ fn a_fleet_file_gives_the_speed_of_its_links() {
     assert!((15.0..=20.5).contains(&ratio), "ratio {ratio}");
     server.stop();
 }
+
+#[test]
+fn the_ide_says_the_speed() {
+    let server = Server::start(&["--speed", "50", "--tcp", "127.0.0.1:0", "--web", "127.0.0.1:0"]);
+    let (_, body) = common::get(&server.printed("web"), "/api/info");
+    assert!(body.contains("\"speed\":50.0"), "{body}");
+    server.stop();
+}

@@ -87,7 +87,8 @@ async function pick(modules, info, id) {
 async function main() {
   unitControls(document.getElementById("units"), document.getElementById("fullsteps"));
   const info = await get("/api/info");
-  document.getElementById("target").textContent = `${info.target === "virtual" ? "virtual modules" : "TMCL link"} · ${info.link}`;
+  const speed = info.speed && info.speed !== 1 ? ` · time ×${info.speed}` : "";
+  document.getElementById("target").textContent = `${info.target === "virtual" ? "virtual modules" : "TMCL link"} · ${info.link}${speed}`;
   let modules = await get("/api/modules");
   let ctxRef = null;
   for (const b of document.querySelectorAll("#tabs button")) {

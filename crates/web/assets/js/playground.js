@@ -11,16 +11,30 @@ import { useTarget } from "./api.js";
 // up in one leap.
 const MAX_STEP_S = 0.25;
 
+// `?speed=N`: virtual time runs N times as fast as the wall clock, as with
+// `tmclsim serve --speed N`; a value the binding refuses is said in the
+// page, and time keeps the wall clock's pace.
+const speedParam = new URLSearchParams(location.search).get("speed");
+let speedRefused = null;
+
 // The WebAssembly loads while the app's modules do; requests wait for it.
 let page = null;
 const loaded = init().then(() => {
   window.tmclsim = tmclsim;
   page = new tmclsim.Playground();
+  window.tmclsimPage = page;
+  if (speedParam !== null) {
+    try {
+      page.setSpeed(Number(speedParam));
+    } catch (e) {
+      speedRefused = `?speed=${speedParam}: ${e.message ?? e}`;
+    }
+  }
   page.request("POST", "/api/modules", JSON.stringify({ profile: "tmcm-1141" }));
   let last = performance.now();
   setInterval(() => {
     const now = performance.now();
-    page.advance(Math.min(MAX_STEP_S, (now - last) / 1000));
+    page.advanceWall(Math.min(MAX_STEP_S, (now - last) / 1000));
     last = now;
   }, 10);
 });
@@ -67,3 +81,11 @@ useTarget({
 });
 
 await import("./app.js");
+await loaded;
+if (speedRefused) {
+  const notice = document.createElement("p");
+  notice.className = "notice";
+  notice.dataset.testid = "notice";
+  notice.textContent = speedRefused;
+  document.querySelector("header").append(notice);
+}
