@@ -10,9 +10,10 @@ module on a serial port or a virtual one served by tmclsim:
     python stage_app.py --interface socket_serial_tmcl --port 127.0.0.1:1141 \\
         --sequence 10000,-50000,200000,0
 
-Time is injected (``sleep`` and ``clock``) so that tests can run the
-application in a module's stepped virtual time: an hour of motion takes
-milliseconds there (see test_stage_app.py).
+It waits as host code does, with ``time.sleep`` and ``time.monotonic``:
+its tests run it unchanged against modules served with a speed (an hour of
+motion in seconds), with tmclsim's clock patch putting those calls on the
+modules' time (see test_stage_app.py).
 """
 
 import argparse
@@ -41,8 +42,7 @@ class StageApp:
     #: direction; the reference point is the middle of the switch.
     HOME_MODE = 8
 
-    def __init__(self, interface, axis=0, search_speed=2047, switch_speed=500, max_speed=2047,
-                 sleep=time.sleep, clock=time.monotonic, poll=0.01):
+    def __init__(self, interface, axis=0, search_speed=2047, switch_speed=500, max_speed=2047, poll=0.01):
         self.interface = interface
         self.axis = axis
         self.module = TMCM1141(interface)
@@ -50,17 +50,15 @@ class StageApp:
         self.search_speed = search_speed
         self.switch_speed = switch_speed
         self.max_speed = max_speed
-        self.sleep = sleep
-        self.clock = clock
         self.poll = poll
 
     def _wait(self, done, timeout):
         """Polls ``done()`` every ``poll`` seconds; False after ``timeout``."""
-        deadline = self.clock() + timeout
+        deadline = time.monotonic() + timeout
         while not done():
-            if self.clock() >= deadline:
+            if time.monotonic() >= deadline:
                 return False
-            self.sleep(self.poll)
+            time.sleep(self.poll)
         return True
 
     def home(self, timeout=30.0):
@@ -98,7 +96,7 @@ class StageApp:
         for p in positions:
             reached.append(self.move_to(p, timeout))
             if dwell:
-                self.sleep(dwell)
+                time.sleep(dwell)
         return reached
 
 

@@ -111,11 +111,11 @@ def test_the_plugin_loads_by_entry_point_and_tears_down(tmp_path):
 
 def test_unknown_options_are_usage_errors(tmp_path):
     (tmp_path / "test_bad.py").write_text(
-        "import pytest\n\n@pytest.mark.tmcl_module(speed=3)\ndef test_bad(tmcl_module):\n    pass\n"
+        "import pytest\n\n@pytest.mark.tmcl_module(pace=3)\ndef test_bad(tmcl_module):\n    pass\n"
     )
     result = run_pytest(tmp_path, "-q")
     assert result.returncode != 0
-    assert "unknown option(s) speed" in result.stdout + result.stderr
+    assert "unknown option(s) pace" in result.stdout + result.stderr
 
 
 def test_the_marker_is_registered(tmp_path):

@@ -16,6 +16,7 @@ use std::time::Duration;
 mod asm;
 mod bench;
 mod client;
+mod clock;
 mod console;
 mod debugger;
 mod duration;
@@ -85,6 +86,8 @@ enum Command {
     FleetBench(fleet::FleetBenchArgs),
     /// The browser IDE against modules on a TMCL link (real or virtual), polled as a host does.
     Ide(ide::IdeArgs),
+    /// Run a Python program with its clocks N times as fast as the wall clock, for modules served with --speed N.
+    Clock(clock::ClockArgs),
     /// Run a TMCL program against every scenario of a matrix file, here or on a Dask cluster (docs/sweeps.md).
     Sweep(sweep::SweepArgs),
     /// Record a host's session with a module through a proxy; check a recorded session against a virtual module.
@@ -299,6 +302,7 @@ where
         Command::Console(a) => console::run(a),
         Command::Ide(a) => ide::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Clock(a) => clock::run(a),
         Command::Profile(a) => profile(&a.module),
         Command::Bench(a) => bench::run(a),
         Command::Asm(a) => asm::asm(a),
