@@ -89,7 +89,7 @@ fn pty_path(endpoint: Endpoint, module_name: &str) -> Option<PathBuf> {
 /// - ``wire_timing``: replies take as long as the bytes take at the
 ///   module's baud rate (GP 65).
 /// - ``speed``: virtual time runs this many times as fast as the wall
-///   clock while it is paced by it (a positive number; ``.speed`` reads
+///   clock while it is paced by it (0.001…100000; ``.speed`` reads
 ///   and sets it while served); ``tmclsim.clock`` puts the host's own
 ///   clocks on the same scale.
 ///
@@ -271,7 +271,7 @@ impl Server {
     }
 
     /// How many times as fast as the wall clock virtual time runs while it
-    /// is paced by the wall clock (a positive number; settable while
+    /// is paced by the wall clock (0.001…100000; settable while
     /// served, from the modules' now on).
     #[getter]
     fn speed(&self) -> f64 {

@@ -201,7 +201,7 @@ def serve(
     - ``wire_timing``: replies take as long as their bytes at the module's
       baud rate (GP 65).
     - ``speed``: virtual time runs this many times as fast as the wall
-      clock (a positive number); ``tmclsim.clock`` puts the host's own
+      clock (0.001…100000); ``tmclsim.clock`` puts the host's own
       clocks on the same scale (docs/host-software.md).
 
     Returns a ``Server`` with the endpoints (``.tcp``, ``.pty``,

@@ -187,7 +187,7 @@ pub struct ServeArgs {
     #[arg(long)]
     pub wire_timing: bool,
     /// Run the modules' virtual time N times as fast as the wall clock
-    /// (a positive number; 0.5 is half as fast): ramps, WAIT, timers,
+    /// (0.001…100000; 0.5 is half as fast): ramps, WAIT, timers,
     /// events, reply delays and wire timing all follow it. Host code waits
     /// on its own clock: `tmclsim clock --speed N -- python SCRIPT` puts a
     /// Python program on the same scale (docs/host-software.md).
@@ -423,7 +423,7 @@ pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::Wo
 
 /// `HOST:PORT` with a host name or an IP address (IPv4 first when a name
 /// has both).
-/// A `--speed` value: a positive number.
+/// A `--speed` value: a number from 0.001 to 100000.
 pub(crate) fn speed(text: &str) -> Result<tmclsim_firmware::Speed, String> {
     text.parse()
 }

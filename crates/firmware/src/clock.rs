@@ -25,8 +25,8 @@ pub enum Clock {
     Stepped,
 }
 
-/// How fast virtual time runs against the wall clock: a positive, finite
-/// factor (1: as fast as the wall clock).
+/// How fast virtual time runs against the wall clock: a factor from
+/// [`Speed::MIN`] to [`Speed::MAX`] (1: as fast as the wall clock).
 #[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
 pub struct Speed(f64);
 
@@ -36,7 +36,14 @@ pub struct BadSpeed(pub f64);
 
 impl std::fmt::Display for BadSpeed {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "speed {} is not a positive finite number (1 = as fast as the wall clock)", self.0)
+        let v = self.0;
+        // Very large or small values in the exponent form, as typed.
+        let value = if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() };
+        if v.is_finite() && v > 0.0 {
+            write!(f, "speed {value} is outside {}…{} (1 = as fast as the wall clock)", Speed::MIN, Speed::MAX)
+        } else {
+            write!(f, "speed {value} is not a positive finite number (1 = as fast as the wall clock)")
+        }
     }
 }
 
@@ -45,10 +52,15 @@ impl std::error::Error for BadSpeed {}
 impl Speed {
     /// The wall clock's own pace.
     pub const REAL_TIME: Speed = Speed(1.0);
+    /// The slowest speed: a thousandth of the wall clock's pace.
+    pub const MIN: f64 = 0.001;
+    /// The fastest speed: a virtual day in under a wall-clock second.
+    pub const MAX: f64 = 100_000.0;
 
-    /// A speed of `factor` virtual seconds per wall-clock second.
+    /// A speed of `factor` virtual seconds per wall-clock second, within
+    /// [`Speed::MIN`]…[`Speed::MAX`].
     pub fn new(factor: f64) -> Result<Speed, BadSpeed> {
-        if factor.is_finite() && factor > 0.0 { Ok(Speed(factor)) } else { Err(BadSpeed(factor)) }
+        if factor.is_finite() && (Speed::MIN..=Speed::MAX).contains(&factor) { Ok(Speed(factor)) } else { Err(BadSpeed(factor)) }
     }
 
     /// The factor.
@@ -58,6 +70,7 @@ impl Speed {
 
     /// The wall-clock time that `virtual_ns` of virtual time take.
     pub fn wall(self, virtual_ns: u64) -> Duration {
+        // (u64::MAX ns at the slowest speed are 5.8e14 s: a Duration holds them.)
         if self.0 == 1.0 { Duration::from_nanos(virtual_ns) } else { Duration::from_secs_f64(virtual_ns as f64 * 1e-9 / self.0) }
     }
 
@@ -95,7 +108,7 @@ impl Clock {
     /// `current_ns`, where the bus already is.
     pub fn now_ns(&self, current_ns: u64) -> u64 {
         match *self {
-            Clock::Wall { origin, origin_ns, speed } => (origin_ns + speed.virtual_ns(origin.elapsed())).max(current_ns),
+            Clock::Wall { origin, origin_ns, speed } => origin_ns.saturating_add(speed.virtual_ns(origin.elapsed())).max(current_ns),
             Clock::Stepped => current_ns,
         }
     }
@@ -104,7 +117,8 @@ impl Clock {
     /// clock (nothing happens until the bus is advanced).
     pub fn instant_of(&self, ns: u64) -> Option<Instant> {
         match *self {
-            Clock::Wall { origin, origin_ns, speed } => Some(origin + speed.wall(ns.saturating_sub(origin_ns))),
+            // Beyond what an Instant holds (centuries away): never.
+            Clock::Wall { origin, origin_ns, speed } => origin.checked_add(speed.wall(ns.saturating_sub(origin_ns))),
             Clock::Stepped => None,
         }
     }
@@ -168,5 +182,14 @@ mod tests {
         assert_eq!("0".parse::<Speed>().unwrap_err(), "speed 0 is not a positive finite number (1 = as fast as the wall clock)");
         assert_eq!("fast".parse::<Speed>().unwrap_err(), "speed 'fast' is not a number (1 = as fast as the wall clock)");
         assert!("inf".parse::<Speed>().is_err());
+        assert_eq!(Speed::new(1e-300).unwrap_err().to_string(), "speed 1e-300 is outside 0.001…100000 (1 = as fast as the wall clock)");
+        assert_eq!(Speed::new(1e6).unwrap_err().to_string(), "speed 1e6 is outside 0.001…100000 (1 = as fast as the wall clock)");
+        // The extremes map every virtual time to a wall time, or to never.
+        for factor in [Speed::MIN, Speed::MAX] {
+            let c = Clock::wall_from(0, Speed::new(factor).unwrap());
+            let _ = c.instant_of(u64::MAX);
+            let _ = c.wall_duration(u64::MAX);
+            assert!(c.now_ns(0) < u64::MAX);
+        }
     }
 }
