@@ -114,6 +114,9 @@ pub struct Parameter {
     /// the motion controller's units (docs/behaviour.md rule 23); only on
     /// modules whose `motion_units` are the TMC429's.
     pub quantity: Option<Quantity>,
+    /// For a duration: the milliseconds one unit stands for, read from
+    /// `unit` when the profile is loaded ([`Parameter::ms_per_unit`]).
+    duration_ms: Option<u64>,
 }
 
 /// A parameter whose value is in the motion controller's units: converted
@@ -160,10 +163,7 @@ impl Parameter {
     /// read from the row's unit (`ms` 1, `10ms` or `10 ms` 10, `s` 1000);
     /// `None` when the unit is no duration.
     pub fn ms_per_unit(&self) -> Option<u64> {
-        let unit: String = self.unit.as_deref()?.chars().filter(|c| !c.is_whitespace()).collect();
-        let (count, scale) = if let Some(n) = unit.strip_suffix("ms") { (n, 1) } else { (unit.strip_suffix('s')?, 1000) };
-        let count = if count.is_empty() { 1 } else { count.parse::<u64>().ok()? };
-        Some(count * scale)
+        self.duration_ms
     }
 }
 
@@ -642,9 +642,19 @@ fn expand(row: &ParameterRow, table: &mut [Option<Parameter>]) -> Result<(), Pro
             note: row.note.clone(),
             ranges: row.ranges.iter().map(|&[lo, hi]| (lo, hi)).collect(),
             quantity: row.quantity,
+            duration_ms: row.unit.as_deref().and_then(duration_ms),
         });
     }
     Ok(())
+}
+
+/// The milliseconds a duration unit stands for (`ms` 1, `10ms` or `10 ms`
+/// 10, `s` 1000); `None` for a unit that is no duration.
+fn duration_ms(unit: &str) -> Option<u64> {
+    let unit: String = unit.chars().filter(|c| !c.is_whitespace()).collect();
+    let (count, scale) = if let Some(n) = unit.strip_suffix("ms") { (n, 1) } else { (unit.strip_suffix('s')?, 1000) };
+    let count = if count.is_empty() { 1 } else { count.parse::<u64>().ok()? };
+    Some(count * scale)
 }
 
 /// The rules of one parameter row: default within its bounds and ranges,

@@ -4,13 +4,9 @@
 
 use crate::common;
 
-use common::{BusOfOne, send};
+use common::{BusOfOne, power_cycle, send};
 
 use tmclsim_firmware::{Eeprom, Module, Profile};
-
-fn power_cycle(m: &BusOfOne) -> BusOfOne {
-    BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()))
-}
 
 #[test]
 fn stap_rsap_survive_power_cycles() {

@@ -7,7 +7,7 @@
 
 use crate::common;
 
-use common::{BusOfOne, MS, reply, send};
+use common::{BusOfOne, MS, power_cycle, reply, send, until};
 
 use tmclsim_firmware::world::Load;
 use tmclsim_firmware::{Module, World};
@@ -18,27 +18,11 @@ fn module() -> BusOfOne {
     BusOfOne::built_in("tmcm-351")
 }
 
-/// A module that powers up with `m`'s EEPROM (a power cycle).
-fn power_cycle(m: &BusOfOne) -> BusOfOne {
-    BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()))
-}
-
 /// Loads a program of mnemonic lines (numeric addresses) and starts it.
 fn run(m: &mut BusOfOne, lines: &[&str]) {
     let words: Vec<Instruction> = lines.iter().map(|l| parse_line(l).unwrap_or_else(|e| panic!("{l}: {e}"))).collect();
     m.load_program(&words).unwrap();
     assert_eq!(send(m, "#129 1 0 0"), 0);
-}
-
-/// Advances in steps of 1 ms until `done` holds; the steps it took.
-fn until(m: &mut BusOfOne, limit_ms: u64, mut done: impl FnMut(&mut BusOfOne) -> bool) -> Option<u64> {
-    for t in 1..=limit_ms {
-        m.advance(MS);
-        if done(m) {
-            return Some(t);
-        }
-    }
-    None
 }
 
 #[test]

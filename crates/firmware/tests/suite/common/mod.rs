@@ -51,6 +51,23 @@ impl DerefMut for BusOfOne {
     }
 }
 
+/// A module that powers up with `m`'s EEPROM (a power cycle).
+pub fn power_cycle(m: &BusOfOne) -> BusOfOne {
+    BusOfOne::new(Module::with_eeprom(m.profile().clone(), m.eeprom().clone()))
+}
+
+/// Advances in steps of 1 ms until `done` holds; the steps it took, or
+/// `None` after `limit_ms`.
+pub fn until(m: &mut BusOfOne, limit_ms: u64, mut done: impl FnMut(&mut BusOfOne) -> bool) -> Option<u64> {
+    for t in 1..=limit_ms {
+        m.advance(MS);
+        if done(m) {
+            return Some(t);
+        }
+    }
+    None
+}
+
 /// The request frame of a command to address 1.
 pub fn frame(line: &str) -> [u8; 9] {
     Request::new(1, parse_line(line).unwrap_or_else(|e| panic!("{line}: {e}"))).encode()
