@@ -50,13 +50,15 @@ impl LinePlace {
 /// instruction at or after that line, or no file of the map matches.
 ///
 /// A file matches when it is the name in the map, or when the map's name
-/// ends with `/` + the name given. Without a file, the file of the first
+/// ends with `/` + the name given (on Windows also `\` + the name, its
+/// paths' separator). Without a file, the file of the first
 /// instruction (the main file) is meant.
 pub fn address_of(map: &[SourceLine], place: &LinePlace) -> Result<u32, PlaceError> {
     let file = match &place.file {
         Some(f) => {
             let names: BTreeMap<&str, ()> = map.iter().map(|s| (&*s.file, ())).collect();
-            let matching: Vec<&str> = names.keys().copied().filter(|n| *n == f || n.ends_with(&format!("/{f}"))).collect();
+            let below = |n: &str| n.ends_with(&format!("/{f}")) || (cfg!(windows) && n.ends_with(&format!("\\{f}")));
+            let matching: Vec<&str> = names.keys().copied().filter(|n| *n == f || below(n)).collect();
             match matching.as_slice() {
                 [one] => one.to_string(),
                 [] => {

@@ -1,6 +1,7 @@
 //! `tmclsim bench`: commands per second in-process, round trips over TCP
 //! and the pty with a Rust client, and the server's CPU time per command.
 
+use crate::platform::{process_cpu, self_cpu};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Command, Stdio};
 use std::sync::Arc;
@@ -80,11 +81,12 @@ fn measure(args: &crate::BenchArgs, frames: &[[u8; 9]]) -> Result<(), String> {
     // Over the links of a `tmclsim serve` process.
     let dir = std::env::temp_dir().join(format!("tmclsim-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let pty = dir.join("pty");
+    // The pty where there are ptys (not on Windows).
+    let pty = crate::platform::PTY_REFUSED.is_none().then(|| dir.join("pty"));
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let mut child = Command::new(exe)
-        .args(["serve", "--tcp", "127.0.0.1:0", "--pty"])
-        .arg(&pty)
+        .args(["serve", "--tcp", "127.0.0.1:0"])
+        .args(pty.iter().flat_map(|p| [std::ffi::OsStr::new("--pty"), p.as_os_str()]))
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
@@ -109,9 +111,11 @@ fn measure(args: &crate::BenchArgs, frames: &[[u8; 9]]) -> Result<(), String> {
         let mut s = std::net::TcpStream::connect(&tcp).map_err(|e| e.to_string())?;
         s.set_nodelay(true).ok();
         report("TCP round trip, Rust client", &mut s, frames, args.round_trips, Some(pid))?;
-        stage("round trips over the pty");
-        let mut port = std::fs::OpenOptions::new().read(true).write(true).open(&pty).map_err(|e| e.to_string())?;
-        report("pty round trip, Rust client", &mut port, frames, args.round_trips, Some(pid))?;
+        if let Some(pty) = &pty {
+            stage("round trips over the pty");
+            let mut port = std::fs::OpenOptions::new().read(true).write(true).open(pty).map_err(|e| e.to_string())?;
+            report("pty round trip, Rust client", &mut port, frames, args.round_trips, Some(pid))?;
+        }
         Ok(())
     })();
     stage("echo baseline");
@@ -257,18 +261,6 @@ fn idle_row(name: &str, modules: usize, seconds: f64, server: &tmclsim_server::S
     Ok(())
 }
 
-/// User plus system CPU time of this process, to the microsecond.
-fn self_cpu() -> Duration {
-    // SAFETY: getrusage writes into the struct we pass.
-    let usage = unsafe {
-        let mut u: libc::rusage = std::mem::zeroed();
-        libc::getrusage(libc::RUSAGE_SELF, &mut u);
-        u
-    };
-    let tv = |t: libc::timeval| Duration::from_secs(t.tv_sec as u64) + Duration::from_micros(t.tv_usec as u64);
-    tv(usage.ru_utime) + tv(usage.ru_stime)
-}
-
 /// The TMCM-1141 manual's timer-interrupt example (3.6.6.4), toggling OUT1
 /// in the main loop (the module has no output 3).
 const TIMER_INTERRUPT: &str = "  VECT 0, Timer0Irq\n  SGP 0, 3, 1000\n  EI 0\n  EI 255\nLoop:\n  SIO 1, 2, 1\n  WAIT TICKS, 0, 50\n  SIO 1, 2, 0\n  WAIT TICKS, 0, 50\n  JA Loop\nTimer0Irq:\n  GIO 0, 2\n  JC NZ, Out0Off\n  SIO 0, 2, 1\n  RETI\nOut0Off:\n  SIO 0, 2, 0\n  RETI\n";
@@ -302,16 +294,4 @@ fn echo_baseline(frames: &[[u8; 9]], n: usize) -> Result<(), String> {
 
 fn us(d: Duration) -> f64 {
     d.as_secs_f64() * 1e6
-}
-
-/// User and system CPU time of a process, from /proc.
-pub(crate) fn process_cpu(pid: u32) -> Result<(Duration, Duration), String> {
-    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).map_err(|e| e.to_string())?;
-    let after = stat.rsplit_once(')').ok_or("bad /proc stat")?.1;
-    let fields: Vec<&str> = after.split_whitespace().collect();
-    let field = |i: usize| fields[i].parse::<u64>().map_err(|e| e.to_string());
-    // SAFETY: sysconf has no preconditions.
-    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) }.max(1) as u64;
-    let time = |ticks: u64| Duration::from_nanos(ticks * 1_000_000_000 / hz);
-    Ok((time(field(11)?), time(field(12)?)))
 }

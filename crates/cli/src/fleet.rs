@@ -9,7 +9,10 @@
 //! speed = 50                     # optional: virtual time 50 × the wall clock
 //!                                # (each link may say its own; --speed otherwise)
 //! [[link]]
-//! tcp = "127.0.0.1:20000"        # or pty = "/tmp/tmclsim-bus"
+//! tcp = "127.0.0.1:20000"        # or pty = "/tmp/tmclsim-bus", or
+//!                                # serial = "/dev/ttyUSB0" (or a list; COM5
+//!                                # on Windows) with baud = 115200 (GP 65's
+//!                                # rate otherwise)
 //! count = 1000                   # 1000 such links, ports 20000, 20001, …
 //! modules = ["tmcm-1141@1"]      # PROFILE@ADDRESS, any mix
 //! [[link]]
@@ -45,6 +48,8 @@ fn stage() -> String {
 struct LinkFile {
     tcp: Option<SocketAddr>,
     pty: Option<PathBuf>,
+    serial: Option<Devices>,
+    baud: Option<u32>,
     #[serde(default)]
     modules: Vec<String>,
     bus: Option<String>,
@@ -57,6 +62,22 @@ struct LinkFile {
     /// This link's speed (the file's otherwise).
     speed: Option<f64>,
 }
+/// `serial = "DEVICE"` or `serial = ["DEVICE", …]`.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum Devices {
+    One(String),
+    Many(Vec<String>),
+}
+
+impl Devices {
+    fn list(&self) -> Vec<String> {
+        match self {
+            Devices::One(d) => vec![d.clone()],
+            Devices::Many(all) => all.clone(),
+        }
+    }
+}
 
 fn one() -> usize {
     1
@@ -67,6 +88,7 @@ fn one() -> usize {
 pub struct Link {
     pub tcp: Option<SocketAddr>,
     pub pty: Option<PathBuf>,
+    pub serial: Vec<tmclsim_server::SerialLine>,
     pub modules: Vec<(String, u8)>,
     pub world: String,
     pub wire_timing: bool,
@@ -105,12 +127,27 @@ pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
         if let Some(a) = tmclsim_firmware::bus::duplicate_address(modules.iter().map(|(_, a)| *a)) {
             return Err(format!("{}: two modules at address {a} (each module of a bus has its own address)", what()));
         }
-        if l.tcp.is_none() && l.pty.is_none() {
-            return Err(format!("{}: give tcp = \"ADDR\" or pty = \"PATH\"", what()));
+        let devices = l.serial.as_ref().map(Devices::list).unwrap_or_default();
+        if l.tcp.is_none() && l.pty.is_none() && devices.is_empty() {
+            return Err(format!("{}: give tcp = \"ADDR\", pty = \"PATH\" or serial = \"DEVICE\"", what()));
         }
         if l.count == 0 {
             return Err(format!("{}: count is at least 1", what()));
         }
+        if let (Some(_), Some(why)) = (&l.pty, crate::platform::PTY_REFUSED) {
+            return Err(format!("{}: pty: {why}", what()));
+        }
+        if !devices.is_empty() && l.count > 1 {
+            return Err(format!("{}: a serial device is one link: count must be 1 with serial = ...", what()));
+        }
+        if l.baud.is_some() && devices.is_empty() {
+            return Err(format!("{}: baud is the rate of a serial device: give serial = \"DEVICE\" too", what()));
+        }
+        if let Some(b) = l.baud {
+            crate::check_baud(b).map_err(|e| format!("{}: {e}", what()))?;
+        }
+        let serial: Vec<tmclsim_server::SerialLine> =
+            devices.into_iter().map(|device| tmclsim_server::SerialLine { device, baud: l.baud }).collect();
         let total = out.iter().map(|l: &Link| l.modules.len()).sum::<usize>();
         if l.count.saturating_mul(modules.len()).saturating_add(total) > MAX_MODULES {
             return Err(format!("{}: the fleet would have more than {MAX_MODULES} modules, the limit of one fleet", what()));
@@ -127,6 +164,7 @@ pub fn load(path: &std::path::Path) -> Result<Vec<Link>, String> {
             out.push(Link {
                 tcp,
                 pty,
+                serial: serial.clone(),
                 modules: modules.clone(),
                 world: l.world.clone().unwrap_or_else(|| f.world.clone()),
                 wire_timing: l.wire_timing,
@@ -163,6 +201,7 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
         let config = ServerConfig {
             tcp: l.tcp,
             pty: l.pty.clone(),
+            serial: l.serial.clone(),
             inter_byte_timeout: crate::millis(args.inter_byte_timeout),
             max_connections: args.max_connections,
             bad_frame_limit: args.bad_frame_limit,
@@ -177,10 +216,12 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     let server = tmclsim_server::start_fleet(specs).map_err(|e| format!("cannot serve the fleet: {e}"))?;
     println!("tmclsim: fleet of {total} modules on {} links is serving", server.links().len());
     let web = crate::ide::start_web(args, server.links())?;
-    if let Some(first) = server.links().first()
-        && let Some(a) = first.endpoints.pytrinamic_args()
-    {
-        println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (first link)");
+    if let Some(first) = server.links().first() {
+        if let Some(a) = first.endpoints.pytrinamic_args() {
+            println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (first link)");
+        } else if let Some(hint) = first.endpoints.serial_hint() {
+            println!("connect with: {hint}  (first link)");
+        }
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
@@ -224,7 +265,7 @@ pub fn bench(args: FleetBenchArgs) -> Result<ExitCode, String> {
     let links = load(&args.fleet)?;
     let modules: usize = links.iter().map(|l| l.modules.len()).sum();
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
-    let mut child = std::process::Command::new(exe)
+    let mut child = crate::platform::stoppable(&mut std::process::Command::new(exe))
         .args(["serve", "--max-connections", "100000", "--fleet"])
         .arg(&args.fleet)
         .stdout(std::process::Stdio::piped())
@@ -239,21 +280,16 @@ pub fn bench(args: FleetBenchArgs) -> Result<ExitCode, String> {
         return Err(format!("the fleet did not start: {line}"));
     }
     let pid = child.id();
-    let cpu0 = crate::bench::process_cpu(pid)?;
+    let cpu0 = crate::platform::process_cpu(pid)?;
     let wall0 = Instant::now();
     let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().map_err(|e| e.to_string())?;
     let duration = Duration::from_nanos(args.duration);
     let results = rt.block_on(drive(links, args.rate, duration));
     let wall = wall0.elapsed();
-    let cpu1 = crate::bench::process_cpu(pid)?;
-    let rss_kib = std::fs::read_to_string(format!("/proc/{pid}/status"))
-        .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("VmRSS:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok()))
-        .unwrap_or(0);
-    // SAFETY: signalling the child we started.
-    unsafe {
-        libc::kill(pid as i32, libc::SIGTERM);
-    }
+    let cpu1 = crate::platform::process_cpu(pid)?;
+    let rss_kib = crate::platform::resident_kib(pid).unwrap_or(0);
+    // Stopped as Ctrl-C stops it, so that it prints its stats.
+    crate::platform::stop(&mut child);
     let mut stats = String::new();
     loop {
         line.clear();

@@ -20,8 +20,10 @@ mod clock;
 mod console;
 mod debugger;
 mod duration;
+mod firmware;
 mod fleet;
 mod ide;
+mod platform;
 mod plot;
 mod progress;
 mod run;
@@ -92,6 +94,8 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Record a host's session with a module through a proxy; check a recorded session against a virtual module.
     Trace(trace::TraceArgs),
+    /// Firmware images for a module's bootloader, to test firmware update tools.
+    Firmware(firmware::FirmwareArgs),
     /// Print a shell's completion script for tmclsim on standard output.
     Completions(CompletionsArgs),
     /// Print the manual page of tmclsim (or of one of its commands) as roff on standard output.
@@ -131,14 +135,24 @@ pub struct ServeArgs {
     #[arg(long, default_value = "tmcm-1141")]
     pub module: String,
     /// Listen for TCP clients on this address (loopback by default). Without
-    /// --tcp and --pty both are served, TCP on 127.0.0.1:1141.
+    /// --tcp, --pty and --serial both are served, TCP on 127.0.0.1:1141 (on Windows,
+    /// which has no ptys, TCP only).
     #[arg(long, value_name = "ADDR", value_parser = socket_address)]
     pub tcp: Option<SocketAddr>,
     /// Create a pty and a symlink to it at PATH, opened like a serial port.
-    /// Without --tcp and --pty both are served, the pty at
-    /// $TMPDIR/tmclsim-<module>.
+    /// Without --tcp, --pty and --serial both are served, the pty at
+    /// $TMPDIR/tmclsim-<module>. Unix only (on Windows: --serial COMn).
     #[arg(long, value_name = "PATH")]
     pub pty: Option<PathBuf>,
+    /// Answer on an existing serial device (a USB–RS485 adapter, a COM
+    /// port, one end of a virtual null-modem pair) as the module's own
+    /// UART/RS485 port; repeatable. A device that vanishes is opened again
+    /// when it is back. With --serial, only the links named are served.
+    #[arg(long, value_name = "DEVICE")]
+    pub serial: Vec<String>,
+    /// The serial devices' baud rate (default: the module's GP 65 at power-up).
+    #[arg(long, value_name = "N", requires = "serial", value_parser = baud)]
+    pub baud: Option<u32>,
     /// Keep the EEPROM in FILE across runs (created if missing; written
     /// atomically). Without it the module starts from factory defaults.
     #[arg(long, value_name = "FILE")]
@@ -291,10 +305,7 @@ where
         // (`tmclsim profile | head`) ends quietly, as other tools do.
         // Servers keep ignoring the signal: their links report a closed
         // peer as an error of that link only.
-        // SAFETY: called before any other thread exists.
-        unsafe {
-            libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-        }
+        platform::default_sigpipe();
     }
     let result = match cli.command {
         Command::Serve(a) => serve::run(a),
@@ -312,6 +323,7 @@ where
         Command::World(a) => world(a),
         Command::FleetBench(a) => fleet::bench(a),
         Command::Trace(a) => trace::run(a),
+        Command::Firmware(a) => firmware::run(a),
         Command::Completions(a) => completions(a.shell),
         Command::Man(a) => man(&a.command),
     };
@@ -426,6 +438,19 @@ pub(crate) fn load_world(name: &str, axes: usize) -> Result<tmclsim_firmware::Wo
 /// A `--speed` value: a number from 0.001 to 100000.
 pub(crate) fn speed(text: &str) -> Result<tmclsim_firmware::Speed, String> {
     text.parse()
+}
+
+/// A serial line's baud rate: what adapters take, 50 baud to 12 Mbaud.
+pub(crate) fn check_baud(rate: u32) -> Result<u32, String> {
+    if (50..=12_000_000).contains(&rate) {
+        Ok(rate)
+    } else {
+        Err(format!("{rate} baud: a serial line runs at 50…12000000 baud (the modules' rates are 9600…1000000)"))
+    }
+}
+
+fn baud(text: &str) -> Result<u32, String> {
+    check_baud(text.parse().map_err(|_| format!("'{text}' is not a baud rate (a whole number, e.g. 9600 or 115200)"))?)
 }
 
 pub(crate) fn socket_address(text: &str) -> Result<SocketAddr, String> {

@@ -30,6 +30,21 @@ pub fn run(args: SendArgs) -> Result<ExitCode, String> {
         println!("(137 sends no reply)");
         return Ok(ExitCode::SUCCESS);
     }
+    // The two bootloader commands that restart the module send no reply
+    // (docs/behaviour.md rule 99).
+    if ins.opcode == opcode::BOOT_START_APPL || ins.opcode == opcode::BOOT && mnemonic::format(ins) == "BOOT" {
+        client.send_only(ins)?;
+        println!(
+            "({} sends no reply: the module restarts, {}; '#136 0 0 0' says what answers)",
+            opcode::name(ins.opcode),
+            if ins.opcode == opcode::BOOT {
+                "into its bootloader, which answers at address 1"
+            } else {
+                "into its firmware if that is complete"
+            }
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
     // A module that does not answer failed the command, as one that
     // answers an error does: exit status 1 (README.md, "Exit status").
     let reply = match client.exchange(ins) {

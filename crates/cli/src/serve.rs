@@ -43,7 +43,7 @@ pub fn run(args: ServeArgs) -> Result<ExitCode, String> {
     let profile = Profile::built_in(&args.module)?;
     let key = profile.module.name.to_ascii_lowercase();
     let (tcp, pty) = match (args.tcp, args.pty.clone()) {
-        (None, None) => (Some("127.0.0.1:1141".parse().unwrap()), Some(std::env::temp_dir().join(format!("tmclsim-{key}")))),
+        (None, None) if args.serial.is_empty() => (Some("127.0.0.1:1141".parse().unwrap()), default_pty(format!("tmclsim-{key}"))),
         other => other,
     };
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
@@ -91,16 +91,15 @@ fn check_args(args: &ServeArgs) -> Result<(), String> {
             args.control
         ));
     }
+    // What this system cannot serve (a pty, SLCAN and EtherCAT on Windows).
+    crate::platform::check_serve(args)?;
     Ok(())
 }
 
 /// A fresh random token for the control socket (128 bits, hex).
 fn control_token() -> Result<String, String> {
-    use std::io::Read;
     let mut bytes = [0u8; 16];
-    std::fs::File::open("/dev/urandom")
-        .and_then(|mut f| f.read_exact(&mut bytes))
-        .map_err(|e| format!("cannot make a control token: {e}"))?;
+    getrandom::fill(&mut bytes).map_err(|e| format!("cannot make a control token: {e}"))?;
     Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
 }
 
@@ -164,10 +163,16 @@ fn read_only_note(file: &EepromFile) -> String {
     " (read-only: EEPROM writes answer status 5, the file stays as it is)".to_string()
 }
 
-/// The links to serve: both defaults when neither is named.
+/// The pty served when no link is named: `NAME` in the directory for
+/// temporary files, where there are ptys (not on Windows: TCP only).
+fn default_pty(name: String) -> Option<std::path::PathBuf> {
+    crate::platform::PTY_REFUSED.is_none().then(|| std::env::temp_dir().join(name))
+}
+
+/// The links to serve: both defaults when no link is named.
 fn args_links(args: &ServeArgs) -> (Option<std::net::SocketAddr>, Option<std::path::PathBuf>) {
     match (args.tcp, args.pty.clone()) {
-        (None, None) => (Some("127.0.0.1:1141".parse().unwrap()), Some(std::env::temp_dir().join("tmclsim-bus"))),
+        (None, None) if args.serial.is_empty() => (Some("127.0.0.1:1141".parse().unwrap()), default_pty("tmclsim-bus".into())),
         other => other,
     }
 }
@@ -182,6 +187,7 @@ fn serve(
     let config = ServerConfig {
         tcp,
         pty,
+        serial: args.serial.iter().map(|device| tmclsim_server::SerialLine { device: device.clone(), baud: args.baud }).collect(),
         eeprom,
         inter_byte_timeout: crate::millis(args.inter_byte_timeout),
         max_connections: args.max_connections,
@@ -202,11 +208,17 @@ fn serve(
     let ep = server.endpoints().clone();
     println!("tmclsim: virtual {} is serving", names.join(", "));
     println!("  EEPROM: {eeprom_note}");
+    for line in bootloader_lines(server.links()) {
+        println!("  {line}");
+    }
     if let Some(addr) = ep.tcp {
         println!("  tcp: {addr}");
     }
     if let Some((link, device)) = &ep.pty {
         println!("  pty: {} -> {}", link.display(), device.display());
+    }
+    for (device, baud) in &ep.serial {
+        println!("  serial: {device} at {baud} baud, 8N1 (host software opens the other end of the line)");
     }
     if let Some((link, device)) = &ep.slcan {
         println!("  slcan: {} -> {}  (CAN adapter: python-can interface \"slcan\")", link.display(), device.display());
@@ -241,6 +253,8 @@ fn serve(
     let web = crate::ide::start_web(args, server.links())?;
     if let Some(a) = ep.pytrinamic_args() {
         println!("connect with: pytrinamic ConnectionManager(\"{a}\")  (or: tmclsim send {} GAP 1, 0)", send_target(&ep));
+    } else if let Some(hint) = ep.serial_hint() {
+        println!("connect with: {hint}");
     }
     use std::io::Write;
     let _ = std::io::stdout().flush();
@@ -252,6 +266,24 @@ fn serve(
     println!("tmclsim: stopping");
     server.stop();
     Ok(ExitCode::SUCCESS)
+}
+
+/// A line for each module that starts in its bootloader (a firmware
+/// update left no valid firmware, docs/behaviour.md rule 100).
+pub(crate) fn bootloader_lines(links: &[tmclsim_server::LinkHandle]) -> Vec<String> {
+    let mut out = Vec::new();
+    for link in links {
+        link.bus.with_bus(|b| {
+            for m in b.modules().iter().filter(|m| m.in_bootloader()) {
+                let text = m.profile().bootloader.as_ref().map_or(String::new(), |f| format!("{}, at address {}", f.version_text, f.address));
+                out.push(format!(
+                    "firmware: the {} is in its bootloader ({text}): a firmware update did not complete; it answers only the bootloader's commands until one does",
+                    m.profile().module.name
+                ));
+            }
+        });
+    }
+    out
 }
 
 fn send_target(ep: &tmclsim_server::Endpoints) -> String {
@@ -275,5 +307,8 @@ fn write_endpoints(path: &std::path::Path, ep: &tmclsim_server::Endpoints, token
     put("slcan", ep.slcan.as_ref().map(|(link, _)| link.display().to_string()));
     put("control", ep.control.map(|a| a.to_string()));
     put("control_token", token.map(str::to_string));
+    if !ep.serial.is_empty() {
+        table.insert("serial".into(), ep.serial.iter().map(|(device, _)| toml::Value::from(device.as_str())).collect::<Vec<_>>().into());
+    }
     std::fs::write(path, table.to_string()).map_err(|e| format!("{}: {e}", path.display()))
 }

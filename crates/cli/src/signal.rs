@@ -1,7 +1,11 @@
-//! The signals that end a server: Ctrl-C, SIGTERM, SIGHUP.
+//! The signals that end a server: Ctrl-C, SIGTERM, SIGHUP; on Windows
+//! Ctrl-C, Ctrl-Break and the console window closing.
 
 use tokio::runtime::Runtime;
+#[cfg(unix)]
 use tokio::signal::unix::{Signal, SignalKind, signal};
+#[cfg(windows)]
+use tokio::signal::windows::{CtrlBreak, CtrlC, CtrlClose, ctrl_break, ctrl_c, ctrl_close};
 
 /// The handlers of the signals that end a server, installed before it
 /// takes connections: what waiting needs (a runtime, the handlers'
@@ -10,9 +14,16 @@ use tokio::signal::unix::{Signal, SignalKind, signal};
 /// [`Signals::wait`] is kept for it.
 pub(crate) struct Signals {
     runtime: Runtime,
-    handlers: [Signal; 3],
+    handlers: Handlers,
 }
 
+#[cfg(unix)]
+type Handlers = [Signal; 3];
+
+#[cfg(windows)]
+type Handlers = (CtrlC, CtrlBreak, CtrlClose);
+
+#[cfg(unix)]
 impl Signals {
     pub(crate) fn install() -> Result<Signals, String> {
         let failed = |e: std::io::Error| format!("cannot install the signal handlers: {e}");
@@ -32,6 +43,32 @@ impl Signals {
                 _ = interrupt.recv() => {}
                 _ = terminate.recv() => {}
                 _ = hangup.recv() => {}
+            }
+        });
+    }
+}
+
+#[cfg(windows)]
+impl Signals {
+    pub(crate) fn install() -> Result<Signals, String> {
+        let failed = |e: std::io::Error| format!("cannot install the console control handlers: {e}");
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_io().build().map_err(failed)?;
+        let handlers = {
+            let _context = runtime.enter();
+            (ctrl_c().map_err(failed)?, ctrl_break().map_err(failed)?, ctrl_close().map_err(failed)?)
+        };
+        Ok(Signals { runtime, handlers })
+    }
+
+    /// Blocks until the process gets Ctrl-C, Ctrl-Break (what
+    /// `fleet-bench` sends its server), or its console window closes.
+    pub(crate) fn wait(self) {
+        let Signals { runtime, handlers: (mut interrupt, mut brk, mut close) } = self;
+        runtime.block_on(async {
+            tokio::select! {
+                _ = interrupt.recv() => {}
+                _ = brk.recv() => {}
+                _ = close.recv() => {}
             }
         });
     }

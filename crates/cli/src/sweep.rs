@@ -14,7 +14,8 @@ pub struct SweepArgs {
 }
 
 pub fn run(args: SweepArgs) -> Result<ExitCode, String> {
-    let python = std::env::var("TMCLSIM_PYTHON").unwrap_or_else(|_| "python3".into());
+    // Python's installer for Windows names its interpreter `python`.
+    let python = std::env::var("TMCLSIM_PYTHON").unwrap_or_else(|_| if cfg!(windows) { "python" } else { "python3" }.into());
     let probe = Command::new(&python).args(["-c", "import tmclsim.sweep, dask.distributed, pandas, tomli_w"]).output();
     match probe {
         Err(e) => {

@@ -360,6 +360,12 @@ mod tests {
         let cases =
             [0.0, -0.0, 0.5, 0.49999999999999994, 1.5, 2.5, 6.5, 7.4, 7.6, -0.4, -3.0, 1022.5, 1023.2, 5e9, f64::NAN, f64::INFINITY];
         for x in cases {
+            // mingw-w64's round(), which f64::round is on windows-gnu, gives
+            // 1 for the largest double below 0.5 (its ceil(x) − x rounds to
+            // 0.5): there the reference is wrong, not round_in.
+            if cfg!(all(windows, target_env = "gnu")) && x == 0.49999999999999994 {
+                continue;
+            }
             for max in [7.0, 1023.0] {
                 assert_eq!(round_in(x, max), x.round().clamp(0.0, max) as i32, "{x} in 0..={max}");
             }

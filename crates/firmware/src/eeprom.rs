@@ -31,6 +31,34 @@ pub struct Eeprom {
     /// TMCL program memory: address → instruction bytes.
     #[serde(default)]
     pub program: BTreeMap<u16, [u8; 7]>,
+    /// The firmware in flash, kept with the EEPROM because both outlive a
+    /// power cycle (docs/behaviour.md rule 102); absent: the factory's.
+    #[serde(default, skip_serializing_if = "Firmware::is_factory")]
+    pub firmware: Firmware,
+}
+
+/// The firmware the module's flash holds, which the bootloader starts at
+/// power-up when it is valid (docs/behaviour.md rules 99–103).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "state", rename_all = "lowercase")]
+pub enum Firmware {
+    /// The firmware the module left the factory with (its profile's).
+    #[default]
+    Factory,
+    /// A complete image written by a firmware update, of this version.
+    Installed {
+        /// Major and minor version (1, 47 for V1.47).
+        version: [u8; 2],
+    },
+    /// Erased, or written but not completed: the bootloader stays.
+    Invalid,
+}
+
+impl Firmware {
+    /// The factory's firmware (not written to the file).
+    pub fn is_factory(&self) -> bool {
+        *self == Firmware::Factory
+    }
 }
 
 fn key(a: u8, b: u8) -> String {
@@ -78,8 +106,10 @@ impl Eeprom {
     pub fn clear(&mut self) {
         let module = std::mem::take(&mut self.module);
         let program = std::mem::take(&mut self.program);
+        let firmware = self.firmware;
         *self = Eeprom::new(&module);
         self.program = program;
+        self.firmware = firmware;
     }
 
     /// The image as pretty-printed JSON, the form of an EEPROM file.

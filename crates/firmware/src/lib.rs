@@ -6,6 +6,7 @@
 //! [`Module::handle_frame`] / [`Module::execute`] and the passing of
 //! virtual time, which only a [`Bus`] moves ([`Bus::advance_to`]).
 
+pub mod bootloader;
 pub mod bus;
 pub mod clock;
 pub mod closed_loop;
@@ -35,7 +36,7 @@ pub mod world_rules;
 
 pub use bus::Bus;
 pub use clock::{Clock, Speed};
-pub use eeprom::Eeprom;
+pub use eeprom::{Eeprom, Firmware};
 pub use link_id::{IN_PROCESS, LinkId};
 pub use module::{Module, Outcome, Special};
 pub use module::{ascii, can};

@@ -41,6 +41,10 @@ pub enum CoilFault {
 pub enum WorldCommand {
     /// The world the module was served in again, carriages at its start.
     Reset,
+    /// Switches the module off and on: it starts as after power-up (its
+    /// bootloader first, which stays when the flash holds no valid
+    /// firmware; docs/behaviour.md rule 100).
+    PowerCycle,
     /// Puts the carriage of an axis at a position (the motor does not move).
     PlaceCarriage {
         /// The axis.
@@ -219,6 +223,10 @@ impl WorldCommand {
                 WorldCommand::Switch { axis, which, pressed }
             }
             "reset" => WorldCommand::Reset,
+            "power" => match w.next() {
+                Some("cycle") => WorldCommand::PowerCycle,
+                other => return Err(expected("cycle", other)),
+            },
             "place" => {
                 let axis = num(w.next(), "axis")?;
                 if w.clone().next() == Some("carriage") {
@@ -284,6 +292,10 @@ impl WorldCommand {
                 m.reset_world();
                 return Ok(String::new());
             }
+            WorldCommand::PowerCycle => {
+                m.reset();
+                return Ok(String::new());
+            }
             WorldCommand::PlaceCarriage { axis, position } => {
                 m.place_carriage(axis, position);
                 return Ok(String::new());
@@ -292,7 +304,7 @@ impl WorldCommand {
         }
         let world = m.world_mut();
         match *self {
-            WorldCommand::Reset | WorldCommand::PlaceCarriage { .. } => {}
+            WorldCommand::Reset | WorldCommand::PowerCycle | WorldCommand::PlaceCarriage { .. } => {}
             WorldCommand::Input { number, high } => world.set_digital(number, high),
             WorldCommand::Analog { number, value } => world.set_analog(number, value),
             WorldCommand::Supply { volts } => world.supply_decivolts = (volts * 10.0).round() as u16,
@@ -380,7 +392,11 @@ impl WorldCommand {
             WorldCommand::Travel { axis, from, to } => on_axis(axis, check_travel(from, to)),
             WorldCommand::Load { axis, torque, from, to } => on_axis(axis, check_load(&Load { torque, from, to, ..Load::default() })),
             WorldCommand::PlaceCarriage { axis, position } => on_axis(axis, check("carriage position", position, POSITION).map(drop)),
-            WorldCommand::Switch { .. } | WorldCommand::Fault { .. } | WorldCommand::Show { .. } | WorldCommand::Reset => Ok(()),
+            WorldCommand::Switch { .. }
+            | WorldCommand::Fault { .. }
+            | WorldCommand::Show { .. }
+            | WorldCommand::Reset
+            | WorldCommand::PowerCycle => Ok(()),
         }
     }
 }

@@ -4,7 +4,7 @@
 /// The `help` answer of the control protocol: every world and link command.
 pub const HELP: &str = "commands: [@ADDRESS] input N 0|1 | analog N VALUE | supply VOLTS | temperature CELSIUS | \
 switch AXIS left|right|home press|release|auto | place AXIS left|right POSITION [WIDTH] | place AXIS home FROM TO | \
-place AXIS carriage POSITION | reset | travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \
+place AXIS carriage POSITION | reset | power cycle | travel AXIS FROM TO | load AXIS TORQUE [FROM TO] | fault AXIS short-a|short-b|open-a|open-b on|off | \
 link drop N | link corrupt N | link delay MS | link mute on|off | link clear | show [AXIS] | help";
 
 /// The commands of [`HELP`], one per item, without the `[@ADDRESS]`

@@ -10,9 +10,14 @@
 //! text and the check against a module are the firmware's
 //! (`tmclsim_firmware::eeprom`, `tmclsim_firmware::eeprom_rules`).
 
-use std::fs::{File, OpenOptions, Permissions};
+#[cfg(unix)]
+use std::fs::Permissions;
+use std::fs::{File, OpenOptions};
 use std::io::{Read, Write};
+#[cfg(unix)]
 use std::os::unix::fs::{OpenOptionsExt, PermissionsExt};
+#[cfg(windows)]
+use std::os::windows::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 use tmclsim_firmware::{Eeprom, Profile};
 
@@ -212,6 +217,7 @@ pub fn load_for(path: &Path, profile: &Profile) -> Result<(Eeprom, bool), LoadEr
 /// may write any file), or this process may not (access(2): another
 /// user's file, a read-only file system). `None`: no such file, or one
 /// tmclsim may replace.
+#[cfg(unix)]
 pub fn read_only(path: &Path) -> Option<String> {
     let meta = std::fs::metadata(path).ok().filter(std::fs::Metadata::is_file)?;
     let mode = meta.permissions().mode() & 0o7777;
@@ -225,6 +231,24 @@ pub fn read_only(path: &Path) -> Option<String> {
         return Some(format!("the file is read-only for this user ({e})"));
     }
     None
+}
+
+/// Why the file at `path` is read-only for tmclsim, which then never
+/// replaces it (docs/behaviour.md rule 89): its read-only attribute is set
+/// (what Windows has for the owner's missing `u+w`), or this process may
+/// not open it for writing (the file's access control list, a read-only
+/// share). `None`: no such file, or one tmclsim may replace.
+#[cfg(windows)]
+pub fn read_only(path: &Path) -> Option<String> {
+    let meta = std::fs::metadata(path).ok().filter(std::fs::Metadata::is_file)?;
+    if meta.permissions().readonly() {
+        return Some("the file is read-only (its read-only attribute is set)".into());
+    }
+    // Opening for writing changes nothing (no truncation, no creation).
+    match OpenOptions::new().write(true).open(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => Some(format!("the file is read-only for this user ({e})")),
+        _ => None,
+    }
 }
 
 /// Writes the image to `path` atomically (a symbolic link is followed: its
@@ -278,27 +302,60 @@ fn write_atomic(path: &Path, image: &Eeprom) -> std::io::Result<()> {
     if let Some(why) = read_only(path) {
         return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, format!("{why}; tmclsim leaves it as it is")));
     }
+    let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{name}.");
+    builder.prefix(&prefix).suffix(".tmp").rand_bytes(TEMP_RANDOM);
     // The file keeps its permissions; a new one gets what a created file
     // gets (0666 less the umask).
+    #[cfg(unix)]
     let mode = std::fs::metadata(path).ok().filter(std::fs::Metadata::is_file).map(|m| m.permissions().mode() & 0o7777);
-    let mut tmp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".tmp")
-        .rand_bytes(TEMP_RANDOM)
-        .permissions(Permissions::from_mode(mode.unwrap_or(0o666)))
-        .tempfile_in(dir)?;
+    #[cfg(unix)]
+    builder.permissions(Permissions::from_mode(mode.unwrap_or(0o666)));
+    // On Windows a file's only permission is its read-only attribute,
+    // which a file tmclsim replaces does not have (read_only above): the
+    // new file inherits its directory's access control list.
+    let mut tmp = builder.tempfile_in(dir)?;
     tmp.write_all(image.to_json().as_bytes())?;
+    #[cfg(unix)]
     if let Some(mode) = mode {
         tmp.as_file().set_permissions(Permissions::from_mode(mode))?;
     }
     tmp.as_file().sync_all()?;
+    // A rename over the file (MoveFileEx with MOVEFILE_REPLACE_EXISTING
+    // on Windows).
     tmp.persist(path).map_err(|e| e.error)?;
     // The rename is durable once the directory is synced; a file system
-    // that cannot sync a directory keeps the new file all the same.
+    // that cannot sync a directory (or a system that cannot open one, as
+    // Windows) keeps the new file all the same.
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();
     }
     Ok(())
+}
+
+/// Opens the lock file `path`, created when `write`: never through a
+/// symbolic link, never waiting (on a pipe).
+#[cfg(unix)]
+fn open_lock(path: &Path, write: bool) -> std::io::Result<File> {
+    OpenOptions::new()
+        .read(true)
+        .write(write)
+        .create(write)
+        .mode(0o644)
+        // Not through a symbolic link, and not waiting on a pipe.
+        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_CLOEXEC)
+        .open(path)
+}
+
+/// Opens the lock file `path`, created when `write`: a symbolic link (a
+/// reparse point) is opened itself, not followed, and then refused as no
+/// regular file. Windows has no pipes in the file system to wait on, and
+/// its handles are not inherited unless asked for.
+#[cfg(windows)]
+fn open_lock(path: &Path, write: bool) -> std::io::Result<File> {
+    /// FILE_FLAG_OPEN_REPARSE_POINT (winbase.h).
+    const OPEN_REPARSE_POINT: u32 = 0x0020_0000;
+    OpenOptions::new().read(true).write(write).create(write).custom_flags(OPEN_REPARSE_POINT).open(path)
 }
 
 /// An EEPROM file in use: the file a path names (symbolic links followed)
@@ -333,16 +390,7 @@ impl EepromFile {
         let (dir, name) = dir_and_name(&target).map_err(|e| error(OpenProblem::Path(e)))?;
         let lock_path = dir.join(format!(".{name}.lock"));
         let cannot = |e: std::io::Error| error(OpenProblem::CannotLock { lock: lock_path.clone(), error: e });
-        let open = |write: bool| {
-            OpenOptions::new()
-                .read(true)
-                .write(write)
-                .create(write)
-                .mode(0o644)
-                // Not through a symbolic link, and not waiting on a pipe.
-                .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_CLOEXEC)
-                .open(&lock_path)
-        };
+        let open = |write: bool| open_lock(&lock_path, write);
         let (mut lock, writable) = match open(true) {
             Ok(f) => (f, true),
             // Another user's lock file can still be locked.
@@ -424,6 +472,9 @@ fn remove_stale_temporaries(dir: &Path, name: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    // Symbolic links on Windows need a privilege or developer mode: the
+    // tests of links are Unix's.
+    #[cfg(unix)]
     use std::os::unix::fs::symlink;
 
     fn tmcm_1141() -> std::sync::Arc<Profile> {
@@ -452,6 +503,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(unix)]
     fn a_symlink_at_the_old_temporary_name_is_not_followed() {
         let dir = tempfile::tempdir().unwrap();
         let victim = dir.path().join("victim");
@@ -472,6 +524,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(unix)]
     fn a_symlinked_file_writes_its_target_and_stays_a_link() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir(dir.path().join("store")).unwrap();
@@ -508,7 +561,10 @@ mod tests {
         let first = EepromFile::open(&path).unwrap();
         let e = EepromFile::open(&path).unwrap_err().to_string();
         assert!(e.starts_with(&format!("{}: ", path.display())), "{e}");
-        assert!(e.contains(&format!("in use by another tmclsim (pid {})", std::process::id())), "{e}");
+        let holder = format!("in use by another tmclsim (pid {})", std::process::id());
+        // Windows' locks are mandatory: the holder's pid in the locked file
+        // cannot be read there (Wine reads it), and the message names none.
+        assert!(e.contains(&holder) || (cfg!(windows) && e.contains("in use by another tmclsim; ")), "{e}");
         drop(first);
         let again = EepromFile::open(&path).unwrap();
         again.save(&image()).unwrap();
@@ -516,6 +572,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(unix)]
     fn a_symlink_at_the_lock_name_is_not_followed() {
         let dir = tempfile::tempdir().unwrap();
         let victim = dir.path().join("victim");
@@ -543,6 +600,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(unix)]
     fn a_save_keeps_the_files_permissions() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.eeprom");
@@ -562,6 +620,14 @@ mod tests {
         assert!(e.contains(&format!("{} bytes, more than an EEPROM file can be ({MAX_FILE_BYTES} bytes)", MAX_FILE_BYTES + 1)), "{e}");
         f.set_len(MAX_FILE_BYTES).unwrap();
         assert!(load(&big).unwrap_err().message().contains("not readable"));
+        drop(f);
+        assert!(load(dir.path()).unwrap_err().message().contains("not a regular file"));
+    }
+
+    #[test]
+    #[cfg(unix)]
+    fn devices_and_pipes_are_refused_unread() {
+        let dir = tempfile::tempdir().unwrap();
         let e = load(Path::new("/dev/zero")).unwrap_err().to_string();
         assert!(e.contains("/dev/zero: not a regular file"), "{e}");
         let fifo = dir.path().join("fifo");
@@ -570,6 +636,30 @@ mod tests {
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         // Refused at once, not waiting for a writer.
         assert!(load_for(&fifo, &tmcm_1141()).unwrap_err().message().contains("not a regular file"));
+    }
+
+    #[test]
+    fn a_read_only_file_is_never_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.eeprom");
+        assert_eq!(read_only(&path), None);
+        save_atomic(&path, &image()).unwrap();
+        assert_eq!(read_only(&path), None);
+        let mut permissions = std::fs::metadata(&path).unwrap().permissions();
+        permissions.set_readonly(true);
+        std::fs::set_permissions(&path, permissions.clone()).unwrap();
+        let why = read_only(&path).unwrap();
+        assert!(why.starts_with("the file is read-only"), "{why}");
+        let file = EepromFile::open(&path).unwrap();
+        let e = file.save(&Eeprom::new("TMCM-1141")).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::PermissionDenied);
+        assert!(e.to_string().contains("tmclsim leaves it as it is"), "{e}");
+        assert_eq!(load(&path).unwrap(), Some(image()));
+        // Writable again, so that the directory can be removed everywhere.
+        #[allow(clippy::permissions_set_readonly_false)]
+        permissions.set_readonly(false);
+        std::fs::set_permissions(&path, permissions).unwrap();
+        file.save(&Eeprom::new("TMCM-1141")).unwrap();
     }
 
     #[test]

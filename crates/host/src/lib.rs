@@ -7,6 +7,7 @@ pub mod client;
 pub mod eeprom_file;
 pub mod eeprom_files;
 pub mod faults;
+pub mod intel_hex;
 pub mod shared;
 pub mod trace;
 

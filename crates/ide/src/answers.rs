@@ -194,7 +194,7 @@ pub fn modules_json(target: &dyn Target) -> Value {
         .enumerate()
         .map(|(id, m)| {
             json!({"id": id, "address": m.address, "profile": m.profile.as_ref().map(|p| p.module.name.clone()),
-                   "firmware": m.firmware, "link": m.link, "virtual": virt})
+                   "firmware": m.firmware, "link": m.link, "virtual": virt, "bootloader": target.bootloader(id)})
         })
         .collect();
     Value::Array(list)

@@ -73,7 +73,18 @@ pub fn describe(ins: Instruction, raw: &[u8; FRAME_LEN], address: u8, profile: O
         let v = r.value as u32;
         return format!("module type {}, firmware V{}.{:02}", v >> 16, (v >> 8) & 0xFF, v & 0xFF);
     }
-    let reads = matches!(ins.opcode, opcode::GAP | opcode::GGP | opcode::GIO | opcode::GCO | opcode::RFS | opcode::APPLICATION_STATUS);
+    let reads = matches!(
+        ins.opcode,
+        opcode::GAP
+            | opcode::GGP
+            | opcode::GIO
+            | opcode::GCO
+            | opcode::RFS
+            | opcode::APPLICATION_STATUS
+            | opcode::BOOT_GET_INFO
+            | opcode::BOOT_GET_CHECKSUM
+            | opcode::BOOT_READ_MEMORY
+    );
     match (reads, parameter) {
         (true, Some((name, unit))) => format!("{name} = {}{}", r.value, unit.map_or(String::new(), |u| format!(" {u}"))),
         (false, Some((name, unit))) if matches!(ins.opcode, opcode::SAP | opcode::SGP) => {

@@ -112,6 +112,13 @@ pub trait Target: Send + Sync + 'static {
     fn run(&self, id: usize, start: bool) -> Result<(), TargetError>;
     /// Stops a run that the target drives itself (breakpoints by steps).
     fn halt(&self, _id: usize) {}
+    /// The bootloader's version text while module `id` runs its bootloader
+    /// instead of its firmware (a firmware update did not complete,
+    /// docs/behaviour.md rule 100): on a link, a module whose 136 answer
+    /// has the bootloader's `B` in it.
+    fn bootloader(&self, id: usize) -> Option<String> {
+        self.modules().get(id).filter(|m| m.firmware.to_ascii_uppercase().contains('B')).map(|m| m.firmware.clone())
+    }
     /// Every module that answers on the link (136 at addresses 1…255).
     fn scan(&self) -> Result<Vec<Found>, TargetError> {
         Err(TargetError::Unsupported("a scan looks for modules on a TMCL link; virtual modules are all in the module list".into()))

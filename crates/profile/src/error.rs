@@ -49,6 +49,8 @@ pub enum ProfileError {
     /// The features disagree with the parameter tables, or a value is
     /// impossible.
     Features(FeatureProblem),
+    /// The `[bootloader]` facts cannot be used (why, in words).
+    Bootloader(String),
     /// No built-in profile has this name.
     NotBuiltIn {
         /// The name asked for, as given.
@@ -161,6 +163,7 @@ impl fmt::Display for ProfileError {
             ProfileError::NoSuchBank { number, bank } => write!(f, "global parameter {number}: bank {bank} does not exist"),
             ProfileError::NoAxis => f.write_str("a module has at least one axis"),
             ProfileError::Features(p) => write!(f, "{p}"),
+            ProfileError::Bootloader(why) => f.write_str(why),
             ProfileError::NotBuiltIn { name, known } => write!(f, "no built-in profile '{name}' (known: {})", known.join(", ")),
             ProfileError::BuiltIn { name, error } => write!(f, "profile {name}: {error}"),
         }

@@ -9,9 +9,11 @@
 //! search, stall detection, encoder, CAN identifiers, EEPROM lock, …). The
 //! firmware and the assembler read them; neither knows module names.
 
+mod bootloader;
 mod error;
 mod features;
 
+pub use bootloader::Bootloader;
 pub use error::{FeatureProblem, ParameterProblem, ProfileError};
 pub use features::{CanIds, EepromMagic, Encoder, ErrorFlags, Features, MotionUnits, ReferenceSearchFamily, StallDetection};
 
@@ -374,6 +376,8 @@ struct ProfileFile {
     port: Vec<Port>,
     #[serde(default)]
     interrupt: Vec<Interrupt>,
+    #[serde(default)]
+    bootloader: Option<Bootloader>,
 }
 
 /// What raises an interrupt, read from the symbols of a profile's interrupt
@@ -434,6 +438,8 @@ pub struct Profile {
     pub ports: Vec<Port>,
     /// The interrupt table.
     pub interrupts: Vec<Interrupt>,
+    /// The TMCL bootloader, on modules whose firmware can be updated.
+    pub bootloader: Option<Bootloader>,
     /// The interrupts' sources, read from their symbols once.
     sources: Vec<(InterruptSource, u8)>,
     /// The interrupt numbers of timers 0, 1 and 2 (looked up on every
@@ -479,10 +485,14 @@ impl Profile {
             sources,
             timers,
             interrupts: file.interrupt,
+            bootloader: file.bootloader,
             opcode_set,
             ascii_set,
         };
         check_features(&profile).map_err(ProfileError::Features)?;
+        if let Some(why) = profile.bootloader.as_ref().and_then(Bootloader::problem) {
+            return Err(ProfileError::Bootloader(why));
+        }
         Ok(profile)
     }
 
@@ -586,20 +596,31 @@ impl Profile {
     /// The 136 type 0 text: the profile's `version_text`, or the
     /// `1141V146` form (type number, `V`, version digits).
     pub fn version_text(&self) -> [u8; 8] {
-        if let Some(text) = &self.module.version_text
-            && let Ok(bytes) = <[u8; 8]>::try_from(text.as_bytes())
-        {
-            return bytes;
-        }
-        let s = format!("{:04}V{}{:02}", self.module.type_number % 10000, self.module.firmware[0] % 10, self.module.firmware[1] % 100);
+        self.version_text_for(self.module.firmware)
+    }
+
+    /// The 136 type 0 text of firmware `version` on this module (one a
+    /// firmware update installed, docs/behaviour.md rule 101): the
+    /// profile's text with its last three characters, the version digits,
+    /// those of `version`.
+    pub fn version_text_for(&self, version: [u8; 2]) -> [u8; 8] {
         let mut out = [b'0'; 8];
-        out.copy_from_slice(&s.as_bytes()[..8]);
+        match &self.module.version_text {
+            Some(text) if text.len() == 8 => out.copy_from_slice(text.as_bytes()),
+            _ => out[..5].copy_from_slice(format!("{:04}V", self.module.type_number % 10000).as_bytes()),
+        }
+        out[5..].copy_from_slice(format!("{}{:02}", version[0] % 10, version[1] % 100).as_bytes());
         out
     }
 
     /// 136 type 1 value: `[type high][type low][major][minor]`.
     pub fn version_word(&self) -> i32 {
-        (u32::from(self.module.type_number) << 16 | u32::from(self.module.firmware[0]) << 8 | u32::from(self.module.firmware[1])) as i32
+        self.version_word_for(self.module.firmware)
+    }
+
+    /// 136 type 1 value of firmware `version` on this module.
+    pub fn version_word_for(&self, version: [u8; 2]) -> i32 {
+        (u32::from(self.module.type_number) << 16 | u32::from(version[0]) << 8 | u32::from(version[1])) as i32
     }
 
     /// Position counter mask for modules with 24-bit positions.

@@ -169,6 +169,9 @@ pub fn parse_line(line: &str) -> Result<Instruction, ParseError> {
             to_i32(n[3]).ok_or_else(|| err(fields[3].0, "value out of 32-bit range".into()))?,
         ));
     }
+    if let Some(opcode) = (0..=255u8).find(|&o| op::boot_name(o).is_some_and(|n| n.eq_ignore_ascii_case(head))) {
+        return boot_line(opcode, &toks[1..]).map_err(|(c, m)| err(c, m));
+    }
     let opcode = op::from_mnemonic(head).ok_or_else(|| {
         let hint = crate::suggest::suggestion(head, (0..=255u8).filter_map(op::mnemonic));
         err(c0, format!("unknown command '{head}'{hint}"))
@@ -220,6 +223,13 @@ pub fn shows_every_field(ins: Instruction) -> bool {
 /// Formats an instruction as source text. `label` names jump targets;
 /// pass `|a| a.to_string()` for plain addresses.
 pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
+    if let Some(name) = op::boot_name(ins.opcode) {
+        let (kind, motor, value) = op::BOOT_MAGIC;
+        if ins.opcode == op::BOOT && (ins.kind, ins.motor, ins.value as u32) == (kind, motor, value) {
+            return name.to_string();
+        }
+        return format!("{name} {}, {}, {}", ins.kind, ins.motor, ins.value as u32);
+    }
     let Some(name) = op::mnemonic(ins.opcode) else {
         return format!("#{} {} {} {}", ins.opcode, ins.kind, ins.motor, ins.value);
     };
@@ -241,6 +251,26 @@ pub fn format_with(ins: Instruction, label: impl Fn(i32) -> String) -> String {
     if parts.is_empty() { name.to_string() } else { format!("{name} {}", parts.join(", ")) }
 }
 
+/// A bootloader command by name (`BOOT_GET_INFO 1`, `BOOT_WRITE_BUFFER 3,
+/// 0, 0x12345678`): type, motor and value, each 0 when left out; `BOOT`
+/// alone carries the key that 242 needs.
+fn boot_line(opcode: u8, operands: &[(usize, &str)]) -> Result<Instruction, (usize, String)> {
+    if operands.len() > 3 {
+        return Err((operands[3].0, format!("{} takes type, motor and value at most", op::name(opcode))));
+    }
+    if opcode == op::BOOT && operands.is_empty() {
+        let (kind, motor, value) = op::BOOT_MAGIC;
+        return Ok(Instruction::new(opcode, kind, motor, value as i32));
+    }
+    let mut n = [0i64; 3];
+    for (k, &(c, t)) in operands.iter().enumerate() {
+        n[k] = parse_number(t).ok_or_else(|| (c, format!("'{t}' is not a number")))?;
+    }
+    let byte = |k: usize| u8::try_from(n[k]).map_err(|_| (operands[k].0, format!("{} does not fit in a byte", n[k])));
+    let value = to_i32(n[2]).ok_or_else(|| (operands[2].0, "value out of 32-bit range".to_string()))?;
+    Ok(Instruction::new(opcode, byte(0)?, byte(1)?, value))
+}
+
 /// An instruction as a source line (`MVP ABS, 0, 51200`), addresses as
 /// numbers.
 pub fn format(ins: Instruction) -> String {
@@ -250,6 +280,19 @@ pub fn format(ins: Instruction) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bootloader_commands_by_name() {
+        assert_eq!(parse_line("BOOT").unwrap(), Instruction::new(242, 0x81, 0x92, 0xA3B4_C5D6_u32 as i32));
+        assert_eq!(parse_line("boot_get_info 1").unwrap(), Instruction::new(206, 1, 0, 0));
+        assert_eq!(parse_line("BOOT_WRITE_BUFFER 3, 1, 0xDEADBEEF").unwrap(), Instruction::new(201, 3, 1, 0xDEAD_BEEF_u32 as i32));
+        assert_eq!(parse_line("BOOT_ERASE_ALL").unwrap(), Instruction::new(200, 0, 0, 0));
+        assert_eq!(parse_line("BOOT_GET_INFO 1 2 3 4").unwrap_err().column, 21);
+        assert_eq!(op::name(203), "BOOT_GET_CHECKSUM");
+        for line in ["BOOT", "BOOT_WRITE_BUFFER 3, 1, 3735928559", "BOOT_GET_INFO 2, 0, 0"] {
+            assert_eq!(format(parse_line(line).unwrap()), line);
+        }
+    }
 
     fn bytes(line: &str) -> [u8; 9] {
         crate::Request::new(1, parse_line(line).unwrap()).encode()

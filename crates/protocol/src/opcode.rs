@@ -134,6 +134,46 @@ pub const ASCII_MODE: u8 = 139;
 /// 255, software reset: the module restarts.
 pub const RESET: u8 = 255;
 
+/// 200, the bootloader's BOOT_ERASE_ALL: erases the firmware.
+pub const BOOT_ERASE_ALL: u8 = 200;
+/// 201, BOOT_WRITE_BUFFER: a 32-bit word into the page buffer (word index:
+/// type low byte, motor high byte).
+pub const BOOT_WRITE_BUFFER: u8 = 201;
+/// 202, BOOT_WRITE_PAGE: the page buffer into the flash page at the value.
+pub const BOOT_WRITE_PAGE: u8 = 202;
+/// 203, BOOT_GET_CHECKSUM: the byte sum of the flash from the firmware's
+/// start through the address in the value.
+pub const BOOT_GET_CHECKSUM: u8 = 203;
+/// 204, BOOT_READ_MEMORY: the flash word at the address in the value.
+pub const BOOT_READ_MEMORY: u8 = 204;
+/// 205, BOOT_START_APPL: starts the firmware (no reply).
+pub const BOOT_START_APPL: u8 = 205;
+/// 206, BOOT_GET_INFO: page size (type 0), firmware start (1), flash size (2).
+pub const BOOT_GET_INFO: u8 = 206;
+/// 208, BOOT_WRITE_LENGTH: the firmware's length (type 0) or checksum (1).
+pub const BOOT_WRITE_LENGTH: u8 = 208;
+/// 242, BOOT: the firmware restarts into its bootloader (no reply), when
+/// type, motor and value are [`BOOT_MAGIC`].
+pub const BOOT: u8 = 242;
+/// The type, motor and value 242 must carry.
+pub const BOOT_MAGIC: (u8, u8, u32) = (0x81, 0x92, 0xA3B4_C5D6);
+
+/// The bootloader's commands and 242 by their names (`BOOT_ERASE_ALL`).
+pub fn boot_name(opcode: u8) -> Option<&'static str> {
+    Some(match opcode {
+        BOOT_ERASE_ALL => "BOOT_ERASE_ALL",
+        BOOT_WRITE_BUFFER => "BOOT_WRITE_BUFFER",
+        BOOT_WRITE_PAGE => "BOOT_WRITE_PAGE",
+        BOOT_GET_CHECKSUM => "BOOT_GET_CHECKSUM",
+        BOOT_READ_MEMORY => "BOOT_READ_MEMORY",
+        BOOT_START_APPL => "BOOT_START_APPL",
+        BOOT_GET_INFO => "BOOT_GET_INFO",
+        BOOT_WRITE_LENGTH => "BOOT_WRITE_LENGTH",
+        BOOT => "BOOT",
+        _ => return None,
+    })
+}
+
 /// Mnemonic of an instruction number; control commands have none.
 pub fn mnemonic(opcode: u8) -> Option<&'static str> {
     Some(match opcode {
@@ -207,7 +247,7 @@ pub fn from_mnemonic(name: &str) -> Option<u8> {
 
 /// A readable name for any instruction number, control commands included.
 pub fn name(opcode: u8) -> &'static str {
-    if let Some(m) = mnemonic(opcode) {
+    if let Some(m) = mnemonic(opcode).or_else(|| boot_name(opcode)) {
         return m;
     }
     match opcode {

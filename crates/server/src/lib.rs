@@ -1,5 +1,5 @@
-//! Serving virtual modules on real links: TCP and a pty that host software
-//! opens like the module's serial port.
+//! Serving virtual modules on real links: TCP, a pty that host software
+//! opens like the module's serial port, and real serial devices.
 //!
 //! A server is request → response: bytes arrive on a link, the serial
 //! framing turns them into frames, the module answers, the reply goes back
@@ -15,11 +15,28 @@
 
 mod clock;
 pub mod control;
+// EtherCAT needs raw Ethernet (AF_PACKET), which is Linux's; elsewhere
+// serving it is refused (no_ethercat.rs).
+#[cfg(target_os = "linux")]
+pub mod ethercat;
+#[cfg(not(target_os = "linux"))]
+#[path = "no_ethercat.rs"]
 pub mod ethercat;
 pub mod files;
 pub mod frame_log;
 mod link;
+// A pty and the SLCAN adapter on one are Unix's; on Windows both are
+// refused (no_pty.rs).
+#[cfg(unix)]
 mod pty;
+#[cfg(not(unix))]
+#[path = "no_pty.rs"]
+mod pty;
+mod serial;
+#[cfg(unix)]
+mod slcan;
+#[cfg(not(unix))]
+#[path = "no_slcan.rs"]
 mod slcan;
 mod slots;
 pub mod sources;
@@ -47,6 +64,8 @@ pub struct ServerConfig {
     pub tcp: Option<SocketAddr>,
     /// Path of the symlink to the pty's serial device.
     pub pty: Option<PathBuf>,
+    /// Real serial devices the modules answer on (`--serial`).
+    pub serial: Vec<SerialLine>,
     /// EEPROM file, held (locked) by the caller; written atomically on
     /// every EEPROM change.
     pub eeprom: Option<Arc<EepromFile>>,
@@ -88,6 +107,17 @@ pub struct ServerConfig {
     pub bad_frame_limit: u32,
 }
 
+/// A serial device the modules answer on.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SerialLine {
+    /// The device: `/dev/ttyUSB0`, `/dev/pts/7`, `COM5`.
+    pub device: String,
+    /// A fixed baud rate; `None`: the rate of the first module's GP 65 at
+    /// power-up, as on the module (its manual: interface bit rates take
+    /// effect after a power cycle).
+    pub baud: Option<u32>,
+}
+
 /// Frames with a wrong checksum in a row after which a TCP connection is
 /// closed: far more than a host that lost a byte sends before it
 /// resynchronises, far fewer than a stream of another protocol makes.
@@ -98,6 +128,7 @@ impl Default for ServerConfig {
         ServerConfig {
             tcp: None,
             pty: None,
+            serial: Vec::new(),
             eeprom: None,
             inter_byte_timeout: Duration::from_millis(5),
             max_connections: 64,
@@ -127,6 +158,8 @@ pub struct Endpoints {
     pub control: Option<SocketAddr>,
     /// The SLCAN adapter's symlink and device.
     pub slcan: Option<(PathBuf, PathBuf)>,
+    /// The serial devices served, each with the baud rate it was opened at.
+    pub serial: Vec<(String, u32)>,
 }
 
 impl Endpoints {
@@ -137,6 +170,13 @@ impl Endpoints {
             return Some(format!("--interface socket_serial_tmcl --port {addr}"));
         }
         self.pty.as_ref().map(|(link, _)| format!("--interface serial_tmcl --port {}", link.display()))
+    }
+
+    /// How a host reaches modules served on serial devices: through the
+    /// other end of the (first) line.
+    pub fn serial_hint(&self) -> Option<String> {
+        let (device, baud) = self.serial.first()?;
+        Some(format!("pytrinamic ConnectionManager(\"--interface serial_tmcl --port <the other end of {device}> --data-rate {baud}\")"))
     }
 }
 
@@ -241,6 +281,7 @@ struct Opened {
     pty: Option<pty::Pty>,
     control: Option<tokio::net::TcpListener>,
     slcan: Option<pty::Pty>,
+    serial: Vec<(SerialLine, Box<dyn serialport::SerialPort>)>,
 }
 
 impl Opened {
@@ -251,11 +292,12 @@ impl Opened {
             pty: self.pty.as_ref().map(|p| (p.link.clone(), p.device.clone())),
             control: self.control.as_ref().and_then(|l| l.local_addr().ok()),
             slcan: self.slcan.as_ref().map(|p| (p.link.clone(), p.device.clone())),
+            serial: self.serial.iter().map(|(line, port)| (line.device.clone(), port.baud_rate().unwrap_or(0))).collect(),
         }
     }
 }
 
-async fn open(config: &ServerConfig) -> std::io::Result<Opened> {
+async fn open(config: &ServerConfig, bus: &SharedBus) -> std::io::Result<Opened> {
     let tcp = match config.tcp {
         Some(addr) => Some(listen(addr, "TCP").await?),
         None => None,
@@ -272,7 +314,8 @@ async fn open(config: &ServerConfig) -> std::io::Result<Opened> {
         Some(path) => Some(open_pty(path, "SLCAN pty")?),
         None => None,
     };
-    Ok(Opened { tcp, pty, control, slcan })
+    let serial = config.serial.iter().map(|line| Ok((line.clone(), serial::open(line, bus)?))).collect::<std::io::Result<_>>()?;
+    Ok(Opened { tcp, pty, control, slcan, serial })
 }
 
 /// Binds a listener; an error names the address and what to do.
@@ -436,8 +479,8 @@ async fn serve_opened(
     stop_rx: watch::Receiver<bool>,
 ) {
     let mut opened = Vec::with_capacity(specs.len());
-    for (_, config) in &specs {
-        match open(config).await {
+    for (bus, config) in &specs {
+        match open(config, bus).await {
             Ok(o) => opened.push(o),
             Err(e) => {
                 drop(opened);
@@ -457,7 +500,7 @@ async fn serve_opened(
 }
 
 /// The tasks of one link: its clock and whichever of TCP, pty, control
-/// port and slcan it serves.
+/// port, slcan and serial devices it serves.
 fn spawn_link(tasks: &mut JoinSet<()>, o: Opened, bus: &Arc<SharedBus>, config: &ServerConfig, stop_rx: &watch::Receiver<bool>) {
     tasks.spawn(clock::run(bus.clone(), stop_rx.clone()));
     if let Some(listener) = o.tcp {
@@ -471,6 +514,9 @@ fn spawn_link(tasks: &mut JoinSet<()>, o: Opened, bus: &Arc<SharedBus>, config: 
     }
     if let Some(p) = o.slcan {
         tasks.spawn(slcan::run(p, bus.clone(), stop_rx.clone()));
+    }
+    for (line, port) in o.serial {
+        tasks.spawn(serial::run(port, line, bus.clone(), config.clone(), stop_rx.clone()));
     }
 }
 

@@ -94,6 +94,27 @@ impl App {
     /// The module exists and takes requests now (no download under way);
     /// a download claimed later waits until the answer is dropped.
     pub fn idle(&self, id: usize) -> Result<InUse, ApiError> {
+        self.not_in_bootloader(id)?;
+        self.gate(id)
+    }
+
+    /// A module in its bootloader takes none of the app's tools (the
+    /// bootloader answers only its own commands, docs/behaviour.md rule 99).
+    fn not_in_bootloader(&self, id: usize) -> Result<(), ApiError> {
+        match self.target.bootloader(id) {
+            None => Ok(()),
+            Some(text) => Err(ApiError(
+                StatusCode::CONFLICT,
+                format!(
+                    "the module is in its bootloader ({text}): a firmware update did not complete, and until one does it answers only \
+                     the bootloader's commands (BOOT_*), at the bootloader's address"
+                ),
+            )),
+        }
+    }
+
+    /// The module's gate, taken for a request.
+    fn gate(&self, id: usize) -> Result<InUse, ApiError> {
         self.address(id)?;
         let mut users = self.gates[id].users();
         if users.downloading {
@@ -105,19 +126,21 @@ impl App {
 
     /// Every module takes requests now (a scan asks every address).
     pub fn all_idle(&self) -> Result<Vec<InUse>, ApiError> {
-        (0..self.gates.len()).map(|id| self.idle(id)).collect()
+        (0..self.gates.len()).map(|id| self.gate(id)).collect()
     }
 
     /// The module exists and may be observed now: always on a target that
     /// observes its model (no use to hold), otherwise while no download is
     /// under way.
     pub fn observable(&self, id: usize) -> Result<Option<InUse>, ApiError> {
-        if self.target.observes_the_model() { self.address(id).map(|_| None) } else { self.idle(id).map(Some) }
+        self.not_in_bootloader(id)?;
+        if self.target.observes_the_model() { self.address(id).map(|_| None) } else { self.gate(id).map(Some) }
     }
 
     /// Claims the module for a download; refused while another runs.
     /// Nothing may be sent before [`Downloading::wait_for_requests`].
     pub fn start_download(&self, id: usize) -> Result<Downloading, ApiError> {
+        self.not_in_bootloader(id)?;
         self.address(id)?;
         let mut users = self.gates[id].users();
         if users.downloading {

@@ -8,7 +8,6 @@ use axum::extract::{Request, State};
 use axum::http::{HeaderMap, StatusCode, header};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
-use std::io::Read;
 
 pub const COOKIE: &str = "tmclsim_token";
 
@@ -38,7 +37,7 @@ impl Failures {
 /// 128 random bits from the operating system, in hex.
 pub fn new_token() -> std::io::Result<String> {
     let mut b = [0u8; 16];
-    std::fs::File::open("/dev/urandom")?.read_exact(&mut b)?;
+    getrandom::fill(&mut b).map_err(std::io::Error::other)?;
     Ok(b.iter().map(|x| format!("{x:02x}")).collect())
 }
 

@@ -127,6 +127,11 @@ impl Target for VirtualTarget {
         self.place(id).map_or(0.0, |p| p.bus.now_ns() as f64 * 1e-9)
     }
 
+    fn bootloader(&self, id: usize) -> Option<String> {
+        let p = self.place(id).ok()?;
+        p.bus.with_module(p.index, |m| m.profile().bootloader.as_ref().filter(|_| m.in_bootloader()).map(|b| b.version_text.clone()))
+    }
+
     fn snapshot(&self, id: usize) -> Option<ModuleSnapshot> {
         let p = self.place(id).ok()?;
         Some(p.bus.with_module(p.index, |m| ModuleSnapshot::of(m)))

@@ -28,7 +28,8 @@ impl Completion {
         let words = mnemonic::tokens(&before[..start]);
         let mut out: Vec<String> = match words.first() {
             None => {
-                let mnemonics = (0..=255u8).filter_map(opcode::mnemonic).map(str::to_string);
+                // The bootloader's commands by name too (docs/behaviour.md rule 99).
+                let mnemonics = (0..=255u8).filter_map(|op| opcode::mnemonic(op).or_else(|| opcode::boot_name(op))).map(str::to_string);
                 let upper = word.chars().next().is_none_or(|c| c.is_ascii_uppercase());
                 let commands = CONSOLE_COMMANDS.iter().map(ToString::to_string);
                 mnemonics.map(|m| if upper { m } else { m.to_ascii_lowercase() }).chain(commands).collect()
@@ -93,5 +94,6 @@ mod tests {
         assert!(!c.candidates("GAP tmcl_t", 10).1.contains(&"tmcl_tick_timer".to_string()), "axis names only");
         assert_eq!(c.candidates("GAP 1, ", 7).1, Vec::<String>::new());
         assert_eq!(c.candidates("he", 2).1, vec!["help"]);
+        assert_eq!(c.candidates("BOOT_GET_", 9).1, vec!["BOOT_GET_CHECKSUM", "BOOT_GET_INFO"]);
     }
 }

@@ -116,7 +116,10 @@ impl Session {
         let mut editor =
             rustyline::Editor::<complete::Completion, rustyline::history::FileHistory>::with_config(config).map_err(|e| e.to_string())?;
         editor.set_helper(Some(complete::Completion { profile: self.profile.clone() }));
-        let history = std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".tmclsim_history"));
+        // The home directory: HOME, or on Windows (where it is rarely set)
+        // the user's profile.
+        let home = std::env::var_os("HOME").or_else(|| if cfg!(windows) { std::env::var_os("USERPROFILE") } else { None });
+        let history = home.map(|h| std::path::PathBuf::from(h).join(".tmclsim_history"));
         if let Some(h) = &history {
             let _ = editor.load_history(h);
         }
@@ -187,6 +190,10 @@ impl Session {
 
     /// `help MNEMONIC` or `help NAME|NUMBER`.
     fn help(&self, topic: &str) -> String {
+        if let Some(op) = (0..=255u8).find(|&o| opcode::boot_name(o).is_some_and(|n| n.eq_ignore_ascii_case(topic))) {
+            let operands = if op == opcode::BOOT { " (alone: with its key, 0x81, 0x92, 0xA3B4C5D6)" } else { " [TYPE[, MOTOR[, VALUE]]]" };
+            return format!("{} (instruction {op}, the bootloader's): {}{operands}", opcode::name(op), opcode::name(op));
+        }
         if let Some(op) = opcode::from_mnemonic(topic) {
             let operands: Vec<String> = mnemonic::layout(op)
                 .unwrap_or(&[])

@@ -241,21 +241,10 @@ fn accept(proxy: Arc<Proxy>, listener: TcpListener) {
 /// for one of them: a signal that comes early (before the banner is read,
 /// say) waits for the waiter instead of ending the process unrecorded.
 fn take_stop_signals() -> Result<impl FnOnce() + Send, String> {
-    use tokio::signal::unix::{SignalKind, signal};
-    let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().map_err(|e| format!("cannot wait for signals: {e}"))?;
-    let signals = rt.block_on(async {
-        Ok::<_, std::io::Error>((signal(SignalKind::interrupt())?, signal(SignalKind::terminate())?, signal(SignalKind::hangup())?))
-    });
-    let (mut int, mut term, mut hup) = signals.map_err(|e| format!("cannot wait for signals: {e}"))?;
-    Ok(move || {
-        rt.block_on(async {
-            tokio::select! {
-                _ = int.recv() => {}
-                _ = term.recv() => {}
-                _ = hup.recv() => {}
-            }
-        });
-    })
+    // A server's signals (on Windows: Ctrl-C, Ctrl-Break, the console
+    // closing).
+    let signals = crate::signal::Signals::install()?;
+    Ok(move || signals.wait())
 }
 
 pub fn run(args: RecordArgs) -> Result<ExitCode, String> {
@@ -265,7 +254,7 @@ pub fn run(args: RecordArgs) -> Result<ExitCode, String> {
     let listening = listener.local_addr().map_err(|e| e.to_string())?;
     let raw = RawLink::open(args.link.tcp.as_deref(), args.link.port.as_deref(), args.link.baud, Duration::from_millis(50))?;
     let file = std::fs::File::create(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    let endpoints = tmclsim_server::Endpoints { tcp: Some(listening), pty: None, control: None, slcan: None };
+    let endpoints = tmclsim_server::Endpoints { tcp: Some(listening), pty: None, control: None, slcan: None, serial: Vec::new() };
     for w in tmclsim_server::exposure_warnings(&[endpoints]) {
         eprintln!("tmclsim: warning: {w}");
     }

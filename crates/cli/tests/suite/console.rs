@@ -64,6 +64,7 @@ fn errors_are_explained_and_fail_the_script() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "a pty is a Unix device: Windows refuses --pty")]
 fn the_pty_and_another_module_type() {
     let dir = tempfile::tempdir().unwrap();
     let pty = dir.path().join("pty");
@@ -77,6 +78,7 @@ fn the_pty_and_another_module_type() {
 }
 
 #[test]
+#[cfg(unix)] // The console on a terminal: a pty (openpty).
 fn on_a_terminal_tab_completes_names_and_history_is_kept() {
     use std::io::Read;
     use std::os::fd::{FromRawFd, OwnedFd};
@@ -138,16 +140,20 @@ fn a_line_past_4096_bytes_is_skipped_unheld_and_fails_the_script() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let pid = child.id();
     let mut stdin = child.stdin.take().unwrap();
     // 256 MiB of one line, then a command.
     let chunk = vec![b'A'; 1 << 20];
     for _ in 0..256 {
         stdin.write_all(&chunk).unwrap();
     }
-    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
-    let peak: u64 = status.lines().find(|l| l.starts_with("VmHWM:")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap();
-    assert!(peak < 64 * 1024, "the line is not held: {peak} KiB at its peak");
+    // The peak of its resident memory, from /proc (Unix).
+    #[cfg(unix)]
+    {
+        let pid = child.id();
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+        let peak: u64 = status.lines().find(|l| l.starts_with("VmHWM:")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap();
+        assert!(peak < 64 * 1024, "the line is not held: {peak} KiB at its peak");
+    }
     stdin.write_all(b"\nGAP 4, 0\n").unwrap();
     drop(stdin);
     let o = child.wait_with_output().unwrap();
@@ -164,5 +170,33 @@ fn comment_lines_are_skipped_and_raw_commands_are_not() {
     let (code, out) = console(&["--tcp", &server.tcp()], script);
     assert_eq!(code, Some(0), "comments are no failures: {out}");
     assert!(out.contains("> #6 4 0 0\nMaximum positioning speed (4) = 700"), "a raw command still runs: {out}");
+    server.stop();
+}
+
+#[test]
+fn the_bootloaders_commands_by_name() {
+    let server = Server::start(&["--tcp", "127.0.0.1:0"]);
+    let tcp = server.tcp();
+    // 242 restarts the module into its bootloader without a reply; it then
+    // answers at address 1 (docs/behaviour.md rule 99).
+    let script = "help BOOT_GET_INFO\nBOOT_GET_INFO 0\nBOOT_GET_INFO 1\n#136 0 0 0\nBOOT_START_APPL\n";
+    let (_, before) = console(&["--tcp", &tcp], "BOOT_GET_INFO 0\n");
+    assert!(before.contains("invalid command"), "the firmware has no 206: {before}");
+    let mut host = server.connect();
+    std::io::Write::write_all(&mut host, &common::frame("#242 129 146 2746533334")).unwrap();
+    // On the same connection, after the 242: the bootloader is there.
+    std::io::Write::write_all(&mut host, &common::frame("#136 0 0 0")).unwrap();
+    let mut text = [0u8; 9];
+    std::io::Read::read_exact(&mut host, &mut text).unwrap();
+    assert_eq!(&text[1..], b"1141B106");
+    let (_, out) = console(&["--tcp", &tcp], script);
+    for line in [
+        "BOOT_GET_INFO (instruction 206, the bootloader's): BOOT_GET_INFO [TYPE[, MOTOR[, VALUE]]]",
+        "> BOOT_GET_INFO 0\nvalue 2048",
+        "> BOOT_GET_INFO 1\nvalue 134234112",
+        "version 1141B106",
+    ] {
+        assert!(out.contains(line), "{line}\n---\n{out}");
+    }
     server.stop();
 }

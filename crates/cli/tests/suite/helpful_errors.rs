@@ -43,10 +43,14 @@ fn host_names_serve_and_the_endpoints_file_tells_scripts_where() {
     let (code, text) = tmclsim(&["world", "--control", &control, "show"]);
     assert_eq!(code, Some(0), "{text}");
     server.stop();
+    // Removed at a clean stop, which Ctrl-C makes (a test on Windows can
+    // only kill the server).
+    #[cfg(unix)]
     assert!(!file.exists(), "the endpoints file goes with the server");
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "the SLCAN adapter lives on a pty: Windows refuses --slcan")]
 fn bus_and_can_hints_say_how_to_reach_each_module() {
     let slcan = std::env::temp_dir().join(format!("tmclsim-hint-slcan-{}", std::process::id()));
     let server = common::Server::start(&["--tcp", "127.0.0.1:0", "--bus", "tmcm-1141@1,tmcm-1141@2", "--slcan", slcan.to_str().unwrap()]);
@@ -72,6 +76,7 @@ fn log_frames_shows_the_traffic_decoded() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "raw Ethernet is Linux's: Windows refuses --ethercat first")]
 fn ethercat_needs_a_module_that_is_an_ethercat_slave() {
     let out = common::tmclsim(&["serve", "--module", "tmcm-1141", "--ethercat", "lo"]);
     assert!(!out.status.success());
@@ -84,15 +89,39 @@ fn ethercat_needs_a_module_that_is_an_ethercat_slave() {
 
 #[test]
 fn a_link_the_module_has_no_interface_for_is_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let can = dir.path().join("can");
-    let out = common::tmclsim(&["serve", "--module", "tmcm-1310", "--tcp", "127.0.0.1:0", "--slcan", can.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(2), "{}", common::text(&out));
-    assert!(common::text(&out).contains("TMCM-1310 has no CAN interface (its interfaces: USB, EtherCAT)"), "{}", common::text(&out));
-    assert!(!can.exists(), "no adapter was left behind");
+    // The SLCAN adapter lives on a pty: Unix only.
+    #[cfg(unix)]
+    {
+        let dir = tempfile::tempdir().unwrap();
+        let can = dir.path().join("can");
+        let out = common::tmclsim(&["serve", "--module", "tmcm-1310", "--tcp", "127.0.0.1:0", "--slcan", can.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{}", common::text(&out));
+        assert!(common::text(&out).contains("TMCM-1310 has no CAN interface (its interfaces: USB, EtherCAT)"), "{}", common::text(&out));
+        assert!(!can.exists(), "no adapter was left behind");
+    }
     let out = common::tmclsim(&["serve", "--bus", "tmcm-1141@1,tmcm-1310@2", "--tcp", "127.0.0.1:0"]);
     assert_eq!(out.status.code(), Some(2), "{}", common::text(&out));
     assert!(common::text(&out).contains("TMCM-1310 has no RS-485 interface"), "{}", common::text(&out));
+}
+
+/// What only Unix has (a pty, the SLCAN adapter on one, raw Ethernet) is
+/// refused on Windows before anything is opened, naming what to use there.
+#[test]
+#[cfg(windows)]
+fn links_only_unix_has_are_refused_on_windows_naming_the_alternative() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x");
+    let path = path.to_str().unwrap();
+    for (args, expected) in [
+        (&["--pty", path][..], "a pty is a Unix device; on Windows serve the module on a COM port with --serial COMn (a com0com"),
+        (&["--tcp", "127.0.0.1:0", "--slcan", path][..], "on Windows serve the modules on --tcp"),
+        (&["--module", "tmcm-1310", "--ethercat", "eth0"][..], "--ethercat eth0: raw Ethernet (an AF_PACKET socket) needs Linux"),
+    ] {
+        let (code, text) = tmclsim(&[&["serve"][..], args].concat());
+        assert_eq!(code, Some(2), "{args:?}: {text}");
+        assert!(text.contains(expected) && !text.contains("panicked"), "{args:?}: {text}");
+        assert!(!dir.path().join("x").exists(), "nothing was made");
+    }
 }
 
 #[test]

@@ -51,6 +51,7 @@ fn two_modules_at_one_address_are_refused() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "/dev/zero: Windows has no endless device file")]
 fn endless_input_files_are_refused_unread() {
     refused(&["serve", "--fleet", "/dev/zero"], "/dev/zero: larger than 1 MiB, the limit for a fleet file");
     refused(&["serve", "--tcp", "127.0.0.1:0", "--world", "/dev/zero"], "/dev/zero: larger than 1 MiB, the limit for a world file");
@@ -73,6 +74,7 @@ fn fleet_bench_refuses_a_rate_it_cannot_send() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "Windows has no SIGPIPE: a write to a closed pipe is an error there, which println! reports")]
 fn a_reader_that_stops_early_ends_the_output_quietly() {
     let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../asm/tests/programs/main_loop_8_2.tmc");
     for args in [&["profile", "tmcm-1141"][..], &["asm", "--list", program][..]] {

@@ -8,12 +8,14 @@ use crate::common;
 use common::{Server, serve_command};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
+#[cfg(unix)]
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// CPU time (user + system) a server used so far.
+#[cfg(unix)]
 fn cpu_time(server: &Server) -> Duration {
     let s = std::fs::read_to_string(format!("/proc/{}/stat", server.child.id())).unwrap();
     let after = &s[s.rfind(')').unwrap() + 2..];
@@ -142,6 +144,7 @@ fn two_tcp_clients_in_ascii_mode_keep_their_own_lines() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "a pty is a Unix device: Windows refuses --pty")]
 fn a_pty_path_served_by_a_live_server_is_refused() {
     let dir = scratch("pty");
     let link = dir.join("tmcm");
@@ -168,6 +171,7 @@ fn a_pty_path_served_by_a_live_server_is_refused() {
 }
 
 #[test]
+#[cfg(unix)] // A pty and a symbolic link to it.
 fn a_stale_link_is_replaced() {
     let dir = scratch("stale");
     let link = dir.join("tmcm");
@@ -181,6 +185,7 @@ fn a_stale_link_is_replaced() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "a pty is a Unix device: Windows refuses --pty")]
 fn a_failed_start_names_the_address_and_leaves_no_link() {
     let dir = scratch("failed");
     let link = dir.join("tmcm");
@@ -247,6 +252,7 @@ fn a_tcp_link_open_to_other_machines_is_warned_about() {
 }
 
 #[test]
+#[cfg(unix)] // A descriptor limit (setrlimit), CPU time from /proc and SIGTERM.
 fn out_of_file_descriptors_the_accept_loop_backs_off() {
     let mut c = serve_command(&["--tcp", "127.0.0.1:0", "--max-connections", "1000"]);
     // SAFETY: setrlimit is async-signal-safe; nothing else runs in the hook.

@@ -13,6 +13,7 @@ mod hostile_network;
 mod hostile_world;
 mod profile_table;
 mod program_tools;
+mod serial;
 mod shell;
 mod speed;
 mod trace;

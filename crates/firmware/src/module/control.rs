@@ -19,6 +19,9 @@ pub(crate) const MAGIC_KEY: i32 = 1234;
 impl Module {
     /// Executes one instruction in direct mode.
     pub fn execute(&mut self, ins: Instruction) -> Outcome {
+        if let Some(answer) = self.boot_command(ins) {
+            return answer;
+        }
         if !self.profile.has_opcode(ins.opcode) {
             return Outcome::error(Status::InvalidCommand, ins.value);
         }
@@ -68,7 +71,7 @@ impl Module {
             ApplicationStatus { kind } => self.application_status(kind),
 
             // ----- the module: 136–139, 255 -------------------------------
-            FirmwareVersion { binary: true } => self.profile.version_word(),
+            FirmwareVersion { binary: true } => self.profile.version_word_for(self.firmware_version()),
             FirmwareVersion { binary: false } => {
                 return Ok(Outcome { status: Status::Ok, value: 0, special: Special::Frame(self.special_version()) });
             }
@@ -103,7 +106,7 @@ impl Module {
 
     /// 136 type 0: the version text as a frame.
     pub(crate) fn special_version(&self) -> [u8; FRAME_LEN] {
-        version_string_reply(self.host_address(), &self.profile.version_text())
+        version_string_reply(self.host_address(), &self.profile.version_text_for(self.firmware_version()))
     }
 
     /// 129: runs the program, from `from` when given; the reply carries it.

@@ -95,6 +95,16 @@ impl Module {
             };
             Some(Reply::new(host, address, status, ins.opcode, value).encode())
         };
+        // The bootloader tells what it is and takes no reads (rule 99).
+        if let Some(facts) = self.profile.bootloader.as_ref().filter(|_| self.in_bootloader()) {
+            return match (ins.opcode, ins.kind) {
+                (opcode::FIRMWARE_VERSION, 0) => {
+                    let text = <[u8; 8]>::try_from(facts.version_text.as_bytes()).expect("checked when the profile loads");
+                    Some(tmclsim_protocol::frame::version_string_reply(host, &text))
+                }
+                _ => reply(Err(Status::InvalidCommand)),
+            };
+        }
         if !self.profile.has_opcode(ins.opcode) {
             return reply(Err(Status::InvalidCommand));
         }
@@ -103,7 +113,7 @@ impl Module {
             Ok(Command::Ggp { param, bank }) => reply(self.peek_global_parameter(param, bank)),
             Ok(Command::Gio { port, bank }) => reply(self.io.read_port(&self.profile, &self.world, port, bank)),
             Ok(Command::FirmwareVersion { binary: false }) => Some(self.special_version()),
-            Ok(Command::FirmwareVersion { binary: true }) => reply(Ok(self.profile.version_word())),
+            Ok(Command::FirmwareVersion { binary: true }) => reply(Ok(self.profile.version_word_for(self.firmware_version()))),
             Ok(Command::ReadMemory { address: a }) => match self.read_memory(a) {
                 Ok(word) => Some(tmclsim_protocol::frame::memory_reply(host, word)),
                 Err(s) => reply(Err(s)),
@@ -129,6 +139,9 @@ impl Module {
 
     /// Does a frame with this address byte reach this module?
     pub fn answers_to(&self, address: u8) -> bool {
+        if self.in_bootloader() {
+            return self.profile.bootloader.as_ref().is_some_and(|b| b.address == address);
+        }
         address == self.address() || (self.secondary_address() != 0 && address == self.secondary_address())
     }
 

@@ -9,6 +9,7 @@
 //! (the bus, snapshots, the world's commands) goes through the accessors.
 
 pub mod ascii;
+mod boot;
 pub mod can;
 mod commands;
 mod control;
@@ -57,6 +58,8 @@ pub struct Module {
     program: Program,
     /// Resets (255) and reinitialisations (137) since the module was created.
     resets: u32,
+    /// The bootloader, while it runs instead of the firmware.
+    boot: Option<crate::bootloader::Session>,
 }
 
 impl Module {
@@ -90,6 +93,7 @@ impl Module {
             interrupts: Interrupts::default(),
             link: Link::default(),
             resets: 0,
+            boot: None,
             program: Program::new(profile.module.program_memory as usize),
             now_ns: 0,
             profile,
@@ -360,6 +364,28 @@ impl Module {
         if self.globals[0][gp::AUTOSTART as usize] == 1 && self.program.length() > 0 {
             self.program.mode = RunMode::Run;
         }
+        // The bootloader starts first and stays when the flash holds no
+        // valid firmware (docs/behaviour.md rule 100).
+        self.boot = None;
+        if self.persistence.eeprom().firmware == crate::eeprom::Firmware::Invalid
+            && let Some(facts) = profile.bootloader.as_ref()
+        {
+            self.enter_bootloader(facts, true);
+        }
+    }
+
+    /// The CPU restarts into the bootloader (docs/behaviour.md rule 99):
+    /// the firmware's RAM is gone (motors stop, the program and ASCII mode
+    /// end); `erased`: the flash holds no firmware (then this is the
+    /// power-up itself).
+    pub(crate) fn enter_bootloader(&mut self, facts: &tmclsim_profile::Bootloader, erased: bool) {
+        if !erased {
+            self.resets += 1;
+            self.power_on();
+        }
+        self.boot = Some(crate::bootloader::Session::new(facts, erased));
+        self.program.mode = RunMode::Stop;
+        self.link.ascii = false;
     }
 
     /// Software reset (255 with 1234): a power cycle.

@@ -37,6 +37,13 @@ impl Persistence {
         self.eeprom = image;
     }
 
+    /// Records the firmware a firmware update left in flash (kept with the
+    /// EEPROM; the EEPROM lock does not guard the flash).
+    pub fn set_firmware(&mut self, firmware: crate::eeprom::Firmware) {
+        self.eeprom.firmware = firmware;
+        self.mark_written();
+    }
+
     /// Records that the EEPROM image was written.
     pub fn mark_written(&mut self) {
         self.generation += 1;

@@ -2,6 +2,7 @@
 //! the shared helpers built once.
 
 mod ascii;
+mod bootloader;
 mod can_bus;
 mod common;
 mod deadlines;

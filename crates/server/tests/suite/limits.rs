@@ -206,6 +206,7 @@ fn a_bind_error_names_the_address() {
 }
 
 #[test]
+#[cfg(unix)] // A pty, and symbolic links to it.
 fn a_pty_path_is_claimed_while_its_server_lives() {
     let dir = scratch("claim");
     let link = dir.join("tmcm");
@@ -234,6 +235,7 @@ fn a_pty_path_is_claimed_while_its_server_lives() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "a pty is a Unix device: the server refuses one on Windows")]
 fn a_failed_start_leaves_no_pty_link() {
     let dir = scratch("failed");
     let taken = TcpListener::bind("127.0.0.1:0").unwrap();

@@ -102,6 +102,7 @@ fn heartbeat_stops_the_motor_when_the_host_falls_silent() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "a pty is a Unix device: the server refuses one on Windows")]
 fn the_pty_works_like_a_serial_port_and_survives_reopening() {
     let dir = std::env::temp_dir().join(format!("tmclsim-pty-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -166,6 +167,7 @@ fn stepped_virtual_time() {
 }
 
 #[test]
+#[cfg_attr(windows, ignore = "a pty is a Unix device: the server refuses one on Windows")]
 fn ascii_session_on_the_pty_in_every_echo_mode() {
     let dir = std::env::temp_dir().join(format!("tmclsim-ascii-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

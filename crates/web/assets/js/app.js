@@ -78,7 +78,9 @@ async function pick(modules, info, id) {
   for (const p of Object.values(panels)) p.setModule(ctx);
   // The title names the module the panels now act on: a command typed as
   // soon as it shows goes to that module.
-  document.getElementById("module-title").textContent = `${mod.profile ?? "unknown type"} · address ${mod.address} · ${mod.firmware}`;
+  document.getElementById("module-title").textContent = mod.bootloader
+    ? `${mod.profile ?? "unknown type"} · in its bootloader (${mod.bootloader}): a firmware update did not complete; the tools are off until one does`
+    : `${mod.profile ?? "unknown type"} · address ${mod.address} · ${mod.firmware}`;
   live = openLive(id, onSample);
   resubscribe(ctx);
   window.tmclsimReady = true;

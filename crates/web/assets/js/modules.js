@@ -33,7 +33,9 @@ export function moduleList(modules, onPick) {
         const mod = modules[i];
         const li = el("li", { "data-testid": "module-item", "data-id": String(i), class: i === selected ? "selected" : "" },
           el("b", { text: `${mod.profile ?? "unknown type"} · address ${mod.address}` }),
-          el("small", { text: `${mod.firmware} · ${short(mod.link)}`, title: `${mod.firmware} · ${mod.link}` }));
+          el("small", mod.bootloader
+            ? { text: `in its bootloader (${mod.bootloader}) · ${short(mod.link)}`, title: `a firmware update did not complete · ${mod.link}`, class: "bootloader" }
+            : { text: `${mod.firmware} · ${short(mod.link)}`, title: `${mod.firmware} · ${mod.link}` }));
         li.addEventListener("click", () => {
           selected = i;
           draw();

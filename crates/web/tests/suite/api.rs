@@ -3,6 +3,7 @@
 //! app see each other's changes.
 
 use crate::common;
+use std::io::Write;
 
 use common::{Served, ask, eventually, get, post, post_text};
 use serde_json::{Value, json};
@@ -316,4 +317,22 @@ fn a_live_stream_does_not_slip_into_a_download() {
     ws.read().unwrap();
     let (code, _) = post(&s.url("/api/modules/0/read"), json!({"reads": [{"kind": "ap", "number": 1, "index": 0}]}));
     assert_eq!(code, 200);
+}
+
+#[test]
+fn a_module_in_its_bootloader_is_shown_as_such_and_its_tools_are_refused_with_the_reason() {
+    let s = Served::new();
+    // A host starts a firmware update: 242 with its key, no reply.
+    let mut host = s.host();
+    host.write_all(&tmclsim_protocol::Request::new(1, tmclsim_protocol::mnemonic::parse_line("BOOT").unwrap()).encode()).unwrap();
+    assert!(eventually(10.0, || get(&s.url("/api/modules")).1[0]["bootloader"] == "1141B106"), "the module list says bootloader");
+    let (code, body) = post(&s.url("/api/modules/0/command"), json!({"line": "GAP 1, 0"}));
+    assert_eq!(code, 409);
+    assert!(body["error"].as_str().unwrap().contains("in its bootloader (1141B106)"), "{body}");
+    let (code, _) = post(&s.url("/api/modules/0/read"), json!({"reads": [{"kind": "ap", "number": 1, "index": 0}]}));
+    assert_eq!(code, 409);
+    // BOOT_START_APPL with the firmware untouched: the tools are back.
+    host.write_all(&tmclsim_protocol::Request::new(1, tmclsim_protocol::Instruction::new(205, 0, 0, 0)).encode()).unwrap();
+    assert!(eventually(10.0, || get(&s.url("/api/modules")).1[0]["bootloader"].is_null()));
+    assert_eq!(post(&s.url("/api/modules/0/command"), json!({"line": "GAP 1, 0"})).0, 200);
 }
