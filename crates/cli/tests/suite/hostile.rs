@@ -103,8 +103,7 @@ fn thousands_of_connects_and_disconnects() {
         }
         drop(s);
     }
-    std::thread::sleep(Duration::from_millis(200));
-    server.check();
+    server.check_soon();
     let after = server.rss_kib();
     assert!(after < before + 8 * 1024, "{before} KiB → {after} KiB");
 }
@@ -112,22 +111,23 @@ fn thousands_of_connects_and_disconnects() {
 #[test]
 fn idle_connections_up_to_the_limit() {
     let server = start(&["--max-connections", "20"]);
-    let idle: Vec<TcpStream> = (0..20).map(|_| TcpStream::connect(server.tcp()).unwrap()).collect();
-    std::thread::sleep(Duration::from_millis(100));
+    // Each of the 20 is served once, so the server holds all of them (a
+    // connection still in the listen queue takes no slot yet); then idle.
+    let idle: Vec<TcpStream> = (0..20)
+        .map(|_| {
+            let mut s = server.connect();
+            assert_eq!(common::ask(&mut s, "GGP 66, 0").map(|r| r.status), Some(100));
+            s
+        })
+        .collect();
     // The 21st is refused: accepted and closed at once, with a log line.
     let mut extra = TcpStream::connect(server.tcp()).unwrap();
-    extra.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
+    extra.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
     let mut b = [0u8; 1];
     assert_eq!(extra.read(&mut b).unwrap_or(0), 0, "closed by the server");
-    std::thread::sleep(Duration::from_millis(100));
-    assert!(
-        server.log.lock().unwrap().iter().any(|l| l.contains("refusing connection") && l.contains("20 connections")),
-        "{:?}",
-        server.log.lock().unwrap()
-    );
+    assert!(server.logged(&["refusing connection", "20 connections"]).is_some(), "no refusal in the log: {:?}", server.log.lock().unwrap());
     drop(idle);
-    std::thread::sleep(Duration::from_millis(200));
-    server.check();
+    server.check_soon();
 }
 
 #[test]
@@ -152,9 +152,7 @@ fn half_open_and_half_closed_connections() {
             s
         })
         .collect();
-    std::thread::sleep(Duration::from_millis(100));
-    server.check();
+    server.check_soon();
     drop(stuck);
-    std::thread::sleep(Duration::from_millis(100));
-    server.check();
+    server.check_soon();
 }

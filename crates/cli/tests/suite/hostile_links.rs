@@ -116,9 +116,17 @@ fn control_connections_at_once_are_limited() {
     assert_eq!(read_line(&mut extra), "", "and closed");
     assert_eq!(server.log_has("refusing control connection"), 1);
     drop(held);
-    std::thread::sleep(Duration::from_millis(200));
-    let mut again = BufReader::new(connect(&server.control()));
-    assert_eq!(say(&mut again, "input 0 0"), "ok");
+    // Served again once the server saw the 16 close.
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let mut again = BufReader::new(connect(&server.control()));
+        let answer = say(&mut again, "input 0 0");
+        if answer == "ok" {
+            break;
+        }
+        assert!(Instant::now() < deadline, "no slot 10 s after the 16 closed: {answer}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 #[test]
@@ -236,19 +244,18 @@ fn a_public_control_socket_takes_a_flag_and_a_token() {
     let out =
         Command::new(env!("CARGO_BIN_EXE_tmclsim")).args(["world", "--control", &at, "auth", &token, "input", "2", "1"]).output().unwrap();
     assert!(out.status.success(), "{out:?}");
-    std::thread::sleep(Duration::from_millis(100));
-    assert_eq!(server.log_has("warning: the control socket on 0.0.0.0:"), 1, "{:?}", server.log.lock().unwrap());
+    let log = server.whole_log();
+    assert_eq!(log.iter().filter(|l| l.contains("warning: the control socket on 0.0.0.0:")).count(), 1, "{log:?}");
 }
 
 #[test]
 fn a_tcp_link_open_to_other_machines_is_warned_about() {
-    let server = Server::start(&["--tcp", "0.0.0.0:0"]);
-    std::thread::sleep(Duration::from_millis(100));
-    assert_eq!(server.log_has("warning: TMCL on 0.0.0.0:"), 1, "{:?}", server.log.lock().unwrap());
-    assert_eq!(server.log_has("drive the motors"), 1);
-    let quiet = Server::start(&["--tcp", "127.0.0.1:0"]);
-    std::thread::sleep(Duration::from_millis(100));
-    assert_eq!(quiet.log_has("warning"), 0);
+    // The whole log, once stopped: the warning once, and none on loopback.
+    let log = Server::start(&["--tcp", "0.0.0.0:0"]).whole_log();
+    assert_eq!(log.iter().filter(|l| l.contains("warning: TMCL on 0.0.0.0:")).count(), 1, "{log:?}");
+    assert_eq!(log.iter().filter(|l| l.contains("drive the motors")).count(), 1, "{log:?}");
+    let quiet = Server::start(&["--tcp", "127.0.0.1:0"]).whole_log();
+    assert!(!quiet.iter().any(|l| l.contains("warning")), "{quiet:?}");
 }
 
 #[test]
@@ -270,15 +277,16 @@ fn out_of_file_descriptors_the_accept_loop_backs_off() {
     // More clients than the server has descriptors: the rest wait in the
     // listen queue while every accept fails.
     let clients: Vec<TcpStream> = (0..60).map(|_| TcpStream::connect(server.tcp()).unwrap()).collect();
-    std::thread::sleep(Duration::from_millis(300));
+    assert!(server.logged(&["cannot accept a TCP connection on"]).is_some(), "{:?}", server.log.lock().unwrap());
+    // A second of the server's CPU time, out of descriptors (about time:
+    // the measurement's window).
     let (cpu, wall) = (cpu_time(&server), Instant::now());
     std::thread::sleep(Duration::from_secs(1));
     let used = cpu_time(&server) - cpu;
     assert!(used < wall.elapsed() / 5, "the server waits instead of spinning: {used:?} of CPU in {:?}", wall.elapsed());
     assert_eq!(server.log_has("cannot accept a TCP connection on"), 1, "logged once: {:?}", server.log.lock().unwrap());
     drop(clients);
-    std::thread::sleep(Duration::from_millis(500));
-    server.check();
+    server.check_soon();
     // Out of descriptors again, it still stops on SIGTERM, at once and
     // cleanly: its signal handlers were installed before it served.
     let clients: Vec<TcpStream> = (0..60).map(|_| TcpStream::connect(server.tcp()).unwrap()).collect();

@@ -60,9 +60,14 @@ fn values_out_of_range_are_refused_and_the_module_keeps_serving() {
     let mut link = TcpStream::connect(server.tcp()).unwrap();
     link.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     assert_eq!(ask(&mut link, "ROR 0, 500").status, 100);
-    std::thread::sleep(Duration::from_millis(300));
-    let speed = ask(&mut link, "GAP 3, 0");
-    let position = ask(&mut link, "GAP 1, 0");
+    // It reaches its speed and covers ground (polled: the wall clock runs
+    // the server's time).
+    let deadline = std::time::Instant::now() + Duration::from_secs(10);
+    let (mut speed, mut position) = (ask(&mut link, "GAP 3, 0"), ask(&mut link, "GAP 1, 0"));
+    while (speed.value != 500 || position.value <= 0) && std::time::Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+        (speed, position) = (ask(&mut link, "GAP 3, 0"), ask(&mut link, "GAP 1, 0"));
+    }
     assert_eq!((speed.status, speed.value), (100, 500));
     assert!(position.status == 100 && position.value > 0, "{position:?}");
     assert_eq!(ask(&mut link, "MST 0").status, 100);

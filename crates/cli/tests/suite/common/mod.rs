@@ -62,6 +62,9 @@ pub struct Server {
     pub child: Child,
     pub banner: Vec<String>,
     pub log: Arc<Mutex<Vec<String>>>,
+    /// The thread that reads standard error into `log`; it ends when the
+    /// process closes it.
+    reader: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Server {
@@ -91,20 +94,23 @@ impl Server {
     /// A started process, once it printed its line beginning with `last`.
     fn serving(mut child: Child, last: &str) -> Server {
         let log = Arc::new(Mutex::new(Vec::new()));
-        if let Some(err) = child.stderr.take() {
+        let reader = child.stderr.take().map(|err| {
             let l = log.clone();
             std::thread::spawn(move || {
                 for line in BufReader::new(err).lines().map_while(Result::ok) {
                     l.lock().unwrap().push(line);
                 }
-            });
-        }
+            })
+        });
         let Some(banner) = read_banner(&mut child, last) else {
             let _ = child.wait();
-            std::thread::sleep(Duration::from_millis(100));
+            // The process is gone: its standard error is read to the end.
+            if let Some(r) = reader {
+                let _ = r.join();
+            }
             panic!("the server ended before serving: {:?}", log.lock().unwrap());
         };
-        Server { child, banner, log }
+        Server { child, banner, log, reader }
     }
 
     /// The value printed after `KEY: ` (first word).
@@ -137,6 +143,34 @@ impl Server {
         }
     }
 
+    /// The module answers correctly ([`Server::check`]) as soon as the
+    /// server took in what happened before (closed connections freeing
+    /// their slots): tried every 20 ms for up to 10 s, failing with what
+    /// the last try saw.
+    pub fn check_soon(&self) {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        loop {
+            let seen = (|| -> Result<(), String> {
+                let mut s = TcpStream::connect(self.tcp()).map_err(|e| format!("connect: {e}"))?;
+                s.set_read_timeout(Some(Duration::from_secs(2))).map_err(|e| e.to_string())?;
+                for (line, expect) in [("SAP 4, 0, 1234", 1234), ("GAP 4, 0", 1234), ("GGP 66, 0", 1)] {
+                    let r = ask(&mut s, line).ok_or_else(|| format!("{line}: no reply"))?;
+                    if (r.status, r.value) != (100, expect) {
+                        return Err(format!("{line}: status {} value {}", r.status, r.value));
+                    }
+                }
+                Ok(())
+            })();
+            match seen {
+                Ok(()) => return,
+                Err(e) if Instant::now() > deadline => {
+                    panic!("the module did not answer within 10 s: {e}; log {:?}", self.log.lock().unwrap())
+                }
+                Err(_) => std::thread::sleep(Duration::from_millis(20)),
+            }
+        }
+    }
+
     /// Resident memory in KiB.
     #[cfg(unix)]
     pub fn rss_kib(&self) -> u64 {
@@ -160,10 +194,10 @@ impl Server {
         counters.WorkingSetSize as u64 / 1024
     }
 
-    /// The first log line holding every piece, waiting up to 5 s for it
+    /// The first log line holding every piece, waiting up to 10 s for it
     /// (the log arrives through a pipe, after a client's answer).
     pub fn logged(&self, pieces: &[&str]) -> Option<String> {
-        let deadline = Instant::now() + Duration::from_secs(5);
+        let deadline = Instant::now() + Duration::from_secs(10);
         loop {
             if let Some(l) = self.log.lock().unwrap().iter().find(|l| pieces.iter().all(|p| l.contains(p))) {
                 return Some(l.clone());
@@ -175,10 +209,10 @@ impl Server {
         }
     }
 
-    /// How many log lines contain `what`, waiting up to 2 s for the first.
+    /// How many log lines contain `what`, waiting up to 10 s for the first.
     pub fn log_has(&self, what: &str) -> usize {
         let count = || self.log.lock().unwrap().iter().filter(|l| l.contains(what)).count();
-        let until = Instant::now() + Duration::from_secs(2);
+        let until = Instant::now() + Duration::from_secs(10);
         while count() == 0 && Instant::now() < until {
             std::thread::sleep(Duration::from_millis(10));
         }
@@ -202,6 +236,17 @@ impl Server {
     pub fn stop(mut self) {
         interrupt(&mut self.child);
         let _ = self.child.wait();
+    }
+
+    /// Everything the server wrote on standard error, once it stopped (as
+    /// Ctrl-C stops it): for what must not be in the log.
+    pub fn whole_log(mut self) -> Vec<String> {
+        interrupt(&mut self.child);
+        let _ = self.child.wait();
+        if let Some(r) = self.reader.take() {
+            let _ = r.join();
+        }
+        self.log.lock().unwrap().clone()
     }
 }
 
