@@ -44,6 +44,7 @@ fn a_lost_byte_is_dropped_after_the_inter_byte_timeout() {
     let server = serve_tcp();
     let mut s = connect(&server);
     s.write_all(&frame("GAP 4, 0")[..5]).unwrap();
+    // About time: a gap longer than the 5 ms inter-byte timeout.
     std::thread::sleep(Duration::from_millis(30));
     let r = ask(&mut s, "GGP 66, 0");
     assert_eq!((r.status, r.opcode, r.value), (100, 10, 1));
@@ -69,10 +70,19 @@ fn target_reached_event_arrives_on_the_link() {
     let t = started.elapsed();
     assert!(t < Duration::from_secs(2), "{t:?}");
     assert_eq!(ask(&mut s, "GAP 1, 0").value, 3000, "the event came when the motor arrived");
-    // Type 0 armed one move only.
+    // Type 0 armed one move only: the motor arrives, and every frame read
+    // meanwhile is a GAP's reply, none an event.
     ask(&mut s, "MVP ABS, 0, 0");
-    std::thread::sleep(Duration::from_millis(300));
-    assert_eq!(ask(&mut s, "GAP 8, 0").value, 1);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let r = ask(&mut s, "GAP 8, 0");
+        assert_eq!((r.status, r.opcode), (100, 6), "a reply, not an event: {r:?}");
+        if r.value == 1 {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the motor did not arrive within 10 s");
+        std::thread::sleep(Duration::from_millis(20));
+    }
     assert_eq!(ask(&mut s, "GAP 1, 0").value, 0);
     server.stop();
 }
@@ -95,6 +105,8 @@ fn heartbeat_stops_the_motor_when_the_host_falls_silent() {
     let mut s = connect(&server);
     ask(&mut s, "SGP 68, 0, 100");
     ask(&mut s, "ROR 0, 200");
+    // About time: the host stays silent longer than the 100 ms heartbeat
+    // (a poll would be a frame, which restarts it).
     std::thread::sleep(Duration::from_millis(400));
     assert_eq!(ask(&mut s, "GAP 2, 0").value, 0, "target speed zeroed by the heartbeat");
     ask(&mut s, "SGP 68, 0, 0");
@@ -146,6 +158,7 @@ fn stepped_virtual_time() {
     server.bus().set_stepped(true);
     let mut s = connect(&server);
     ask(&mut s, "ROR 0, 1000");
+    // About time: wall time passes, virtual time does not.
     std::thread::sleep(Duration::from_millis(100));
     assert_eq!(ask(&mut s, "GAP 1, 0").value, 0, "time stands still");
     server.bus().advance(3_600_000_000_000);
@@ -161,8 +174,11 @@ fn stepped_virtual_time() {
     assert_eq!((event.status, event.opcode), (128, 138));
     server.bus().set_stepped(false);
     ask(&mut s, "ROR 0, 1000");
-    std::thread::sleep(Duration::from_millis(50));
-    assert_ne!(ask(&mut s, "GAP 1, 0").value, 0, "back on the wall clock");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while ask(&mut s, "GAP 1, 0").value == 0 {
+        assert!(Instant::now() < deadline, "back on the wall clock, the motor moves");
+        std::thread::sleep(Duration::from_millis(20));
+    }
     server.stop();
 }
 
