@@ -436,6 +436,9 @@ mod tests {
         bus.set_wire_timing(true);
         // 9600 baud (GP 65 = 0): 180 bits.
         assert_eq!(bus.handle_frame(&frame(1, 6, 1, 0)).delay_ns, 18_750_000);
+        // 230400 baud (GP 65 = 8): the same 180 bits in 0.78 ms.
+        bus.handle_frame(&frame(1, 9, 65, 8));
+        assert_eq!(bus.handle_frame(&frame(1, 6, 1, 0)).delay_ns, 781_250);
     }
 
     #[test]
