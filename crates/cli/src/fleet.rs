@@ -215,6 +215,9 @@ pub fn serve(path: &std::path::Path, args: &crate::ServeArgs) -> Result<ExitCode
     let signals = crate::signal::Signals::install()?;
     let server = tmclsim_server::start_fleet(specs).map_err(|e| format!("cannot serve the fleet: {e}"))?;
     println!("tmclsim: fleet of {total} modules on {} links is serving", server.links().len());
+    for line in tmclsim_server::bootloader_lines(server.links()) {
+        println!("  {line}");
+    }
     let web = crate::ide::start_web(args, server.links())?;
     if let Some(first) = server.links().first() {
         if let Some(a) = first.endpoints.pytrinamic_args() {

@@ -208,7 +208,7 @@ fn serve(
     let ep = server.endpoints().clone();
     println!("tmclsim: virtual {} is serving", names.join(", "));
     println!("  EEPROM: {eeprom_note}");
-    for line in bootloader_lines(server.links()) {
+    for line in tmclsim_server::bootloader_lines(server.links()) {
         println!("  {line}");
     }
     if let Some(addr) = ep.tcp {
@@ -266,24 +266,6 @@ fn serve(
     println!("tmclsim: stopping");
     server.stop();
     Ok(ExitCode::SUCCESS)
-}
-
-/// A line for each module that starts in its bootloader (a firmware
-/// update left no valid firmware, docs/behaviour.md rule 100).
-pub(crate) fn bootloader_lines(links: &[tmclsim_server::LinkHandle]) -> Vec<String> {
-    let mut out = Vec::new();
-    for link in links {
-        link.bus.with_bus(|b| {
-            for m in b.modules().iter().filter(|m| m.in_bootloader()) {
-                let text = m.profile().bootloader.as_ref().map_or(String::new(), |f| format!("{}, at address {}", f.version_text, f.address));
-                out.push(format!(
-                    "firmware: the {} is in its bootloader ({text}): a firmware update did not complete; it answers only the bootloader's commands until one does",
-                    m.profile().module.name
-                ));
-            }
-        });
-    }
-    out
 }
 
 fn send_target(ep: &tmclsim_server::Endpoints) -> String {

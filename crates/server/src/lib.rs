@@ -247,6 +247,24 @@ impl Drop for ServerHandle {
     }
 }
 
+/// A line for each module that starts in its bootloader (a firmware
+/// update left no valid firmware, docs/behaviour.md rule 100).
+pub fn bootloader_lines(links: &[LinkHandle]) -> Vec<String> {
+    let mut out = Vec::new();
+    for link in links {
+        link.bus.with_bus(|b| {
+            for m in b.modules().iter().filter(|m| m.in_bootloader()) {
+                let text = m.profile().bootloader.as_ref().map_or(String::new(), |f| format!("{}, at address {}", f.version_text, f.address));
+                out.push(format!(
+                    "firmware: the {} is in its bootloader ({text}): a firmware update did not complete; it answers only the bootloader's commands until one does",
+                    m.profile().module.name
+                ));
+            }
+        });
+    }
+    out
+}
+
 /// What one link serves and how.
 pub struct LinkSpec {
     /// The modules on the link, each with the file its EEPROM is saved in.
