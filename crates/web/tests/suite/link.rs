@@ -143,7 +143,10 @@ fn a_module_on_a_serial_port_is_reached_as_a_real_one() {
 /// program stops there every time it comes round, also after Continue, and
 /// no state read while it runs on names a breakpoint.
 fn stops_every_time(url: &dyn Fn(&str) -> String) {
-    let source = "Loop: CALC ADD, 1\n  WAIT TICKS, 0, 2\n  CALC ADD, 10\n  JA Loop\n";
+    // Half a second between two hits: more than the app needs, even on a
+    // busy machine, to read the program's state (about twenty requests)
+    // between them.
+    let source = "Loop: CALC ADD, 1\n  WAIT TICKS, 0, 50\n  CALC ADD, 10\n  JA Loop\n";
     let last = post_text(&url("/api/modules/0/program/download"), json!({"source": source}));
     assert!(last.contains("\"verified\":true"), "{last}");
     post(&url("/api/modules/0/program/breakpoints"), json!({"addresses": [2]}));
@@ -173,7 +176,7 @@ fn stops_every_time(url: &dyn Fn(&str) -> String) {
     let (status, back) = get(&url("/api/modules/0/program/source"));
     assert_eq!((status, back["words"].as_u64()), (200, Some(5)), "{back}");
     let text = back["source"].as_str().unwrap();
-    assert!(text.contains("CALC ADD, 1") && text.contains("WAIT TICKS, 0, 2") && text.contains("JA "), "{text}");
+    assert!(text.contains("CALC ADD, 1") && text.contains("WAIT TICKS, 0, 50") && text.contains("JA "), "{text}");
     assert!(text.contains("    STOP"), "{text}");
     // Run starts over at address 0: the last hit is not reported there.
     let (_, st) = post(&url("/api/modules/0/program/run"), json!({}));
