@@ -17,12 +17,13 @@ impl Module {
     /// The bootloader's answer to a command, when the module has one and
     /// it runs (or the command is 242); `None`: the firmware executes it.
     pub(crate) fn boot_command(&mut self, ins: Instruction) -> Option<Outcome> {
+        // Every direct-mode command passes here: the firmware's go on at once.
+        if self.boot.is_none() && ins.opcode != opcode::BOOT {
+            return None;
+        }
         let profile = self.profile.clone();
         let facts = profile.bootloader.as_ref()?;
         if self.boot.is_none() {
-            if ins.opcode != opcode::BOOT {
-                return None;
-            }
             // A 242 without the key is answered and does nothing, as the
             // firmware does (rule 99).
             if (ins.kind, ins.motor, ins.value as u32) != opcode::BOOT_MAGIC {
