@@ -84,8 +84,13 @@ pub fn format_line(t_ns: u64, dir: Dir, frame: &[u8; FRAME_LEN]) -> String {
 /// What is wrong with a line of a trace.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LineError {
-    /// The line is no JSON (the parser's message).
-    NotJson(String),
+    /// The line is no JSON.
+    NotJson {
+        /// The parser's message, without its position.
+        message: String,
+        /// Where the parser stopped: 1-based, in characters of the text.
+        column: usize,
+    },
     /// The line is JSON but no object.
     NotObject,
     /// No `t`.
@@ -111,7 +116,7 @@ pub enum LineError {
 impl std::fmt::Display for LineError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            LineError::NotJson(e) => write!(f, "not a JSON object: {e}"),
+            LineError::NotJson { message, .. } => write!(f, "not a JSON object: {message}"),
             LineError::NotObject => {
                 write!(f, "not a JSON object: write {{\"t\": 0.0123, \"dir\": \"host\", \"frame\": \"01 06 01 00 00 00 00 00 08\"}}")
             }
@@ -170,7 +175,16 @@ fn cut(text: &str) -> String {
 /// One line of a trace: its time in nanoseconds, who sent the frame, the
 /// frame. Keys other than `t`, `dir` and `frame` are ignored.
 pub fn parse_line(text: &str) -> Result<(u64, Dir, [u8; FRAME_LEN]), LineError> {
-    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| LineError::NotJson(e.to_string()))?;
+    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+        // serde_json ends its message with " at line L column C"; a trace
+        // line is one line, so the column alone says where. Its column
+        // counts bytes: it becomes characters here.
+        let message = e.to_string();
+        let message = message.strip_suffix(&format!(" at line {} column {}", e.line(), e.column())).unwrap_or(&message).to_string();
+        let before = e.column().saturating_sub(1).min(text.len());
+        let column = text.get(..before).map_or(e.column(), |b| b.chars().count() + 1);
+        LineError::NotJson { message, column }
+    })?;
     let Some(object) = value.as_object() else {
         return Err(LineError::NotObject);
     };
@@ -221,6 +235,8 @@ fn read_within(input: impl Read, name: &str, max_bytes: u64) -> Result<Vec<Entry
             return Err(format!("{name}:{number}: line longer than {MAX_LINE_BYTES} bytes"));
         }
         let text = std::str::from_utf8(&buf).map_err(|_| format!("{name}:{number}: not UTF-8 text"))?;
+        let indent = text.len() - text.trim_start().len();
+        let indent_chars = text[..indent].chars().count();
         let text = text.trim();
         if text.is_empty() {
             continue;
@@ -228,7 +244,10 @@ fn read_within(input: impl Read, name: &str, max_bytes: u64) -> Result<Vec<Entry
         if entries.len() == MAX_ENTRIES {
             return Err(format!("{name}:{number}: more than {MAX_ENTRIES} frames, the limit of a trace"));
         }
-        let (t_ns, dir, frame) = parse_line(text).map_err(|e| format!("{name}:{number}: {e}"))?;
+        let (t_ns, dir, frame) = parse_line(text).map_err(|e| match e {
+            LineError::NotJson { column, .. } => format!("{name}:{number}:{}: {e}", indent_chars + column),
+            e => format!("{name}:{number}: {e}"),
+        })?;
         if t_ns < last_t {
             return Err(format!("{name}:{number}: \"t\" goes back in time ({} after {})", seconds(t_ns), seconds(last_t)));
         }
@@ -445,6 +464,10 @@ mod tests {
         let long = format!("{}\n", "x".repeat(MAX_LINE_BYTES + 1));
         assert_eq!(read(long.as_bytes(), "t.jsonl").unwrap_err(), "t.jsonl:1: line longer than 4096 bytes");
         assert!(read(&b"\xff\n"[..], "t.jsonl").unwrap_err().starts_with("t.jsonl:1: not UTF-8"));
+        // A JSON error: the file's line, and the column in it (counted in
+        // characters, the indent included), not the parser's "line 1".
+        let bad = "{\"t\": 0.1, \"dir\": \"host\", \"frame\": \"01 06 01 00 00 00 00 00 08\"}\n\t{\"t\": 0.2, \"dir\": \"µ\" \"x\"}\n";
+        assert_eq!(read(bad.as_bytes(), "t.jsonl").unwrap_err(), "t.jsonl:2:24: not a JSON object: expected `,` or `}`");
         let endless = std::io::repeat(b'\n');
         assert_eq!(read_within(endless, "t.jsonl", 1 << 20).unwrap_err(), "t.jsonl: larger than 1 MiB, the limit for a trace");
         assert_eq!(size_text(MAX_TRACE_BYTES), "256 MiB");

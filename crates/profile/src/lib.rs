@@ -242,6 +242,25 @@ pub struct Port {
     pub note: Option<String>,
 }
 
+impl Port {
+    /// What the port is, in the same words on every module (`analog
+    /// input 0`, `digital output 1`, `supply voltage`), where `name` is
+    /// the module's manual's pin name (`IN0` on one module, `AIN0` or
+    /// `AIN_0` on others for the same meaning).
+    pub fn meaning(&self) -> String {
+        let n = self.number;
+        match (self.direction, self.role) {
+            (PortDirection::Input, Some(PortRole::Supply)) => "supply voltage".into(),
+            (PortDirection::Input, Some(PortRole::Temperature)) => "temperature".into(),
+            (PortDirection::Input, None) if self.bank == 1 => format!("analog input {n}"),
+            (PortDirection::Input, None) => format!("digital input {n}"),
+            (PortDirection::Output, _) => format!("digital output {n}"),
+            (PortDirection::Pullup, _) => "pull-ups".into(),
+            (PortDirection::InputRange, _) => "analog input range".into(),
+        }
+    }
+}
+
 /// An interrupt of the module's TMCL interrupt table (EI, DI, VECT).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -827,6 +846,25 @@ mod tests {
         }
         let e = Profile::built_in("tmcm-9999").unwrap_err().to_string();
         assert!(e.contains("known: ") && e.contains(&Profile::names().join(", ")), "{e}");
+    }
+
+    #[test]
+    fn a_port_means_the_same_on_every_module_whatever_its_pin_name() {
+        let meaning = |module: &str, direction: PortDirection, bank: u8, number: u8| {
+            let p = Profile::built_in(module).unwrap();
+            let port = p.ports.iter().find(|q| (q.direction, q.bank, q.number) == (direction, bank, number)).unwrap();
+            (port.name.clone(), port.meaning())
+        };
+        // The manuals name the analog input IN0, AIN0 and AIN_0.
+        assert_eq!(meaning("tmcm-1141", PortDirection::Input, 1, 0), ("IN0".into(), "analog input 0".into()));
+        assert_eq!(meaning("tmcm-1140", PortDirection::Input, 1, 0), ("AIN0".into(), "analog input 0".into()));
+        assert_eq!(meaning("tmcm-351", PortDirection::Input, 1, 0), ("AIN_0".into(), "analog input 0".into()));
+        assert_eq!(meaning("tmcm-351", PortDirection::Input, 0, 6).1, "digital input 6");
+        assert_eq!(meaning("tmcm-351", PortDirection::Input, 1, 4).1, "supply voltage");
+        assert_eq!(meaning("tmcm-351", PortDirection::Input, 1, 5).1, "temperature");
+        assert_eq!(meaning("tmcm-1141", PortDirection::Input, 1, 8).1, "supply voltage");
+        assert_eq!(meaning("tmcm-1141", PortDirection::Output, 2, 1).1, "digital output 1");
+        assert_eq!(meaning("tmcm-1141", PortDirection::Pullup, 0, 0).1, "pull-ups");
     }
 
     #[test]

@@ -30,7 +30,8 @@ use tmclsim_protocol::{FRAME_LEN, Instruction, Reply, Request, Status, mnemonic,
 pub struct CheckArgs {
     /// The trace: JSON Lines, one frame per line (docs/host-software.md).
     pub file: PathBuf,
-    /// The profile of the module the trace was recorded with.
+    /// The profile of the module the trace was recorded with, or `auto`:
+    /// the profile whose module the trace's own 136 reply names.
     #[arg(long, default_value = "tmcm-1141")]
     pub module: String,
     /// The virtual module's address (GP 66), for a trace whose module
@@ -118,6 +119,9 @@ struct Group {
     label: String,
     reason: Option<&'static str>,
     findings: Vec<Finding>,
+    /// Not comparable readings whose value was the same on both modules:
+    /// counted, not listed.
+    identical: usize,
 }
 
 #[derive(Default)]
@@ -129,17 +133,38 @@ struct Report {
 }
 
 impl Report {
-    fn add(&mut self, comparable: bool, label: String, reason: Option<&'static str>, finding: Finding) {
+    fn group(&mut self, comparable: bool, label: String, reason: Option<&'static str>) -> &mut Group {
         let groups = if comparable { &mut self.differences } else { &mut self.not_comparable };
         let i = *self.index.entry((comparable, label.clone())).or_insert_with(|| {
-            groups.push(Group { label, reason, findings: Vec::new() });
+            groups.push(Group { label, reason, findings: Vec::new(), identical: 0 });
             groups.len() - 1
         });
-        groups[i].findings.push(finding);
+        &mut groups[i]
     }
 
+    fn add(&mut self, comparable: bool, label: String, reason: Option<&'static str>, finding: Finding) {
+        self.group(comparable, label, reason).findings.push(finding);
+    }
+
+    /// A not comparable reading; listed only when the two modules'
+    /// replies differ.
+    fn not_comparable(&mut self, label: String, reason: &'static str, finding: Finding) {
+        let group = self.group(false, label, Some(reason));
+        if finding.expected.is_some() && finding.expected == finding.actual {
+            group.identical += 1;
+        } else {
+            group.findings.push(finding);
+        }
+    }
+
+    /// Findings listed (differing readings).
     fn count(groups: &[Group]) -> usize {
         groups.iter().map(|g| g.findings.len()).sum()
+    }
+
+    /// Not comparable readings whose values were the same.
+    fn identical(&self) -> usize {
+        self.not_comparable.iter().map(|g| g.identical).sum()
     }
 }
 
@@ -186,15 +211,44 @@ fn label(profile: &Profile, ins: Instruction) -> String {
         Some(Table::Axis) => format!("{op} {}{}, motor {}", ins.kind, named(profile.axis_parameter(ins.kind)), ins.motor),
         Some(Table::Global) => format!("{op} {}{}, bank {}", ins.kind, named(profile.global_parameter(ins.motor, ins.kind)), ins.motor),
         None if matches!(ins.opcode, opcode::GIO | opcode::SIO) => {
-            let port = profile
-                .ports
-                .iter()
-                .filter(|p| p.bank == ins.motor && p.number == ins.kind)
-                .min_by_key(|p| p.direction == PortDirection::Pullup);
-            format!("{op} {}, bank {}{}", ins.kind, ins.motor, port.map_or(String::new(), |p| format!(" ({})", p.name)))
+            // A port by what it is, in the same words on every module (the
+            // manuals name the same pin IN0, AIN0 or AIN_0). GIO reads
+            // inputs and outputs; SIO sets outputs, pull-ups and ranges.
+            let rank = |d: PortDirection| match (ins.opcode, d) {
+                (opcode::GIO, PortDirection::Input | PortDirection::Output) => 0,
+                (opcode::SIO, PortDirection::Output | PortDirection::Pullup | PortDirection::InputRange) => 0,
+                _ => 1,
+            };
+            let port = profile.ports.iter().filter(|p| p.bank == ins.motor && p.number == ins.kind).min_by_key(|p| rank(p.direction));
+            format!("{op} {}, bank {}{}", ins.kind, ins.motor, port.map_or(String::new(), |p| format!(" ({})", p.meaning())))
         }
         None if opcode::mnemonic(ins.opcode).is_some() => format!("{op} type {}, motor {}", ins.kind, ins.motor),
         None => format!("{op} ({}), type {}", ins.opcode, ins.kind),
+    }
+}
+
+/// A request in words: its mnemonic form, or a control command by name
+/// (`get firmware version (136), type 0`).
+fn request_text(ins: Instruction) -> String {
+    if opcode::mnemonic(ins.opcode).is_some() || opcode::boot_name(ins.opcode).is_some() {
+        return mnemonic::format(ins);
+    }
+    let mut text = format!("{} ({}), type {}", opcode::name(ins.opcode), ins.opcode, ins.kind);
+    if ins.motor != 0 {
+        let _ = write!(text, ", motor {}", ins.motor);
+    }
+    if ins.value != 0 {
+        let _ = write!(text, ", value {}", ins.value);
+    }
+    text
+}
+
+/// "1 reply", "3 replies", "2 differences".
+fn count_of(n: usize, noun: &str) -> String {
+    match (n, noun.strip_suffix('y')) {
+        (1, _) => format!("1 {noun}"),
+        (_, Some(stem)) => format!("{n} {stem}ies"),
+        _ => format!("{n} {noun}s"),
     }
 }
 
@@ -212,6 +266,146 @@ fn describe(ins: Option<Instruction>, frame: &[u8; FRAME_LEN]) -> String {
     }
 }
 
+/// What a trace says of its own module: its first answered 136.
+struct Recorded {
+    /// The reply's line.
+    line: usize,
+    /// The type number the reply names (1141).
+    type_number: u16,
+    /// The reply as it reads (`136: 1141V146`).
+    said: String,
+}
+
+/// The trace's first 136 reply that names a module (type 0: the version
+/// string, type 1: the version number; a bootloader's `1141B106` too).
+fn recorded_module(exchanges: &[Exchange]) -> Option<Recorded> {
+    exchanges.iter().find_map(|x| {
+        let ins = instruction(&x.request.frame);
+        let reply = x.reply?;
+        if ins.opcode != opcode::FIRMWARE_VERSION {
+            return None;
+        }
+        match ins.kind {
+            0 => {
+                let text = String::from_utf8_lossy(&reply.frame[1..]).trim_end_matches('\0').to_string();
+                let digits: String = text.chars().take_while(char::is_ascii_digit).collect();
+                let type_number = digits.parse().ok()?;
+                Some(Recorded { line: reply.line, type_number, said: format!("136: {text}") })
+            }
+            1 => {
+                let r = Reply::decode(&reply.frame).filter(|r| r.status == Status::Ok.code())?;
+                let v = r.value as u32;
+                let type_number = (v >> 16) as u16;
+                let said = format!("136 type 1: {type_number} V{}.{:02}", (v >> 8) & 0xFF, v & 0xFF);
+                Some(Recorded { line: reply.line, type_number, said })
+            }
+            _ => None,
+        }
+    })
+}
+
+/// The built-in profile of the module with this type number.
+fn profile_named_by(type_number: u16) -> Option<&'static str> {
+    Profile::names().into_iter().find(|n| Profile::built_in(n).is_ok_and(|p| p.module.type_number == type_number))
+}
+
+/// What the recorded module accepted (status 100) that `profile` lacks: a
+/// motor, an axis or a global parameter; each with its first line.
+fn lacking(exchanges: &[Exchange], profile: &Profile) -> Vec<(usize, String)> {
+    let mut found: Vec<(usize, String)> = Vec::new();
+    for x in exchanges {
+        let Some(reply) = x.reply.and_then(|r| Reply::decode(&r.frame).map(|d| (r.line, d))) else { continue };
+        if reply.1.status != Status::Ok.code() {
+            continue;
+        }
+        let ins = instruction(&x.request.frame);
+        let motor = |m: u8| (m >= profile.module.axes).then(|| format!("motor {m}"));
+        let what = match table_of(ins.opcode) {
+            Some(Table::Axis) => {
+                motor(ins.motor).or_else(|| profile.axis_parameter(ins.kind).is_none().then(|| format!("axis parameter {}", ins.kind)))
+            }
+            Some(Table::Global) => profile
+                .global_parameter(ins.motor, ins.kind)
+                .is_none()
+                .then(|| format!("global parameter {}, bank {}", ins.kind, ins.motor)),
+            None if matches!(ins.opcode, opcode::ROR | opcode::ROL | opcode::MST) => motor(ins.motor),
+            None if ins.opcode == opcode::MVP && ins.kind < 2 => motor(ins.motor),
+            None => None,
+        };
+        if let Some(what) = what
+            && !found.iter().any(|(_, w)| *w == what)
+        {
+            found.push((reply.0, what));
+        }
+    }
+    found
+}
+
+/// The line that says the trace is from another module than the one it
+/// is checked as (none when nothing says so).
+fn other_module(exchanges: &[Exchange], profile: &Profile) -> Option<String> {
+    let checked = &profile.module.name;
+    if let Some(r) = recorded_module(exchanges) {
+        if r.type_number == profile.module.type_number {
+            return None;
+        }
+        return Some(match profile_named_by(r.type_number) {
+            Some(n) => {
+                let name = Profile::built_in(n).map_or(n.to_string(), |p| p.module.name.clone());
+                format!(
+                    "this trace is from a {name} ({} on line {}); checked as {}: give --module {n} (or --module auto)",
+                    r.said,
+                    r.line,
+                    checked.to_lowercase()
+                )
+            }
+            None => format!(
+                "this trace is from a module of type {} ({} on line {}), which has no profile here; checked as {}",
+                r.type_number,
+                r.said,
+                r.line,
+                checked.to_lowercase()
+            ),
+        });
+    }
+    let lacks = lacking(exchanges, profile);
+    if lacks.is_empty() {
+        return None;
+    }
+    let fits: Vec<&str> =
+        Profile::names().into_iter().filter(|n| Profile::built_in(n).is_ok_and(|p| lacking(exchanges, &p).is_empty())).collect();
+    let list: Vec<String> = lacks.iter().take(3).map(|(line, what)| format!("{what} on line {line}")).collect();
+    let more = if lacks.len() > 3 { format!(" and {} more", lacks.len() - 3) } else { String::new() };
+    let fits = match fits.as_slice() {
+        [] => "no profile here has all of it".to_string(),
+        fits => format!("it fits {}", fits.join(", ")),
+    };
+    Some(format!(
+        "this trace is not from a {checked}: its module accepted what a {checked} does not have ({}{more}); {fits}",
+        list.join(", ")
+    ))
+}
+
+/// The profile to check with: `--module`, or for `auto` the one the
+/// trace's 136 reply names (with the line that says so).
+fn chosen_profile(module: &str, exchanges: &[Exchange], name: &str) -> Result<(std::sync::Arc<Profile>, Option<String>), String> {
+    if module != "auto" {
+        return Ok((Profile::built_in(module)?, None));
+    }
+    let Some(r) = recorded_module(exchanges) else {
+        return Err(format!(
+            "{name}: --module auto: the trace holds no reply to 136 (the firmware version) that names its module; give --module NAME (tmclsim profile lists them)"
+        ));
+    };
+    let Some(n) = profile_named_by(r.type_number) else {
+        return Err(format!(
+            "{name}: --module auto: the trace's {} (line {}) names a module of type {}, which has no profile here; give --module NAME",
+            r.said, r.line, r.type_number
+        ));
+    };
+    Ok((Profile::built_in(n)?, Some(format!("module: {n}, from the trace's {} on line {}", r.said, r.line))))
+}
+
 pub fn run(args: CheckArgs) -> Result<ExitCode, String> {
     let name = args.file.display().to_string();
     let file = std::fs::File::open(&args.file).map_err(|e| format!("{name}: {e}"))?;
@@ -219,7 +413,8 @@ pub fn run(args: CheckArgs) -> Result<ExitCode, String> {
     let Some(last) = entries.last() else {
         return Err(format!("{name}: holds no frames"));
     };
-    let profile = Profile::built_in(&args.module)?;
+    let (exchanges, orphans, events) = split(&entries);
+    let (profile, chosen) = chosen_profile(&args.module, &exchanges, &name)?;
     let world = crate::load_world(&args.world, profile.module.axes as usize)?;
     let mut module = Module::with_world(profile.clone(), Eeprom::new(&profile.module.name), world);
     if let Some(a) = args.address {
@@ -229,23 +424,31 @@ pub fn run(args: CheckArgs) -> Result<ExitCode, String> {
         crate::run::setup(&mut module, path)?;
     }
     let address = module.address();
-    let (exchanges, orphans, events) = split(&entries);
+    let mut out = String::new();
+    // First: a trace from another module than the one it is checked as.
+    for line in [chosen, other_module(&exchanges, &profile)].into_iter().flatten() {
+        let _ = writeln!(out, "{line}");
+    }
     let mut replay = Replay { bus: Bus::single(module), events: Vec::new() };
     let report = replay.run(&exchanges, &orphans, &events, args.time_tolerance * 1_000_000, last.t_ns, &profile);
-    let mut out = String::new();
     let _ = writeln!(
         out,
-        "{name}: {} request(s) and {} event(s) replayed on a virtual {} (address {address}, world {}) over {} s of recorded time",
-        exchanges.len(),
-        events.len(),
+        "{name}: {} and {} replayed on a virtual {} (address {address}, world {}) over {} s of recorded time",
+        count_of(exchanges.len(), "request"),
+        count_of(events.len(), "event"),
         profile.module.name,
         args.world,
         seconds(last.t_ns)
     );
     write_groups(&mut out, &report.differences, "difference", args.show);
-    if !report.not_comparable.is_empty() {
+    let identical = report.identical();
+    let differing = Report::count(&report.not_comparable);
+    if differing > 0 {
         out.push_str("not comparable (listed, not counted as differences: these values depend on what the virtual module cannot know)\n");
         write_groups(&mut out, &report.not_comparable, "reply", args.show);
+    }
+    if identical > 0 {
+        let _ = writeln!(out, "{} not comparable but the same on both modules (not listed)", count_of(identical, "reply"));
     }
     let differences = Report::count(&report.differences);
     if differences > 0
@@ -257,11 +460,12 @@ pub fn run(args: CheckArgs) -> Result<ExitCode, String> {
             "note: the trace's first request goes to address {first}; the virtual module answers to {address}: give --address {first}"
         );
     }
+    let same = if identical > 0 { format!(" ({identical} of them the same)") } else { String::new() };
     let _ = writeln!(
         out,
-        "result: {differences} difference{}, {} not comparable, {} match",
-        if differences == 1 { "" } else { "s" },
-        Report::count(&report.not_comparable),
+        "result: {}, {} not comparable{same}, {} match",
+        count_of(differences, "difference"),
+        differing + identical,
         report.matched
     );
     print!("{out}");
@@ -324,7 +528,7 @@ impl Replay {
             match trace::compare(ins, x.reply.map(|r| &r.frame), early.as_ref(), late.as_ref()) {
                 Verdict::Match => report.matched += 1,
                 Verdict::Differs(note) => report.add(true, label(profile, ins), None, finding(note)),
-                Verdict::NotComparable(why) => report.add(false, label(profile, ins), Some(why), finding(String::new())),
+                Verdict::NotComparable(why) => report.not_comparable(label(profile, ins), why, finding(String::new())),
             }
             for e in &x.extra {
                 let note = format!("the recorded module sent it after its reply to line {}", x.request.line);
@@ -390,16 +594,16 @@ fn compare_events(recorded: &[&Entry], virtual_events: &[(u64, [u8; FRAME_LEN])]
 }
 
 fn write_groups(out: &mut String, groups: &[Group], noun: &str, show: usize) {
-    for g in groups {
+    for g in groups.iter().filter(|g| !g.findings.is_empty()) {
         let n = g.findings.len();
         let reason = g.reason.map_or(String::new(), |r| format!("; {r}"));
-        let _ = writeln!(out, "{}: {n} {noun}{}{reason}", g.label, if n == 1 { "" } else { "s" });
+        let _ = writeln!(out, "{}: {}{reason}", g.label, count_of(n, noun));
         for f in g.findings.iter().take(show) {
             let ins = f.request.map(|r| instruction(&r));
             let at = f.line.map_or("the virtual module".to_string(), |l| format!("line {l}"));
             let what = match f.request.map(|r| Request::decode(&r)) {
-                Some(Ok(r)) => format!(": {}", mnemonic::format(r.instruction)),
-                Some(Err(r)) => format!(": {} (wrong checksum)", mnemonic::format(r.instruction)),
+                Some(Ok(r)) => format!(": {}", request_text(r.instruction)),
+                Some(Err(r)) => format!(": {} (wrong checksum)", request_text(r.instruction)),
                 None => String::new(),
             };
             let when = match f.request_line {

@@ -105,6 +105,7 @@ fn killed_during_store_and_download_storms_leaves_old_or_new_values() {
         let kill_after = Duration::from_micros(500 + (seed >> 33) % 30_000);
         let download = round % 2 == 1;
         let killer = std::thread::spawn(move || {
+            // About time: the kill lands at a random moment of the run.
             std::thread::sleep(kill_after);
             let _ = child.kill();
             let _ = child.wait();

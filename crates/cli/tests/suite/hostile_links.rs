@@ -143,7 +143,6 @@ fn two_tcp_clients_in_ascii_mode_keep_their_own_lines() {
     };
     // Echo each character (the default): each client sees its own.
     assert_eq!(text(&mut a, "ASAP 4, 0, 9", 12), "ASAP 4, 0, 9");
-    std::thread::sleep(Duration::from_millis(50));
     assert_eq!(text(&mut b, "AGAP 1, 0\r", 19), "AGAP 1, 0\rBA 100 0\r", "B's line alone");
     assert_eq!(text(&mut a, "9\r", 12), "9\rBA 100 99\r");
     assert_eq!(text(&mut b, "AGAP 4, 0\r", 20), "AGAP 4, 0\rBA 100 99\r");
@@ -289,8 +288,10 @@ fn out_of_file_descriptors_the_accept_loop_backs_off() {
     server.check_soon();
     // Out of descriptors again, it still stops on SIGTERM, at once and
     // cleanly: its signal handlers were installed before it served.
+    let before = server.log_has("cannot accept a TCP connection on");
     let clients: Vec<TcpStream> = (0..60).map(|_| TcpStream::connect(server.tcp()).unwrap()).collect();
-    std::thread::sleep(Duration::from_millis(300));
+    let failing = server.log_has_at_least("cannot accept a TCP connection on", before + 1);
+    assert!(failing > before, "out of descriptors again: {:?}", server.log.lock().unwrap());
     let mut server = server;
     // SAFETY: signalling the child this test started.
     unsafe {

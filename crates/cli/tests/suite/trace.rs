@@ -135,7 +135,7 @@ fn a_session_over_tcp_checks_clean_and_an_altered_reply_is_one_difference() {
     nobody[0] = 5;
     nobody[8] = nobody[..8].iter().fold(0u8, |s, b| s.wrapping_add(*b));
     host.s.write_all(&nobody).unwrap();
-    std::thread::sleep(Duration::from_millis(400));
+    assert!(rec.logged(&["no reply to 05 06 01 00"]).is_some(), "{:?}", rec.log.lock().unwrap());
     // A wrong checksum: status 1.
     let mut bad = frame("GAP 1, 0");
     bad[8] ^= 0x55;
@@ -155,7 +155,32 @@ fn a_session_over_tcp_checks_clean_and_an_altered_reply_is_one_difference() {
     assert_eq!(code, Some(0), "{out}");
     assert!(out.contains("result: 0 differences, 1 not comparable"), "{out}");
     assert!(out.contains("GGP 132 (TMCL tick timer), bank 0: 1 reply; tick timer"), "{out}");
-    assert!(out.contains("and 1 event(s) replayed on a virtual TMCM-1141"), "{out}");
+    assert!(out.contains("and 1 event replayed on a virtual TMCM-1141"), "{out}");
+    // The session's own 136 reply tells its module: checked as another,
+    // the report says so first; `--module auto` takes it.
+    let (code, out) = check(&trace, &[&["--module", "tmcm-6110"][..], &patient].concat());
+    assert_eq!(code, Some(1), "{out}");
+    let version_line = reply_line(&trace, frame("#136 0 0 0"));
+    assert_eq!(
+        out.lines().next(),
+        Some(
+            format!(
+                "this trace is from a TMCM-1141 (136: 1141V146 on line {version_line}); checked as tmcm-6110: give --module tmcm-1141 (or --module auto)"
+            )
+            .as_str()
+        ),
+        "{out}"
+    );
+    assert!(out.contains("get firmware version (136), type 0: 1 difference\n"), "{out}");
+    assert!(out.contains(": get firmware version (136), type 0\n"), "control commands by name: {out}");
+    let (code, out) = check(&trace, &[&["--module", "auto"][..], &patient].concat());
+    assert_eq!(code, Some(0), "{out}");
+    assert_eq!(
+        out.lines().next(),
+        Some(format!("module: tmcm-1141, from the trace's 136: 1141V146 on line {version_line}").as_str()),
+        "{out}"
+    );
+    assert!(out.contains("result: 0 differences, 1 not comparable"), "{out}");
 
     // One reply altered: exactly that difference, at its line.
     let altered = dir.path().join("altered.jsonl");
@@ -257,7 +282,9 @@ fn bad_trace_files_are_refused_with_their_line() {
     let dir = tempfile::tempdir().unwrap();
     let good = r#"{"t": 0.1, "dir": "host", "frame": "01 06 01 00 00 00 00 00 08"}"#;
     let cases = [
-        ("not-json", "hello\n".to_string(), ":1: not a JSON object"),
+        ("not-json", "hello\n".to_string(), ":1:1: not a JSON object: expected value\n"),
+        // The column in the file's line (indent included), not the parser's "line 1".
+        ("column", "  {\"t\": 0.1, \"dir\": host}\n".to_string(), ":1:21: not a JSON object: expected value\n"),
         ("short", format!("{good}\n{}\n", good.replace(" 08\"", "\"")), ":2: \"frame\" has 8 bytes; a TMCL frame has 9"),
         ("dir", good.replace("host", "hots"), ":1: \"dir\" is \"hots\"; write \"host\" or \"module\""),
         ("back", format!("{good}\n{}\n", good.replace("0.1", "0.05")), ":2: \"t\" goes back in time (0.050000 after 0.100000)"),
@@ -281,4 +308,91 @@ fn bad_trace_files_are_refused_with_their_line() {
     std::fs::write(&path, good).unwrap();
     let o = tmclsim(&["trace", "check", path.to_str().unwrap(), "--module", "tmcm-9999"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}
+
+/// A trace file of (seconds, direction, frame) lines.
+fn write_trace(path: &Path, frames: &[(f64, &str, [u8; 9])]) {
+    let text: String = frames
+        .iter()
+        .map(|(t, dir, f)| {
+            let hex: Vec<String> = f.iter().map(|b| format!("{b:02X}")).collect();
+            format!("{{\"t\": {t}, \"dir\": \"{dir}\", \"frame\": \"{}\"}}\n", hex.join(" "))
+        })
+        .collect();
+    std::fs::write(path, text).unwrap();
+}
+
+/// A module's reply to the host (address 2 from module 1).
+fn reply(status: u8, op: u8, value: i32) -> [u8; 9] {
+    let mut f = [2, 1, status, op, 0, 0, 0, 0, 0];
+    f[4..8].copy_from_slice(&value.to_be_bytes());
+    f[8] = f[..8].iter().fold(0u8, |s, b| s.wrapping_add(*b));
+    f
+}
+
+#[test]
+fn a_trace_without_136_from_another_module_is_told_by_what_it_touches() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("three-axes.jsonl");
+    // Motor 2 answered with status 100: no TMCM-1141 (one motor) did that.
+    write_trace(
+        &trace,
+        &[
+            (0.001, "host", frame("GAP 4, 2")),
+            (0.002, "module", reply(100, 6, 2047)),
+            (0.003, "host", frame("GAP 4, 0")),
+            (0.004, "module", reply(100, 6, 1000)),
+        ],
+    );
+    let (code, out) = check(&trace, &[]);
+    assert_eq!(code, Some(1), "{out}");
+    let first = out.lines().next().unwrap_or_default();
+    assert!(
+        first.starts_with(
+            "this trace is not from a TMCM-1141: its module accepted what a TMCM-1141 does not have (motor 2 on line 2); it fits "
+        ),
+        "{out}"
+    );
+    assert!(first.contains("tmcm-351") && !first.contains("tmcm-1141"), "{out}");
+    // Without a 136 reply, `auto` has nothing to go by.
+    let o = tmclsim(&["trace", "check", trace.to_str().unwrap(), "--module", "auto"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--module auto: the trace holds no reply to 136"), "{}", text(&o));
+    // A trace of the module it is checked as says nothing of the kind.
+    let own = dir.path().join("own.jsonl");
+    write_trace(&own, &[(0.001, "host", frame("GAP 4, 0")), (0.002, "module", reply(100, 6, 1000))]);
+    let (code, out) = check(&own, &[]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.starts_with(&format!("{}: 1 request and 0 events replayed", own.display())), "{out}");
+}
+
+#[test]
+fn not_comparable_readings_are_listed_only_when_they_differ() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("inputs.jsonl");
+    // The virtual module's analog input 0 reads 0 in the stage world: the
+    // first reading is the same, the other two differ.
+    write_trace(
+        &trace,
+        &[
+            (0.001, "host", frame("GIO 0, 1")),
+            (0.002, "module", reply(100, 15, 0)),
+            (0.003, "host", frame("GIO 0, 1")),
+            (0.004, "module", reply(100, 15, 256)),
+            (0.005, "host", frame("GIO 0, 1")),
+            (0.006, "module", reply(100, 15, 300)),
+        ],
+    );
+    // The TMCM-1141's manual calls the pin IN0, the TMCM-1140's AIN0.
+    for module in ["tmcm-1141", "tmcm-1140"] {
+        let (code, out) = check(&trace, &["--module", module]);
+        assert_eq!(code, Some(0), "{module}: {out}");
+        // The same words for the same port on both modules, whatever their
+        // manuals call the pin.
+        assert!(out.contains("GIO 0, bank 1 (analog input 0): 2 replies; "), "{module}: {out}");
+        assert!(!out.contains("line 2 "), "the identical reading is not listed: {out}");
+        assert!(out.contains("  line 4 (request on line 3") && out.contains("  line 6 (request on line 5"), "{out}");
+        assert!(out.contains("1 reply not comparable but the same on both modules (not listed)\n"), "{out}");
+        assert!(out.contains("result: 0 differences, 3 not comparable (1 of them the same), 0 match"), "{out}");
+    }
 }

@@ -67,6 +67,9 @@ fn two_tcp_clients_type_their_own_ascii_lines() {
     assert_eq!(read_text(&mut a, 25), "ASGP 67, 0, 32\rBA 100 32\r");
     // A types half a line; B types a whole one; A finishes its own.
     a.write_all(b"AGAP 4").unwrap();
+    // Not a synchronisation (no echo tells when A's bytes are in): the
+    // answers are the same in either order; the pause makes the
+    // interleaving likely.
     std::thread::sleep(Duration::from_millis(50));
     b.write_all(b"ASAP 4, 0, 555\r").unwrap();
     assert_eq!(read_text(&mut b, 11), "BA 100 555\r");
@@ -74,6 +77,7 @@ fn two_tcp_clients_type_their_own_ascii_lines() {
     assert_eq!(read_text(&mut a, 11), "BA 100 555\r");
     // B's half line is not finished by A's carriage return.
     b.write_all(b"AGAP 4").unwrap();
+    // As above: either order gives the same answers.
     std::thread::sleep(Duration::from_millis(50));
     a.write_all(b"\r").unwrap();
     b.write_all(b", 0\r").unwrap();
@@ -96,9 +100,11 @@ fn an_idle_client_gives_its_slot_to_a_new_one() {
             if dribble.write_all(&[1]).is_err() {
                 break;
             }
+            // About time: slower than any frame's inter-byte timeout.
             std::thread::sleep(Duration::from_millis(50));
         }
     });
+    // About time: longer than the 300 ms idle timeout.
     std::thread::sleep(Duration::from_millis(400));
     let mut busy = connect(addr);
     assert_eq!(ask(&mut busy, "GAP 4, 0").status, 100);
@@ -159,6 +165,7 @@ fn control_connections_are_limited_and_idle_ones_give_way() {
     third.read_line(&mut a).unwrap();
     assert_eq!(a, "error: 2 control connections open (the limit)\n");
     assert!(closed(third.get_mut()));
+    // About time: longer than the 300 ms idle timeout.
     std::thread::sleep(Duration::from_millis(400));
     assert_eq!(say(&mut first, "input 1 0"), "ok");
     // The silent one has gone 400 ms without a line: it makes room.

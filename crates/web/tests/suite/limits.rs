@@ -35,6 +35,7 @@ fn a_client_that_sends_no_request_head_in_time_is_closed() {
         if slow.write_all(&[*b]).is_err() {
             break;
         }
+        // About time: a byte every 20 ms, slower than the head timeout allows.
         std::thread::sleep(Duration::from_millis(20));
     }
     let answer = read_to_close(&mut slow);
@@ -50,8 +51,9 @@ fn a_client_that_sends_no_request_head_in_time_is_closed() {
 #[test]
 fn connections_past_the_limit_are_answered_503() {
     let s = Served::with_limits(Limits { connections: 4, ..Limits::default() });
+    // The server takes connections in the order they came: the four take
+    // the slots before the fifth is looked at.
     let held: Vec<TcpStream> = (0..4).map(|_| TcpStream::connect(s.web.addr()).unwrap()).collect();
-    std::thread::sleep(Duration::from_millis(200));
     let mut fifth = TcpStream::connect(s.web.addr()).unwrap();
     let answer = read_to_close(&mut fifth);
     assert!(answer.starts_with("HTTP/1.1 503") && answer.contains("4 connections at once"), "{answer}");

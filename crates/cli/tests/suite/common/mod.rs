@@ -211,9 +211,14 @@ impl Server {
 
     /// How many log lines contain `what`, waiting up to 10 s for the first.
     pub fn log_has(&self, what: &str) -> usize {
+        self.log_has_at_least(what, 1)
+    }
+
+    /// How many log lines contain `what`, waiting up to 10 s for `n` of them.
+    pub fn log_has_at_least(&self, what: &str, n: usize) -> usize {
         let count = || self.log.lock().unwrap().iter().filter(|l| l.contains(what)).count();
         let until = Instant::now() + Duration::from_secs(10);
-        while count() == 0 && Instant::now() < until {
+        while count() < n && Instant::now() < until {
             std::thread::sleep(Duration::from_millis(10));
         }
         count()
