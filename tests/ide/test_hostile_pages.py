@@ -7,7 +7,6 @@ world must not change."""
 import http.server
 import socket
 import threading
-import time
 
 import pytest
 
@@ -22,19 +21,26 @@ def frame(op, kind, motor, value, address=1):
 
 ATTACK = """
 async (target) => {
+  // How each request ended: "closed" when the server closed the connection
+  // (the fetch fails at once), else the error's name ("TimeoutError": a
+  // server that took the request for frames and never answered it).
+  const ends = [];
+  const post = async (url, body) => {
+    try {
+      await fetch(url, {method: "POST", mode: "no-cors", body, signal: AbortSignal.timeout(5000)});
+      ends.push("answered");
+    } catch (e) {
+      ends.push(e.name === "TypeError" ? "closed" : e.name);
+    }
+  };
   const frames = new Uint8Array(target.frames);
   for (let skew = 0; skew < 9; skew++) {
     const body = new Uint8Array(skew + frames.length);
     body.set(frames, skew);
-    try {
-      // A server that takes the request for frames never answers it.
-      await fetch(target.url, {method: "POST", mode: "no-cors", body, signal: AbortSignal.timeout(500)});
-    } catch (e) {}
+    await post(target.url, body);
   }
-  try {
-    await fetch(target.control, {method: "POST", mode: "no-cors", body: "link mute on\\n", signal: AbortSignal.timeout(500)});
-  } catch (e) {}
-  return true;
+  if (target.control) await post(target.control, "link mute on\\n");
+  return ends;
 }
 """
 
@@ -67,8 +73,10 @@ def test_a_web_page_cannot_drive_a_motor_or_mute_a_link(served, page, another_si
     control = served.printed("control")
     ror = b"".join(frame(1, 0, 0, 800) for _ in range(40))
     page.goto(another_site)
-    assert page.evaluate(ATTACK, {"url": f"http://{served.tcp}/", "control": f"http://{control}/", "frames": list(ror)})
-    time.sleep(0.3)
+    # Every request is closed by the server (none times out): the server
+    # is done with each before the checks below.
+    ends = page.evaluate(ATTACK, {"url": f"http://{served.tcp}/", "control": f"http://{control}/", "frames": list(ror)})
+    assert ends == ["closed"] * 10, ends
     with ConnectionManager(f"--interface socket_serial_tmcl --port {served.tcp}").connect() as interface:
         motor = TMCM1141(interface).motors[0]
         assert motor.get_axis_parameter(motor.AP.TargetVelocity) == 0, "the page did not start the motor"
@@ -77,3 +85,28 @@ def test_a_web_page_cannot_drive_a_motor_or_mute_a_link(served, page, another_si
     with socket.create_connection(tuple(served.tcp.rsplit(":", 1)), timeout=3) as s:
         s.sendall(frame(6, 4, 0, 0))
         assert len(s.recv(9)) == 9
+
+
+def test_a_web_page_cannot_reach_a_module_through_the_trace_proxy(served, page, another_site, start, tmp_path):
+    """`tmclsim trace record` forwards what a host sends to a module, often a
+    real one on USB: its listening port screens what a page sends as the
+    TMCL port does, and the recording goes on (docs/behaviour.md rule 90)."""
+    trace = tmp_path / "session.jsonl"
+    recorder = start(["trace", "record", "--listen", "127.0.0.1:0", "--tcp", served.tcp, "--out", str(trace)])
+    listen = recorder.printed("listen")
+    ror = b"".join(frame(1, 0, 0, 800) for _ in range(40))
+    page.goto(another_site)
+    ends = page.evaluate(ATTACK, {"url": f"http://{listen}/", "control": None, "frames": list(ror)})
+    assert ends == ["closed"] * 9, ends
+    # The recording goes on: a host through the proxy finds the motor still.
+    with ConnectionManager(f"--interface socket_serial_tmcl --port {listen}").connect() as interface:
+        motor = TMCM1141(interface).motors[0]
+        assert motor.get_axis_parameter(motor.AP.TargetVelocity) == 0, "the page did not start the motor"
+    recorder.proc.terminate()
+    log = recorder.proc.stdout.read()
+    assert recorder.proc.wait(timeout=10) == 0, log
+    closed = [line for line in log.splitlines() if "it opened with an HTTP request, not TMCL; nothing was executed" in line]
+    assert len(closed) == 9 and all(line.startswith("tmclsim: closing connection tcp 127.0.0.1:") for line in closed), log
+    assert "stopping; 2 frame(s) in" in log, log
+    recorded = trace.read_text()
+    assert frame(1, 0, 0, 800).hex(" ").upper() not in recorded, recorded

@@ -28,7 +28,7 @@ pub(crate) async fn run(listener: TcpListener, bus: Arc<SharedBus>, config: Serv
             accepted = accept(&listener, &mut failing, "a control connection") => {
                 let Some((stream, peer)) = accepted else { continue };
                 if let Err(why) = slots.make_room() {
-                    eprintln!("tmclsim: refusing control connection from {peer}: {why}");
+                    eprintln!("tmclsim: {}", crate::log_lines::refused("control connection", peer, why));
                     // A fresh socket's send buffer is empty: the line fits.
                     let _ = stream.try_write(format!("error: {why}\n").as_bytes());
                     continue;

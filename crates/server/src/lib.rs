@@ -25,6 +25,7 @@ pub mod ethercat;
 pub mod files;
 pub mod frame_log;
 mod link;
+pub mod log_lines;
 // A pty and the SLCAN adapter on one are Unix's; on Windows both are
 // refused (no_pty.rs).
 #[cfg(unix)]

@@ -182,11 +182,7 @@ impl<'a> Session<'a> {
         let bytes = match screen(&mut self.preamble, read) {
             Screened::Hold => return Ok(Flow::Open),
             Screened::Foreign(what) => {
-                eprintln!(
-                    "tmclsim: closing connection {}: it opened with {}, not TMCL; nothing was executed",
-                    self.options.name,
-                    what.describe()
-                );
+                eprintln!("tmclsim: {}", crate::log_lines::foreign(&self.options.name, what));
                 return Ok(Flow::Close);
             }
             Screened::Pass(bytes) => bytes,
@@ -244,7 +240,7 @@ impl<'a> Session<'a> {
         }
         if self.options.network.is_some_and(|limit| limit > 0 && self.bad_frames >= limit) {
             writer.flush().await?;
-            eprintln!("tmclsim: closing connection {}: {} frames in a row with a wrong checksum", self.options.name, self.bad_frames);
+            eprintln!("tmclsim: {}", crate::log_lines::bad_frames(&self.options.name, self.bad_frames));
             return Ok(Flow::Close);
         }
         Ok(Flow::Open)

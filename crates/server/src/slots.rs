@@ -12,6 +12,8 @@ use std::time::{Duration, Instant};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::task::{AbortHandle, Id, JoinSet};
 
+use crate::log_lines::Full;
+
 /// How long the accept loop waits after a failed accept (out of file
 /// descriptors, …) before it tries again.
 pub const ACCEPT_BACKOFF: Duration = Duration::from_millis(100);
@@ -54,24 +56,6 @@ pub(crate) struct Slots {
     tasks: JoinSet<()>,
 }
 
-/// Why a new client was refused: every slot is taken by a client that is
-/// not idle long enough to be closed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Full {
-    /// How many slots there are.
-    pub limit: usize,
-    /// What a slot holds (`connection`).
-    pub what: &'static str,
-}
-
-impl std::fmt::Display for Full {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{} {}s open (the limit)", self.limit, self.what)
-    }
-}
-
-impl std::error::Error for Full {}
-
 impl Slots {
     pub fn new(what: &'static str, limit: usize, idle_timeout: Duration) -> Slots {
         Slots { what, limit, idle_timeout, open: HashMap::new(), tasks: JoinSet::new() }
@@ -89,13 +73,7 @@ impl Slots {
             Some((id, idle)) if idle >= self.idle_timeout => {
                 if let Some(o) = self.open.remove(&id) {
                     o.abort.abort();
-                    eprintln!(
-                        "tmclsim: closing {} from {}: no request for {} s and all {} slots are taken",
-                        self.what,
-                        o.peer,
-                        idle.as_secs_f64().round(),
-                        self.limit
-                    );
+                    eprintln!("tmclsim: {}", crate::log_lines::idle_closed(self.what, o.peer, idle, self.limit));
                 }
                 Ok(())
             }

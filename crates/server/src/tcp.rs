@@ -15,7 +15,7 @@ pub(crate) async fn run(listener: TcpListener, bus: Arc<SharedBus>, config: Serv
             accepted = accept(&listener, &mut failing, "a TCP connection") => {
                 let Some((stream, peer)) = accepted else { continue };
                 if let Err(why) = slots.make_room() {
-                    eprintln!("tmclsim: refusing connection from {peer}: {why}");
+                    eprintln!("tmclsim: {}", crate::log_lines::refused("connection", peer, why));
                     drop(stream);
                     continue;
                 }

@@ -6,37 +6,13 @@
 
 use crate::common;
 
-use common::{Server, ask, frame, get};
+use common::{Server, ask, frame, get, http_post_with_frames, send_and_read_to_close};
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 use tmclsim_protocol::{Instruction, Reply, Request};
-
-/// An HTTP POST whose head is padded to a multiple of nine bytes, so that
-/// a server that took the head for bad frames would meet the body's
-/// frames in step: what a web page sends with `fetch(…, {mode:
-/// "no-cors", method: "POST", body})`.
-fn http_post_with_frames(addr: &str, body: &[u8]) -> Vec<u8> {
-    let mut head = format!("POST / HTTP/1.1\r\nHost: {addr}\r\nContent-Type: text/plain\r\nContent-Length: {}\r\nX-Pad: ", body.len());
-    while (head.len() + 4) % 9 != 0 {
-        head.push('a');
-    }
-    head.push_str("\r\n\r\n");
-    [head.into_bytes(), body.to_vec()].concat()
-}
-
-/// Sends `bytes` on a new connection and reads until the server closes it
-/// (at most 5 s): what came back.
-fn send_and_read_to_close(addr: &str, bytes: &[u8]) -> Vec<u8> {
-    let mut s = TcpStream::connect(addr).unwrap();
-    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-    s.write_all(bytes).unwrap();
-    let mut back = Vec::new();
-    let _ = s.read_to_end(&mut back);
-    back
-}
 
 fn value_of(s: &mut TcpStream, line: &str) -> i32 {
     let r = ask(s, line).unwrap_or_else(|| panic!("{line}: no reply"));

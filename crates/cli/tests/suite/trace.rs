@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use common::{Server, frame, text, tmclsim};
+use common::{Server, frame, http_post_with_frames, send_and_read_to_close, text, tmclsim};
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::path::Path;
@@ -247,10 +247,13 @@ fn one_host_at_a_time_and_the_end_of_the_module_link() {
     let listen = rec.printed("listen");
     let mut first = Host::connect(&listen);
     assert_eq!(first.value("GAP 4, 0"), first.value("GAP 4, 0"));
+    // A second host is refused once it has said it speaks TMCL; its frame
+    // goes nowhere.
     let mut second = TcpStream::connect(&listen).unwrap();
     second.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    second.write_all(&frame("SAP 4, 0, 7")).unwrap();
     assert_eq!(second.read(&mut [0u8; 9]).unwrap_or(0), 0, "the second host is closed");
-    assert!(rec.logged(&["refusing host", "one host at a time"]).is_some());
+    assert!(rec.logged(&["refusing connection from", ": 1 connection open (the limit)"]).is_some(), "{:?}", rec.log.lock().unwrap());
     first.value("GAP 4, 0");
     drop(first);
     // The next host is served.
@@ -262,6 +265,65 @@ fn one_host_at_a_time_and_the_end_of_the_module_link() {
     let mut rec = rec;
     assert_eq!(rec.exit_code_within(Duration::from_secs(10)), Some(2));
     assert!(rec.logged(&["the link to the module closed; 8 frame(s) in"]).is_some(), "{:?}", rec.log.lock().unwrap());
+    assert!(!lines(&trace).iter().any(|l| l.contains("01 05 04 00 00 00 00 07")), "the refused host's frame is not recorded");
+}
+
+#[test]
+fn the_proxy_port_has_the_defences_of_a_tmcl_port() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("t.jsonl");
+    let server = Server::start(&["--tcp", "127.0.0.1:0"]);
+    let rec = recorder(&["--tcp", &server.tcp(), "--bad-frame-limit", "3", "--idle-timeout", "1"], &trace);
+    let listen = rec.printed("listen");
+    let log = || format!("{:?}", rec.log.lock().unwrap());
+
+    // What a web page sends: an HTTP request whose body holds frames in
+    // step, and a TLS client hello. Closed before anything is forwarded,
+    // in the TMCL port's words.
+    let body: Vec<u8> = (0..20).flat_map(|_| frame("ROR 0, 500")).collect();
+    assert!(send_and_read_to_close(&listen, &http_post_with_frames(&listen, &body)).is_empty());
+    assert!(
+        rec.logged(&["closing connection tcp 127.0.0.1:", "it opened with an HTTP request, not TMCL; nothing was executed"]).is_some(),
+        "{}",
+        log()
+    );
+    let hello = [[0x16, 0x03, 0x01, 0x00, 0xC8, 0x01, 0x00, 0x00, 0xC4].as_slice(), &body].concat();
+    assert!(send_and_read_to_close(&listen, &hello).is_empty());
+    assert!(rec.logged(&["it opened with a TLS client hello, not TMCL"]).is_some(), "{}", log());
+    let mut s = server.connect();
+    assert_eq!(common::ask(&mut s, "GAP 2, 0").unwrap().value, 0, "the motor was not started");
+
+    // Frames with a wrong checksum, three in a row: answered (status 1),
+    // then the connection is closed.
+    let mut bad = Host::connect(&listen);
+    let mut wrong = frame("GAP 1, 0");
+    wrong[8] ^= 0x55;
+    for _ in 0..3 {
+        assert_eq!(bad.raw(wrong)[2], 1);
+    }
+    assert_eq!(bad.s.read(&mut [0u8; 9]).unwrap_or(0), 0, "closed after three bad frames");
+    assert!(rec.logged(&["closing connection tcp 127.0.0.1:", ": 3 frames in a row with a wrong checksum"]).is_some(), "{}", log());
+    assert!(rec.logged(&["disconnected"]).is_some(), "{}", log());
+
+    // One host at a time; one that has sent no frame for the idle timeout
+    // gives its place to a new one.
+    let mut first = Host::connect(&listen);
+    assert_eq!(first.value("GAP 4, 0"), 1000);
+    // About time: longer than the 1 s idle timeout.
+    std::thread::sleep(Duration::from_millis(1300));
+    let mut next = Host::connect(&listen);
+    assert_eq!(next.value("GGP 66, 0"), 1);
+    assert!(rec.logged(&["closing connection from 127.0.0.1:", "no request for 1 s and its only slot is wanted"]).is_some(), "{}", log());
+    assert_eq!(first.s.read(&mut [0u8; 9]).unwrap_or(0), 0, "the idle host was closed");
+    drop(next);
+
+    // None of it ended the recording, and nothing of the refused
+    // connections is in the trace.
+    assert_eq!(stop(rec), Some(0));
+    let all = lines(&trace);
+    assert_eq!(all.len(), 10, "3 bad frames, 2 requests, their 5 replies: {all:#?}");
+    assert!(!all.iter().any(|l| l.contains("01 01 00 00 00 00 01 F4")), "no frame of the page's body: {all:#?}");
+    server.stop();
 }
 
 #[test]
