@@ -89,7 +89,7 @@ def test_each_clock_starts_at_the_real_reading_and_runs_at_the_speed(name):
     scaled = getattr(time, name)
     assert scaled is not real
     a0, v0, a1 = real(), scaled(), real()
-    REAL_SLEEP(0.05)
+    REAL_SLEEP(0.05)  # about time: 50 ms of wall time for the clock to run at its speed
     b0, v1, b1 = real(), scaled(), real()
     assert isinstance(v1, type(a0))
     assert before_install <= v0 <= before_install + SPEED * (a1 - before_install) + EPSILON * unit
@@ -98,6 +98,7 @@ def test_each_clock_starts_at_the_real_reading_and_runs_at_the_speed(name):
 
 def test_a_speed_below_one_slows_the_clocks():
     with clock.scaled(0.5):
+        # about time: the sleep's length is measured
         virtual, wall = timed(lambda: time.sleep(0.1))
     assert wall >= 0.2 - EPSILON, "time.sleep(0.1) at speed 0.5 lasts 0.2 s of wall time"
     assert virtual >= 0.1 - EPSILON
@@ -109,6 +110,7 @@ def test_a_thread_started_before_install_sees_the_scaled_clock():
 
     def host():
         go.wait()
+        # about time: the sleep's length is measured
         measured.append(timed(lambda: time.sleep(VIRTUAL)))
 
     thread = threading.Thread(target=host)
@@ -120,7 +122,8 @@ def test_a_thread_started_before_install_sees_the_scaled_clock():
     assert wall < WALL_LIMIT and virtual >= VIRTUAL - EPSILON, (virtual, wall)
 
 
-# Waits with a timeout: each lasts its whole timeout of VIRTUAL seconds.
+# Waits with a timeout: each lasts its whole timeout of VIRTUAL seconds
+# (about time: their lengths are measured).
 
 
 def sleep():
@@ -276,7 +279,7 @@ def test_a_copy_taken_while_installed_reads_the_real_clock_after():
     before, copy, after = ORIGINALS[time, "monotonic"](), monotonic(), ORIGINALS[time, "monotonic"]()
     assert before <= copy <= after
     wall = WALL()
-    sleep(0.05)
+    sleep(0.05)  # about time: its length is measured
     assert WALL() - wall >= 0.05 - EPSILON
 
 
@@ -287,7 +290,7 @@ def test_installing_again_changes_the_speed_and_time_goes_on():
     after, wall1 = time.monotonic(), WALL()
     assert clock.installed_speed() == 0.5
     assert before <= after <= before + SPEED * (wall1 - wall0) + EPSILON, "virtual time jumped"
-    virtual, wall = timed(lambda: time.sleep(0.1))
+    virtual, wall = timed(lambda: time.sleep(0.1))  # about time: its length is measured
     assert wall >= 0.2 - EPSILON and virtual >= 0.1 - EPSILON
 
 
@@ -338,7 +341,7 @@ def test_pyserial_timeout_stays_on_the_wall_clock():
     serialutil = pytest.importorskip("serial.serialutil", reason="pyserial is not installed")
     with clock.scaled(SPEED):
         timeout = serialutil.Timeout(5.0)
-        time.sleep(5.0)  # 0.1 s of wall time
+        time.sleep(5.0)  # about time: 5 virtual s, 0.1 s of wall time
         assert not timeout.expired()
         assert 2.5 < timeout.time_left() <= 5.0
 
@@ -350,7 +353,7 @@ def test_a_serial_read_timeout_stays_on_the_wall_clock():
     try:
         with serial.Serial(os.ttyname(device), timeout=0.3) as port, clock.scaled(SPEED):
             wall = WALL()
-            assert port.read(1) == b""
+            assert port.read(1) == b""  # about time: the read's timeout is measured
             wall = WALL() - wall
     finally:
         os.close(controller)
@@ -372,7 +375,7 @@ import json, sys, time
 from tmclsim import clock
 
 wall, virtual = clock.real_monotonic(), time.monotonic()
-time.sleep(1)
+time.sleep(1)  # about time: its length is measured
 print(json.dumps({
     "argv": sys.argv,
     "virtual": time.monotonic() - virtual,
@@ -424,7 +427,7 @@ def test_pyserial_imported_by_the_program_stays_on_the_wall_clock(tmp_path):
             from serial.serialutil import Timeout
 
             timeout = Timeout(5.0)
-            time.sleep(5.0)
+            time.sleep(5.0)  # about time: 5 virtual s, 0.1 s of wall time
             print(timeout.expired(), timeout.time_left())
             """
         )

@@ -21,8 +21,8 @@ def test_the_fixture_serves_a_module_on_tcp_and_a_pty(tmcl_module):
     with tmcl_module.connect(via="pty") as interface:
         deadline = time.monotonic() + 10
         while interface.get_axis_parameter(8, 0) != 1:  # position reached
-            assert time.monotonic() < deadline
-            time.sleep(0.01)
+            assert time.monotonic() < deadline, f"position not reached in 10 s: at {interface.get_axis_parameter(1, 0)}"
+            time.sleep(0.01)  # the poll's interval
         assert interface.get_axis_parameter(1, 0) == 10000
 
 
@@ -43,6 +43,8 @@ def test_a_test_can_switch_to_stepped_time(tmcl_module):
         tmcm = TMCM1141(interface)
         tmcl_module.stepped = True
         tmcm.move_to(0, 30000)
+        # about time: wall time passes, and in stepped time the module does
+        # not move until the test advances it.
         time.sleep(0.05)
         assert tmcl_module.module.actual_position() == 0
         tmcl_module.advance(10)

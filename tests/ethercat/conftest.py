@@ -13,13 +13,12 @@ import os
 import pathlib
 import subprocess
 import sys
-import time
 import uuid
 
 import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from tmclsim_binary import tmclsim_binary  # noqa: E402
+from tmclsim_binary import read_banner, tmclsim_binary  # noqa: E402
 
 
 def _ip(*args):
@@ -69,10 +68,10 @@ def ethercat(veth):
             text=True,
         )
         procs.append(p)
-        line = p.stdout.readline()
-        assert "EtherCAT slave" in line, line
-        p.stdout.readline()
-        time.sleep(0.1)
+        # The banner's last line comes once the slaves' raw socket is bound:
+        # from then on the master's frames wait for them in its queue.
+        lines = read_banner(p, timeout=10)
+        assert "EtherCAT slave" in lines[0], lines
         return master
 
     yield start

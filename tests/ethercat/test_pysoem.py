@@ -62,7 +62,10 @@ def to_op(m):
 
 
 def cycle_until(m, done, timeout=10.0):
+    """Process data cycles until `done()`; fails after `timeout` seconds
+    with the last working counter and the slaves' inputs."""
     deadline = time.monotonic() + timeout
+    wkc = None
     while time.monotonic() < deadline:
         m.send_processdata()
         wkc = m.receive_processdata(RECEIVE_TIMEOUT_US)
@@ -74,8 +77,8 @@ def cycle_until(m, done, timeout=10.0):
         assert wkc == m.expected_wkc
         if done():
             return
-        time.sleep(0.001)
-    pytest.fail("process data never showed the expected state")
+        time.sleep(0.001)  # the cycle's interval
+    pytest.fail(f"process data never showed the expected state in {timeout} s: last working counter {wkc}, inputs {[inputs(s) for s in m.slaves]}")
 
 
 def inputs(slave):
@@ -150,10 +153,13 @@ def test_stap_over_the_mailbox_reaches_the_eeprom_file(ethercat, tmp_path):
         assert tmcl(s, 5, 4, 0, value) == (100, value)  # SAP 4
         assert tmcl(s, 7, 4, 0, 0)[0] == 100  # STAP 4
     m.close()
-    deadline = time.time() + 5
-    while '"0/4": 1039' not in eeprom.read_text() if eeprom.exists() else True:
-        assert time.time() < deadline, "the EEPROM file was not written"
-        time.sleep(0.05)
+    deadline = time.monotonic() + 10
+    while True:
+        text = eeprom.read_text() if eeprom.exists() else "(no file)"
+        if '"0/4": 1039' in text:
+            break
+        assert time.monotonic() < deadline, f"the EEPROM file was not written in 10 s: {text[:500]}"
+        time.sleep(0.05)  # the poll's interval
 
 
 def test_the_state_machine_refuses_invalid_transitions(ethercat):
@@ -191,7 +197,9 @@ def test_malformed_frames_are_ignored(ethercat):
     ]:
         raw.send(junk.ljust(14, b"\x00"))
     raw.close()
-    time.sleep(0.1)
+    # A veth hands each frame to the peer as it is sent: the junk waits on
+    # the slave's socket ahead of the master's frames, so the slave has gone
+    # through it when it answers them.
     m = open_master(iface)
     to_op(m)
     m.close()
@@ -214,9 +222,15 @@ def test_process_data_watchdog(ethercat):
     cycle_until(m, lambda: inputs(s)[5] == 800)
     s.set_watchdog("processdata", 100)
     assert s.get_watchdog("processdata") == pytest.approx(100)
-    time.sleep(0.3)  # no process data for longer than the 100 ms watchdog
-    m.read_state()
-    assert s.state == pysoem.SAFEOP_STATE | 0x10
+    # No more process data: after 100 ms the watchdog drops the slave to
+    # SafeOp with an error.
+    deadline = time.monotonic() + 10
+    while True:
+        m.read_state()
+        if s.state == pysoem.SAFEOP_STATE | 0x10:
+            break
+        assert time.monotonic() < deadline, f"no SafeOp with an error in 10 s: state {s.state:#x}, AL status {s.al_status:#06x}"
+        time.sleep(0.01)  # the poll's interval
     assert s.al_status == 0x001B
     assert tmcl(s, 6, 2, 0, 0) == (100, 0), "the motor was stopped"
     m.close()

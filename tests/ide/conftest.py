@@ -12,7 +12,7 @@ import time
 import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from tmclsim_binary import ROOT, stop, tmclsim_binary  # noqa: E402
+from tmclsim_binary import ROOT, read_banner, stop, tmclsim_binary  # noqa: E402
 
 CHROMIUM = os.environ.get("TMCLSIM_CHROMIUM", "/usr/bin/chromium")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -30,19 +30,9 @@ TAKEN = []
 class Process:
     """A tmclsim process printing `key: value` lines up to `last`."""
 
-    def __init__(self, args, last):
+    def __init__(self, args, last, timeout=30):
         self.proc = subprocess.Popen([tmclsim_binary(), *args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        self.lines = []
-        deadline = time.monotonic() + 30
-        while True:
-            line = self.proc.stdout.readline()
-            if not line:
-                raise RuntimeError(f"tmclsim {args[0]} exited: " + "".join(self.lines))
-            self.lines.append(line)
-            if line.startswith(last):
-                break
-            if time.monotonic() > deadline:
-                raise RuntimeError(f"tmclsim {args[0]} did not start")
+        self.lines = read_banner(self.proc, last, timeout)
 
     def printed(self, key):
         m = re.search(rf"^\s*{key}: (\S+)", "".join(self.lines), re.M)
@@ -130,10 +120,43 @@ def text(page, testid):
     return page.inner_text(f"[data-testid={testid}]")
 
 
-def wait_text(page, testid, expression):
+def until(page, what, probe, ok=bool, timeout=10):
+    """Polls `probe()` until `ok` takes its value (then returns it); the
+    page's events come in between (page.wait_for_timeout, the poll's
+    interval). After `timeout` seconds fails naming `what` and the last
+    value seen."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = probe()
+        if ok(value):
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"waited {timeout} s for {what}; last saw {value!r}")
+        page.wait_for_timeout(20)  # the poll's interval
+
+
+def until_js(page, what, condition, seen, arg=None, timeout=10):
+    """Waits until the JavaScript function `condition` (given `arg`) is true
+    in the page; after `timeout` seconds fails naming `what` and what the
+    JavaScript function `seen` (given `arg`) gives then."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    try:
+        page.wait_for_function(condition, arg=arg, timeout=timeout * 1000)
+    except PlaywrightTimeout:
+        raise AssertionError(f"waited {timeout} s for {what}; saw {page.evaluate(seen, arg)!r}") from None
+
+
+def wait_text(page, testid, expression, timeout=30):
     """Waits until the element's text `t` makes the JavaScript `expression`
-    true."""
-    page.wait_for_function(f"(() => {{ const t = document.querySelector('[data-testid={testid}]').textContent; return {expression}; }})()")
+    true; fails with the text it had."""
+    until_js(
+        page,
+        f"[data-testid={testid}] to make `{expression}` true",
+        f"() => {{ const t = document.querySelector('[data-testid={testid}]').textContent; return {expression}; }}",
+        f"() => document.querySelector('[data-testid={testid}]')?.textContent",
+        timeout=timeout,
+    )
 
 
 def shot(page, name):
@@ -167,6 +190,18 @@ def series(page, key):
     return page.evaluate("(k) => window.tmclsimCharts.store.get(k)", key)
 
 
-def wait_samples(page, n):
+def wait_samples(page, n, timeout=30):
     """Until the charts hold at least `n` samples."""
-    page.wait_for_function(f"window.tmclsimCharts.t.length >= {n}")
+    until_js(page, f"{n} samples in the charts", f"() => window.tmclsimCharts.t.length >= {n}", "() => `${window.tmclsimCharts.t.length} samples`", timeout=timeout)
+
+
+def wait_drawn(page, n, timeout=10):
+    """Until every chart draws at least `n` samples (the store's samples
+    are drawn on the charts' next redraw)."""
+    until_js(
+        page,
+        f"every chart to draw {n} samples",
+        f"() => window.tmclsimCharts.charts.every((u) => u.data[0].length >= {n})",
+        "() => window.tmclsimCharts.charts.map((u) => `${u.panel.title}: ${u.data[0].length}`)",
+        timeout=timeout,
+    )

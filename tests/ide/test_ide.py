@@ -10,7 +10,7 @@ import urllib.error
 import urllib.request
 
 import pytest
-from conftest import csv_rows, downloaded, open_app, series, shot, tab, wait_samples
+from conftest import csv_rows, downloaded, open_app, series, shot, tab, until, until_js, wait_drawn, wait_samples
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1141
 
@@ -24,6 +24,12 @@ Loop:   CALC ADD, 1
 
 def pytrinamic(served):
     return ConnectionManager(f"--interface socket_serial_tmcl --port {served.tcp}").connect()
+
+
+def reads_ap_1(post_data):
+    """Whether a read request's body reads AP 1 of motor 0."""
+    reads = json.loads(post_data or "{}").get("reads", [])
+    return any(r.get("kind") == "ap" and r.get("number") == 1 and r.get("index") == 0 for r in reads)
 
 
 def test_module_list_and_filter(served, page, start):
@@ -65,8 +71,14 @@ def test_a_parameter_changed_in_the_grid_is_read_by_pytrinamic(served, page):
         return Number(rows[rows.length - 1].dataset.testid.split('-').pop());
     }""")
     cell = f"[data-testid=value-ap-0-{last}]"
+    # The grid's rounds of reads (POST …/read with the first row, AP 1).
+    rounds = []
+    page.on("requestfinished", lambda r: rounds.append(r.url) if r.url.endswith("/read") and reads_ap_1(r.post_data) else None)
     page.wait_for_function("document.querySelector('[data-testid=value-ap-0-1]').textContent !== '–'")
-    page.wait_for_timeout(700)
+    # Two more rounds finished: the first of them is shown, and the last
+    # row was not in it.
+    before = len(rounds)
+    until(page, "two more rounds of the grid's reads", lambda: len(rounds), lambda n: n >= before + 2)
     assert page.inner_text(cell) == "–"
     page.locator(cell).scroll_into_view_if_needed()
     page.wait_for_function(f"document.querySelector({cell!r}).textContent !== '–'")
@@ -87,7 +99,9 @@ def test_a_move_from_pytrinamic_shows_on_the_chart_and_the_position(served, page
     info = page.inner_text("[data-testid=chart-info]")
     assert re.search(r"\d+ samples", info), info
     assert page.locator("[data-testid=chart-position] canvas").count() == 1
-    page.wait_for_timeout(500)
+    # The chart draws the position reached (its redraw follows the samples).
+    until_js(page, "the position chart to draw 51200", "() => window.tmclsimCharts.charts[0].data[1]?.at(-1) === 51200",
+             "() => window.tmclsimCharts.charts[0].data[1]?.slice(-3)")
     shot(page, "charts")
     with page.expect_download() as d:
         page.click("[data-testid=chart-csv]")
@@ -105,6 +119,8 @@ def test_a_server_that_stopped_is_an_error_the_page_shows(served, page):
     # on any error the page does not handle).
     open_app(page, served.url)
     served.stop()
+    sockets = []
+    page.on("websocket", lambda ws: sockets.append(ws.url))
     page.fill("[data-testid=direct-input]", "GAP 4, 0")
     page.press("[data-testid=direct-input]", "Enter")
     page.locator("[data-testid=direct-reply]").wait_for()
@@ -113,7 +129,10 @@ def test_a_server_that_stopped_is_an_error_the_page_shows(served, page):
     page.evaluate("s => window.tmclEditor.setValue(s)", LOOP_WITH_WAIT)
     page.click("[data-testid=prog-download]")
     page.wait_for_function("document.querySelector('[data-testid=prog-message]').textContent.startsWith('no answer from the server')")
-    page.wait_for_timeout(500)
+    # And it goes on: its live stream, gone with the server, tries again
+    # every second (api.js); two more tries without an error in the page.
+    tries = len(sockets)
+    until(page, "two more tries of the live stream", lambda: len(sockets), lambda n: n >= tries + 2)
 
 
 def test_direct_mode_answers_in_words(served, page):
@@ -153,14 +172,14 @@ def test_direct_mode_answers_in_words(served, page):
 
 def test_a_line_typed_while_a_command_is_on_its_way_is_kept(served, page):
     open_app(page, served.url)
-    # The first command's reply is held back half a second (a slow link).
+    # The first command is held back until the test lets it go (a slow link).
     page.evaluate("""() => {
       const fetch = window.fetch;
       let first = true;
       window.fetch = async (url, init) => {
         if (first && String(url).endsWith("/command")) {
           first = false;
-          await new Promise((r) => setTimeout(r, 500));
+          await new Promise((r) => { window.letTheCommandGo = r; });
         }
         return fetch(url, init);
       };
@@ -168,6 +187,8 @@ def test_a_line_typed_while_a_command_is_on_its_way_is_kept(served, page):
     page.fill("[data-testid=direct-input]", "GAP 4, 0")
     page.press("[data-testid=direct-input]", "Enter")
     page.fill("[data-testid=direct-input]", "GGP 65, 0")
+    until_js(page, "the first command to be held", "() => !!window.letTheCommandGo", "() => String(window.letTheCommandGo)")
+    page.evaluate("() => window.letTheCommandGo()")
     replies = page.locator("[data-testid=direct-reply]")
     replies.nth(0).wait_for()
     assert page.input_value("[data-testid=direct-input]") == "GGP 65, 0", "the reply did not clear the next line"
@@ -312,9 +333,10 @@ def test_a_drag_zooms_and_pauses_the_view_while_the_samples_keep_coming(served, 
     view = "(() => { const u = window.tmclsimCharts.charts[0]; return [u.data[0].length, u.scales.x.min, u.scales.x.max]; })()"
     kept = page.evaluate("window.tmclsimCharts.t.length")
     frozen = page.evaluate(view)
-    page.wait_for_timeout(1000)
+    # 20 samples at 50 a second: several of the charts' redraws (every 100 ms).
+    until_js(page, "paused: the samples keep coming", "(n) => window.tmclsimCharts.t.length >= n",
+             "() => `${window.tmclsimCharts.t.length} samples`", arg=kept + 20)
     assert page.evaluate(view) == frozen, "paused and zoomed: the view stays"
-    assert page.evaluate("window.tmclsimCharts.t.length") >= kept + 20, "paused: the samples keep coming"
     page.click("[data-testid=chart-pause]")
     page.wait_for_function(f"window.tmclsimCharts.charts[0].data[0].length > {frozen[0]}")
     # The samples taken while paused are drawn: no hole in the time axis.
@@ -343,7 +365,7 @@ def test_each_scale_group_has_its_own_axis(served, page):
     open_app(page, served.url)
     tab(page, "charts")
     wait_samples(page, 20)
-    page.wait_for_timeout(300)
+    wait_drawn(page, 20)
     axes = page.evaluate("""Object.fromEntries(window.tmclsimCharts.charts.map((u) => [u.panel.title,
         u.axes.slice(1).map((a) => ({ scale: a.scale, label: a.label, min: u.scales[a.scale].min, max: u.scales[a.scale].max }))]))""")
     drawn_on = page.evaluate("Object.fromEntries(window.tmclsimCharts.charts.map((u) => [u.panel.title, u.series.slice(1).map((s) => s.scale)]))")
@@ -417,8 +439,7 @@ def test_one_module_found_among_a_thousand(page, fleet_dir, start):
     held = []
     page.route("**/api/modules/*/profile", lambda route: held.append(route))
     items.first.click()
-    while not held:
-        page.wait_for_timeout(20)
+    until(page, "the picked module's profile request", lambda: len(held))
     assert "address 1 " in page.inner_text("[data-testid=module-title]")
     page.fill("[data-testid=direct-input]", "SAP 4, 0, 1111")
     page.press("[data-testid=direct-input]", "Enter")
@@ -450,14 +471,10 @@ def test_charts_follow_a_chosen_motor_and_the_world_sets_an_analog_input(page, s
     page.select_option("[data-testid=chart-axis]", "2")
     with ConnectionManager(f"--interface socket_serial_tmcl --port {served.printed('tcp')}").connect() as interface:
         interface.send(1, 0, 2, 300)  # ROR 2, 300
-        for _ in range(100):
-            speed = interface.get_axis_parameter(3, 2)
-            if speed == 300:
-                break
-            page.wait_for_timeout(50)
-        assert speed == 300
+        until(page, "motor 2 at speed 300", lambda: interface.get_axis_parameter(3, 2), lambda v: v == 300)
         other = interface.get_axis_parameter(3, 0)
-    page.wait_for_timeout(500)
+    until_js(page, "motor 2's speed 300 in the charts", "() => (window.tmclsimCharts.store.get('ap:2:3') || []).at(-1) === 300",
+             "() => (window.tmclsimCharts.store.get('ap:2:3') || []).slice(-5)")
     # Motor 2's series start where it was chosen, with gaps before (never a
     # 0 that was not read); motor 0's samples are kept.
     motor2, motor0 = series(page, "ap:2:3"), series(page, "ap:0:3")
@@ -628,7 +645,8 @@ def test_speeds_and_accelerations_convert_with_the_modules_formula(served, page)
     with pytrinamic(served) as interface:
         assert interface.get_axis_parameter(2, 0) == 1678
     tab(page, "charts")
-    page.wait_for_timeout(500)
+    until_js(page, "the velocity chart to draw 60.01 rpm", "() => Math.abs(window.tmclsimCharts.charts[1].data[1]?.at(-1) - 60.00996) < 1e-4",
+             "() => window.tmclsimCharts.charts[1].data[1]?.slice(-3)")
     velocity = page.evaluate("(() => { const u = window.tmclsimCharts.charts[1]; return [u.axes[1].label, u.data[1][u.data[1].length - 1]]; })()")
     assert velocity[0] == "rpm" and abs(velocity[1] - 60.00996) < 1e-4, velocity
     head, *rows = csv_rows(page, "chart-velocity-csv")

@@ -8,7 +8,7 @@ import threading
 import urllib.parse
 
 import pytest
-from conftest import ROOT, open_app, shot, tab, text, wait_text
+from conftest import ROOT, open_app, shot, tab, text, until_js, wait_text
 
 PLAYGROUND = ROOT / "target" / "playground"
 # Served under a subpath, as from a project's pages.
@@ -110,7 +110,8 @@ def test_the_playground_runs_the_ide_in_the_page_from_static_files_only(playgrou
     wait_text(page, "ro-speed", "t === '400'")
     wait_text(page, "ro-position", "Number(t) > 1000")
     tab(page, "charts")
-    page.wait_for_timeout(500)
+    until_js(page, "the position chart to draw the motor's move", "() => window.tmclsimCharts.charts[0].data[1]?.at(-1) > 1000",
+             "() => window.tmclsimCharts.charts[0].data[1]?.slice(-3)")
     shot(page, "playground-charts")
     tab(page, "world")
     page.click("[data-testid=sw-right-press]")

@@ -11,7 +11,7 @@ import time
 import urllib.request
 
 import pytest
-from conftest import open_app, shot, tab, text, wait_text
+from conftest import open_app, shot, tab, text, until, wait_text
 from pytrinamic.connections import ConnectionManager
 from tmclsim_binary import tmclsim_binary
 
@@ -141,13 +141,31 @@ def test_a_long_error_wraps_and_the_page_stays_within_the_window(served, page):
 # --- tools -------------------------------------------------------------------
 
 
-def rotates(served, speed, seconds=1.5):
+def stopped(served, page):
+    """MST, and the motor at rest (AP 3 = 0)."""
+    tmcl(served, 3, 0, 0)
+    until(page, "the motor to stop after MST", lambda: tmcl(served, 6, 3, 0), lambda v: v == 0)
+
+
+def stalls(served, page, speed):
+    """ROR at `speed`: the motor moves, then stops by itself (a stall); then
+    MST. AP 207 stays unread (a read clears it, rule 52)."""
+    start = tmcl(served, 6, 1, 0)
+    tmcl(served, 1, 0, 0, speed)
+    until(page, f"the motor to move from {start} and stop by itself; (position, speed)", lambda: (tmcl(served, 6, 1, 0), tmcl(served, 6, 3, 0)),
+          lambda seen: seen[0] != start and seen[1] == 0)
+    stopped(served, page)
+
+
+def runs_on(served, page, speed, seconds=1.5):
     """Whether the motor still runs `seconds` after ROR at `speed`; then stopped."""
     tmcl(served, 1, 0, 0, speed)
+    # about time: no stall within 1.5 s, far longer than the ramp up to the
+    # speed (about 0.3 s at the default acceleration) after which a stall
+    # stops the motor (none while it accelerates, rule 78).
     time.sleep(seconds)
     running = tmcl(served, 6, 3, 0) != 0
-    tmcl(served, 3, 0, 0)
-    time.sleep(0.3)
+    stopped(served, page)
     return running
 
 
@@ -173,13 +191,13 @@ def test_the_stallguard2_tool_suggests_the_threshold_that_detects_the_stall(serv
     assert tmcl(served, 6, 174, 0) == threshold and tmcl(served, 6, 181, 0) == 250
     # At this threshold the load stops the motor (a stall, AP 207); one
     # above it does not, and without the load the motor runs on.
-    assert not rotates(served, 500)
+    stalls(served, page, 500)
     assert tmcl(served, 6, 207, 0) == 1
     tmcl(served, 5, 174, 0, threshold + 1)
-    assert rotates(served, 500)
+    assert runs_on(served, page, 500)
     tmcl(served, 5, 174, 0, threshold)
     world(served, "load 0 0")
-    assert rotates(served, 500)
+    assert runs_on(served, page, 500)
 
 
 @pytest.mark.parametrize("target", TARGETS)

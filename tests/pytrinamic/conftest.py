@@ -4,12 +4,11 @@ import pathlib
 import re
 import subprocess
 import sys
-import time
 
 import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from tmclsim_binary import ROOT, stop, tmclsim_binary  # noqa: E402,F401
+from tmclsim_binary import ROOT, read_banner, stop, tmclsim_binary  # noqa: E402,F401
 
 
 class Served:
@@ -19,17 +18,7 @@ class Served:
         self.pty_link = str(tmp_path / "tmcm-1141")
         cmd = [tmclsim_binary(), "serve", "--tcp", "127.0.0.1:0", "--pty", self.pty_link, *args]
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        self.banner = []
-        deadline = time.monotonic() + 30
-        while True:
-            line = self.proc.stdout.readline()
-            if not line:
-                raise RuntimeError("tmclsim serve exited: " + "".join(self.banner))
-            self.banner.append(line)
-            if line.startswith("connect with:"):
-                break
-            if time.monotonic() > deadline:
-                raise RuntimeError("tmclsim serve did not start")
+        self.banner = read_banner(self.proc)
         text = "".join(self.banner)
         self.tcp = re.search(r"tcp: (\S+)", text).group(1)
         control = re.search(r"control: (\S+)", text)

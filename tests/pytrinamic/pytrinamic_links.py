@@ -1,6 +1,7 @@
 """Helpers shared by the PyTrinamic tests: a connection over one of the
 served links, and waiting for a condition in wall-clock time."""
 
+import inspect
 import time
 
 from pytrinamic.connections import ConnectionManager
@@ -18,10 +19,29 @@ def connect(served, link):
     return ConnectionManager(args.split()).connect()
 
 
-def wait_until(predicate, timeout=20.0):
+def wait_until(predicate, timeout=20.0, what=None, seen=None):
+    """Polls `predicate()` until it is true (returns True). After `timeout`
+    seconds fails, naming `what` was awaited (by default the predicate's
+    source line) and what `seen()` gives then."""
     deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.01)
-    return False
+    while not predicate():
+        if time.monotonic() > deadline:
+            saw = f"; saw {seen()!r}" if seen else ""
+            raise AssertionError(f"waited {timeout} s for {what or _source(predicate)}{saw}")
+        time.sleep(0.01)  # the poll's interval
+    return True
+
+
+def _source(function):
+    try:
+        return inspect.getsource(function).strip()
+    except (OSError, TypeError):
+        return repr(function)
+
+
+def module_time_passes(module, ms):
+    """Waits until `ms` milliseconds of the module's own time pass (its tick
+    timer, GP 132): what a check that something does not happen waits for."""
+    start = module.get_global_parameter(132, 0)
+    wait_until(lambda: (module.get_global_parameter(132, 0) - start) % 2**31 >= ms, what=f"{ms} ms of the module's time (GP 132 from {start})",
+               seen=lambda: module.get_global_parameter(132, 0))

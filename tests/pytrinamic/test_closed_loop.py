@@ -2,10 +2,9 @@
 (its TMCM-1311 class is the closest host class; raw commands where the
 classes differ)."""
 
-import time
-
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1311
+from pytrinamic_links import wait_until
 
 
 def test_closed_loop_move_over_the_pty(serve):
@@ -20,10 +19,8 @@ def test_closed_loop_move_over_the_pty(serve):
         motor.set_axis_parameter(motor.AP.MaxVelocity, 51200)  # pps: one turn a second
         served.world("load 0 60")
         interface.move_to(0, 51200)
-        deadline = time.monotonic() + 10
-        while not interface.get_axis_parameter(8, 0):
-            assert time.monotonic() < deadline
-            time.sleep(0.01)
+        wait_until(lambda: interface.get_axis_parameter(8, 0), 10, "position reached (AP 8)",
+                   seen=lambda: f"position {motor.get_axis_parameter(motor.AP.ActualPosition, signed=True)}")
         assert motor.get_axis_parameter(motor.AP.ActualPosition, signed=True) == 51200
         assert motor.get_axis_parameter(motor.AP.CLPositionError, signed=True) == 0
         status = motor.get_axis_parameter(motor.AP.StatusWord)

@@ -3,10 +3,10 @@ instruction, as the LoadTMCLBinary pattern reads it), verifies it by reading
 the program memory back and starts it."""
 
 import subprocess
-import time
 
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1141
+from pytrinamic_links import wait_until
 
 from tmclsim_binary import tmclsim_binary
 
@@ -57,16 +57,15 @@ def test_pytrinamic_downloads_our_binary_and_runs_it(served, tmp_path):
             assert (r.module_address, r.status, r.command) == (op, typ, motor)
             assert r.value == value & 0xFFFFFFFF
         interface.send(129, 1, 0, 0)
-        deadline = time.monotonic() + 5
-        while module.get_global_parameter(7, 2) != 100:
-            assert time.monotonic() < deadline
-            time.sleep(0.01)
+        wait_until(lambda: module.get_global_parameter(7, 2) == 100, 10, "user variable 7 to count to 100", seen=lambda: module.get_global_parameter(7, 2))
         assert module.get_global_parameter(128, 0) == 1  # running
         seen = set()
-        deadline = time.monotonic() + 2
-        while len(seen) < 2 and time.monotonic() < deadline:
+
+        def out0_was_both():
             seen.add(module.get_digital_output(0))
-            time.sleep(0.01)
+            return len(seen) == 2
+
+        wait_until(out0_was_both, 10, "OUT0 to be both 0 and 1", seen=lambda: seen)
         assert seen == {0, 1}, "OUT0 blinks"
         interface.send(128, 0, 0, 0)
         assert module.get_global_parameter(128, 0) == 0

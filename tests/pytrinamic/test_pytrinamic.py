@@ -1,10 +1,8 @@
 """PyTrinamic 0.2.26 from the package registry against a virtual TMCM-1141,
 over TCP (socket_serial_tmcl) and over the pty (serial_tmcl)."""
 
-import time
-
 import pytest
-from pytrinamic_links import LINKS, connect, wait_until
+from pytrinamic_links import LINKS, connect, module_time_passes, wait_until
 from pytrinamic.modules import TMCM1141
 from pytrinamic.tmcl import TMCLReplyStatusError
 
@@ -47,10 +45,10 @@ def test_move_to_and_wait_for_position_reached(served, link):
         motor.linear_ramp.max_acceleration = 2047
         module.move_to(0, 20000)
         assert motor.get_position_reached() == 0
-        assert wait_until(lambda: motor.get_position_reached() == 1)
+        assert wait_until(lambda: motor.get_position_reached() == 1, seen=lambda: motor.actual_position)
         assert motor.actual_position == 20000
         motor.move_by(-5000)
-        assert wait_until(lambda: motor.get_position_reached() == 1)
+        assert wait_until(lambda: motor.get_position_reached() == 1, seen=lambda: motor.actual_position)
         assert motor.actual_position == 15000
 
 
@@ -60,17 +58,17 @@ def test_rotate_and_stop(served, link):
         module = TMCM1141(interface)
         motor = module.motors[0]
         module.rotate(0, 800)
-        assert wait_until(lambda: motor.actual_velocity == 800)
+        assert wait_until(lambda: motor.actual_velocity == 800, seen=lambda: motor.actual_velocity)
         p1 = motor.actual_position
-        time.sleep(0.05)
-        assert motor.actual_position > p1
+        assert wait_until(lambda: motor.actual_position > p1, what=f"the position to pass {p1}", seen=lambda: motor.actual_position)
         module.stop(0)
-        assert wait_until(lambda: motor.actual_velocity == 0)
+        assert wait_until(lambda: motor.actual_velocity == 0, seen=lambda: motor.actual_velocity)
         p2 = motor.actual_position
-        time.sleep(0.05)
+        # Stopped: the position stays while 50 ms of the module's time pass.
+        module_time_passes(module, 50)
         assert motor.actual_position == p2
         module.rotate(0, -300)
-        assert wait_until(lambda: motor.actual_velocity == -300)
+        assert wait_until(lambda: motor.actual_velocity == -300, seen=lambda: motor.actual_velocity)
         module.stop(0)
 
 

@@ -7,7 +7,6 @@ import re
 import shutil
 import subprocess
 import threading
-import time
 
 import pytest
 from pytrinamic.connections import ConnectionManager
@@ -17,17 +16,6 @@ from tmclsim_binary import stop, tmclsim_binary
 
 SOCAT = shutil.which("socat")
 pytestmark = pytest.mark.skipif(SOCAT is None, reason="socat is not installed (scripts/test installs it as root)")
-
-
-def poll(predicate, what, timeout=20.0):
-    """Waits for `predicate` with a generous deadline; fails saying what
-    was awaited."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return
-        time.sleep(0.02)
-    raise AssertionError(f"waited {timeout} s for {what}")
 
 
 class NullModem:
@@ -43,13 +31,15 @@ class NullModem:
     def plug(self):
         ends = [f"pty,rawer,link={end}" for end in (self.module_end, self.host_end)]
         self.proc = subprocess.Popen([SOCAT, *ends], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        poll(lambda: all(pathlib.Path(e).exists() for e in (self.module_end, self.host_end)), "socat's two ends")
+        ends = (self.module_end, self.host_end)
+        wait_until(lambda: all(pathlib.Path(e).exists() for e in ends), what="socat's two ends",
+                   seen=lambda: {e: pathlib.Path(e).exists() for e in ends} | {"socat's exit status": self.proc.poll()})
 
     def unplug(self):
         """The cable is gone: both ptys vanish (as a USB adapter does)."""
         self.proc.terminate()
         self.proc.wait(timeout=10)
-        poll(lambda: not pathlib.Path(self.module_end).exists(), "socat's ends to be removed")
+        wait_until(lambda: not pathlib.Path(self.module_end).exists(), what=f"socat's end {self.module_end} to be removed")
 
     def close(self):
         if self.proc.poll() is None:
@@ -66,7 +56,8 @@ class Serving:
         self.lines = []
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()
-        poll(lambda: any(line.startswith("connect with:") for line in self.lines) or self.proc.poll() is not None, "the banner")
+        wait_until(lambda: any(line.startswith("connect with:") for line in self.lines) or self.proc.poll() is not None,
+                   what="the banner", seen=self.text)
         assert self.proc.poll() is None, "".join(self.lines)
 
     def _read(self):
@@ -77,7 +68,7 @@ class Serving:
         return "".join(self.lines)
 
     def wait_for(self, pattern):
-        poll(lambda: re.search(pattern, self.text()), f"{pattern!r} in the output:\n{self.text()}")
+        wait_until(lambda: re.search(pattern, self.text()), what=f"{pattern!r} in the output", seen=self.text)
 
     def stop(self):
         stop(self.proc)
@@ -123,7 +114,7 @@ def test_pytrinamic_drives_a_module_on_the_other_end_of_the_line(null_modem, ser
         motor.linear_ramp.max_acceleration = 2047
         assert motor.linear_ramp.max_velocity == 2047
         module.move_to(0, 20000)
-        assert wait_until(lambda: motor.get_position_reached() == 1)
+        assert wait_until(lambda: motor.get_position_reached() == 1, seen=lambda: motor.actual_position)
         assert motor.actual_position == 20000
 
 

@@ -5,13 +5,12 @@ virtual module; one reply altered in the file is exactly one difference."""
 import json
 import re
 import subprocess
-import time
 
 import pytest
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1141
 from pytrinamic_links import wait_until
-from tmclsim_binary import stop, tmclsim_binary
+from tmclsim_binary import read_banner, stop, tmclsim_binary
 
 GAP_4 = "01 06 04 00 00 00 00 00 0B"  # GAP 4, 0: maximum positioning speed
 
@@ -23,14 +22,7 @@ def recording(served, tmp_path):
     trace = tmp_path / "session.jsonl"
     cmd = [tmclsim_binary(), "trace", "record", "--listen", "127.0.0.1:0", "--tcp", served.tcp, "--out", str(trace)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    banner = []
-    deadline = time.monotonic() + 30
-    while not banner or not banner[-1].startswith("connect with:"):
-        line = proc.stdout.readline()
-        if not line or time.monotonic() > deadline:
-            stop(proc)
-            raise RuntimeError("tmclsim trace record did not start: " + "".join(banner))
-        banner.append(line)
+    banner = read_banner(proc)
     listen = re.search(r"listen: (\S+)", "".join(banner)).group(1)
     yield proc, listen, trace
     stop(proc)

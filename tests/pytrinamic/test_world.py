@@ -8,6 +8,7 @@ import pytest
 from pytrinamic.connections import ConnectionManager
 from pytrinamic.modules import TMCM1141
 from pytrinamic.tmcl import TMCLReplyChecksumError
+from pytrinamic_links import module_time_passes, wait_until
 
 
 def pty_connection(served, timeout=5):
@@ -29,20 +30,15 @@ def test_homing_routine_over_the_pty(served):
         motor.set_axis_parameter(motor.AP.ReferenceSearchSpeed, 2047)
         motor.set_axis_parameter(motor.AP.ReferenceSwitchSpeed, 500)
         interface.send(13, 0, 0, 0)  # RFS START
-        deadline = time.monotonic() + 30
-        while interface.send(13, 2, 0, 0).value != 0:  # RFS STATUS
-            assert time.monotonic() < deadline, "homing did not finish"
-            time.sleep(0.02)
+        # RFS STATUS: 0 once the search is done.
+        wait_until(lambda: interface.send(13, 2, 0, 0).value == 0, 30, "the homing to finish", seen=lambda: f"position {motor.actual_position}")
         assert motor.actual_position == 0
         # The built-in stage's home switch spans 100000…110000: its middle
         # is where the position counter was 105000 before homing.
         assert motor.get_axis_parameter(motor.AP.LastReferenceSwitchPosition, signed=True) == 105000
         motor.linear_ramp.max_velocity = 2047
         module.move_to(0, -20000)
-        deadline = time.monotonic() + 10
-        while not motor.get_position_reached():
-            assert time.monotonic() < deadline
-            time.sleep(0.01)
+        wait_until(lambda: motor.get_position_reached(), 10, "position reached", seen=lambda: f"position {motor.actual_position}")
         assert motor.actual_position == -20000
 
 
@@ -58,7 +54,7 @@ def test_switches_and_inputs_from_the_control_socket(served):
         served.world("switch 0 right press")
         assert motor.get_axis_parameter(motor.AP.RightEndstop) == 1
         module.rotate(0, 500)
-        time.sleep(0.05)
+        module_time_passes(module, 50)
         assert motor.actual_velocity == 0, "the pressed right switch blocks positive motion"
         served.world("switch 0 right auto")
         assert "axis 0" in served.world("show 0")
