@@ -288,13 +288,18 @@ mod tests {
     fn a_late_reply_is_never_taken_for_the_next_requests() {
         let listener = TcpListener::bind("127.0.0.1:0").unwrap();
         let addr = listener.local_addr().unwrap().to_string();
+        // The host tells the module when it has given up on GAP 1; the
+        // module tells the host when the late reply is on its way.
+        let (gave_up, host_gave_up) = std::sync::mpsc::channel::<()>();
+        let (late_sent, late_reply_sent) = std::sync::mpsc::channel::<()>();
         let module = std::thread::spawn(move || {
             let (mut s, _) = listener.accept().unwrap();
             let mut request = [0u8; FRAME_LEN];
             // GAP 1: answered after the host gave up waiting.
             s.read_exact(&mut request).unwrap();
-            std::thread::sleep(Duration::from_millis(150));
+            host_gave_up.recv().unwrap();
             s.write_all(&reply(6, 111)).unwrap();
+            late_sent.send(()).unwrap();
             // SAP 4: answered at once.
             s.read_exact(&mut request).unwrap();
             s.write_all(&reply(5, 222)).unwrap();
@@ -310,7 +315,8 @@ mod tests {
         });
         let mut c = Client::open(Some(&addr), None, 9600, 1, Duration::from_millis(50)).unwrap();
         assert!(c.exchange(Instruction::new(6, 1, 0, 0)).unwrap_err().to_string().starts_with("no reply"));
-        std::thread::sleep(Duration::from_millis(200));
+        gave_up.send(()).unwrap();
+        late_reply_sent.recv().unwrap();
         assert_eq!(c.exchange(Instruction::new(5, 4, 0, 222)).unwrap(), reply(5, 222), "the late GAP reply was dropped");
         c.timeout = Duration::from_secs(2);
         assert_eq!(c.exchange(Instruction::new(10, 0, 0, 0)).unwrap(), reply(10, 444), "the late reply skipped");
