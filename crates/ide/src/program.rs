@@ -154,7 +154,10 @@ pub fn state_of(target: &dyn Target, id: usize) -> Result<Value, TargetError> {
     // rule 86): 135 types 1…3, then the user variables.
     let mut reads: Vec<Instruction> = (1..=3).map(|kind| Instruction::new(opcode::APPLICATION_STATUS, kind, 0, 0)).collect();
     reads.extend((0..variables).map(|n| Instruction::new(opcode::GGP, n, 2, 0)));
-    let (replies, _) = t.observe(id, &reads)?;
+    // The module's clock at the reads: a page that gets states by two ways
+    // (the answers to its requests, the live stream) shows the newest and
+    // drops one that comes late.
+    let (replies, time) = t.observe(id, &reads)?;
     for raw in &replies[..3] {
         check(raw)?;
     }
@@ -191,7 +194,7 @@ pub fn state_of(target: &dyn Target, id: usize) -> Result<Value, TargetError> {
         "errors": snap.as_ref().map(|s| s.program.errors),
         "stack_depth": snap.as_ref().map(|s| s.program.stack_depth),
         "breakpoint": breakpoint, "breakpoints": t.breakpoints(id), "user_variables": user,
-        "time": t.time(id),
+        "time": time,
     }))
 }
 

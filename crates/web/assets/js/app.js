@@ -26,6 +26,7 @@ const panels = {
 // Read by the tests.
 window.tmclsimCharts = panels.charts;
 window.tmclsimTools = panels.tools;
+window.tmclsimProgram = panels.program;
 let active = "direct";
 let live = null;
 // Per subscription id: which panel's signals are where in a sample.

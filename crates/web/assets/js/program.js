@@ -214,6 +214,16 @@ export class ProgramPanel {
   }
 
   showState(st) {
+    // States come by two ways, the answers to this page's requests and the
+    // live stream, and may arrive out of order: one older than the state
+    // shown (by the module's clock at its reads) is dropped, so a late
+    // answer to "run" cannot hide the breakpoint hit that followed it.
+    if (st && this.shownTime !== undefined && st.time < this.shownTime) {
+      const ps = document.getElementById("ps-mode").dataset;
+      ps.dropped = String(Number(ps.dropped ?? 0) + 1);
+      return;
+    }
+    this.shownTime = st ? st.time : undefined;
     const set = (id, v) => (document.getElementById(id).textContent = v ?? "–");
     if (this.current !== undefined) {
       this.editor.removeLineClass(this.current, "background", "cm-current-line");
