@@ -94,9 +94,32 @@ def page(browser, start):
     pg.on("request", lambda r: pg.unanswered.__setitem__(id(r), f"{r.method} {r.url}"))
     pg.on("requestfinished", lambda r: pg.unanswered.pop(id(r), None))
     pg.on("requestfailed", lambda r: pg.failed.append(f"{r.method} {r.url}: {r.failure}") or pg.unanswered.pop(id(r), None))
+    # The helpers below that report on their own wait with the plain one.
+    pg.wait_for_function_plain = pg.wait_for_function
+    pg.wait_for_function = reporting(pg, pg.wait_for_function)
     yield pg
     context.close()
     assert not errors, f"errors in the page: {errors}"
+
+
+def reporting(page, wait_for_function):
+    """`page.wait_for_function` that, when its deadline passes, fails with
+    what the elements its expression looks at held then (their text and
+    data attributes), not Playwright's bare "Timeout exceeded"."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    def wait(expression, *args, **kwargs):
+        try:
+            return wait_for_function(expression, *args, **kwargs)
+        except PlaywrightTimeout:
+            ids = sorted(set(re.findall(r"data-testid=([\w-]+)", expression)))
+            seen = page.evaluate("""(ids) => Object.fromEntries(ids.map((id) => {
+                const e = document.querySelector(`[data-testid=${id}]`);
+                return [id, e ? { text: e.textContent.slice(0, 200), data: { ...e.dataset } } : null];
+            }))""", ids)
+            raise AssertionError(f"waited for {expression!r}; saw {seen}") from None
+
+    return wait
 
 
 def open_app(page, url):
@@ -104,7 +127,7 @@ def open_app(page, url):
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
     try:
-        page.wait_for_function("window.tmclsimReady === true")
+        getattr(page, "wait_for_function_plain", page.wait_for_function)("window.tmclsimReady === true")
     except PlaywrightTimeout:
         unanswered = list(getattr(page, "unanswered", {}).values())
         raise AssertionError(f"the app did not get ready: unanswered {unanswered}, failed {getattr(page, 'failed', [])}") from None
@@ -142,7 +165,7 @@ def until_js(page, what, condition, seen, arg=None, timeout=10):
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
     try:
-        page.wait_for_function(condition, arg=arg, timeout=timeout * 1000)
+        getattr(page, "wait_for_function_plain", page.wait_for_function)(condition, arg=arg, timeout=timeout * 1000)
     except PlaywrightTimeout:
         raise AssertionError(f"waited {timeout} s for {what}; saw {page.evaluate(seen, arg)!r}") from None
 

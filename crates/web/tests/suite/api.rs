@@ -5,7 +5,7 @@
 use crate::common;
 use std::io::Write;
 
-use common::{Served, ask, eventually, get, post, post_text};
+use common::{Served, ask, get, post, post_text, until};
 use serde_json::{Value, json};
 use tmclsim_protocol::Status;
 
@@ -159,15 +159,12 @@ fn a_breakpoint_stops_the_program_on_its_line_with_the_accumulator_shown() {
     let (_, st) = post(&m("breakpoints"), json!({"addresses": [2]}));
     assert_eq!(st["breakpoints"], json!([2]));
     post(&m("run"), json!({}));
-    assert!(eventually(5.0, || get(&m("state")).1["breakpoint"] == 2));
+    until("the breakpoint hit", || get(&m("state")).1, |st| st["breakpoint"] == 2);
     let (_, st) = get(&m("state"));
     assert_eq!((st["pc"].as_u64(), st["accumulator"].as_i64()), (Some(2), Some(1)));
     assert!(st["stack_depth"].is_number() && st["flags"].is_string(), "a virtual module shows flags and stack depth: {st}");
     post(&m("continue"), json!({}));
-    assert!(eventually(5.0, || {
-        let st = get(&m("state")).1;
-        st["accumulator"] == 2 && st["breakpoint"] == 2
-    }));
+    until("the next hit, accumulator 2", || get(&m("state")).1, |st| st["accumulator"] == 2 && st["breakpoint"] == 2);
     // Stopped (128) on the breakpoint's address, the program no longer
     // stands at a breakpoint: the next run must not look paused there.
     let (_, st) = post(&m("stop"), json!({}));
@@ -182,13 +179,14 @@ fn the_world_panel_stops_the_motor_with_a_switch() {
     let s = Served::new();
     let mut host = s.host();
     assert_eq!(ask(&mut host, "ROL 0, 500").status, 100);
-    assert!(eventually(5.0, || get(&s.url("/api/modules/0/world")).1["axes"][0]["speed"].as_i64().unwrap_or(0) < 0));
+    until("the motor turning left", || get(&s.url("/api/modules/0/world")).1["axes"][0].clone(), |a| a["speed"].as_i64().unwrap_or(0) < 0);
     let (code, r) = post(&s.url("/api/modules/0/world"), json!({"line": "switch 0 left press"}));
     assert_eq!(code, 200, "{r}");
-    assert!(eventually(5.0, || {
-        let (_, w) = get(&s.url("/api/modules/0/world"));
-        w["axes"][0]["left"] == true && w["axes"][0]["speed"] == 0
-    }));
+    until(
+        "the left switch pressed and the motor stopped",
+        || get(&s.url("/api/modules/0/world")).1["axes"][0].clone(),
+        |a| a["left"] == true && a["speed"] == 0,
+    );
     let (code, r) = post(&s.url("/api/modules/0/world"), json!({"line": "switch 0 sideways press"}));
     assert_eq!(code, 400, "{r}");
 }
@@ -325,7 +323,7 @@ fn a_module_in_its_bootloader_is_shown_as_such_and_its_tools_are_refused_with_th
     // A host starts a firmware update: 242 with its key, no reply.
     let mut host = s.host();
     host.write_all(&tmclsim_protocol::Request::new(1, tmclsim_protocol::mnemonic::parse_line("BOOT").unwrap()).encode()).unwrap();
-    assert!(eventually(10.0, || get(&s.url("/api/modules")).1[0]["bootloader"] == "1141B106"), "the module list says bootloader");
+    until("the module list to say bootloader", || get(&s.url("/api/modules")).1[0].clone(), |m| m["bootloader"] == "1141B106");
     let (code, body) = post(&s.url("/api/modules/0/command"), json!({"line": "GAP 1, 0"}));
     assert_eq!(code, 409);
     assert!(body["error"].as_str().unwrap().contains("in its bootloader (1141B106)"), "{body}");
@@ -333,6 +331,6 @@ fn a_module_in_its_bootloader_is_shown_as_such_and_its_tools_are_refused_with_th
     assert_eq!(code, 409);
     // BOOT_START_APPL with the firmware untouched: the tools are back.
     host.write_all(&tmclsim_protocol::Request::new(1, tmclsim_protocol::Instruction::new(205, 0, 0, 0)).encode()).unwrap();
-    assert!(eventually(10.0, || get(&s.url("/api/modules")).1[0]["bootloader"].is_null()));
+    until("the module list to say firmware", || get(&s.url("/api/modules")).1[0].clone(), |m| m["bootloader"].is_null());
     assert_eq!(post(&s.url("/api/modules/0/command"), json!({"line": "GAP 1, 0"})).0, 200);
 }

@@ -58,7 +58,7 @@ fn connections_past_the_limit_are_answered_503() {
     let answer = read_to_close(&mut fifth);
     assert!(answer.starts_with("HTTP/1.1 503") && answer.contains("4 connections at once"), "{answer}");
     drop(held);
-    assert!(common::eventually(2.0, || get(&s.url("/api/info")).0 == 200));
+    common::until("/api/info answered once the four closed", || get(&s.url("/api/info")).0, |code| *code == 200);
 }
 
 #[test]

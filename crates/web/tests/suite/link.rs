@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::{Served, app_on_loopback, app_over_tcp, eventually, get, post, post_text};
+use common::{Served, app_on_loopback, app_over_tcp, get, post, post_text, until};
 use serde_json::json;
 use std::time::Duration;
 use tmclsim_web::LinkTarget;
@@ -36,12 +36,12 @@ fn a_served_module_over_tcp_lists_answers_and_stops_at_breakpoints() {
     assert!(last.trim_end().ends_with("}") && last.contains("\"verified\":true"), "{last}");
     post(&url("/api/modules/0/program/breakpoints"), json!({"addresses": [3]}));
     post(&url("/api/modules/0/program/run"), json!({}));
-    assert!(eventually(5.0, || get(&url("/api/modules/0/program/state")).1["breakpoint"] == 3));
+    until("the breakpoint hit", || get(&url("/api/modules/0/program/state")).1, |st| st["breakpoint"] == 3);
     let (_, st) = get(&url("/api/modules/0/program/state"));
     assert_eq!((st["pc"].as_u64(), st["accumulator"].as_i64()), (Some(3), Some(2)));
     assert!(st["flags"].is_null(), "TMCL does not report flags");
     post(&url("/api/modules/0/program/continue"), json!({}));
-    assert!(eventually(5.0, || get(&url("/api/modules/0/program/state")).1["accumulator"] == 4));
+    until("accumulator 4", || get(&url("/api/modules/0/program/state")).1, |st| st["accumulator"] == 4);
     post(&url("/api/modules/0/program/stop"), json!({}));
 }
 
@@ -152,14 +152,7 @@ fn stops_every_time(url: &dyn Fn(&str) -> String) {
     post(&url("/api/modules/0/program/breakpoints"), json!({"addresses": [2]}));
     post(&url("/api/modules/0/program/run"), json!({}));
     for round in 1..=3 {
-        let mut st = serde_json::Value::Null;
-        assert!(
-            eventually(5.0, || {
-                st = get(&url("/api/modules/0/program/state")).1;
-                st["breakpoint"] == 2
-            }),
-            "round {round}: {st}"
-        );
+        let st = until(&format!("round {round}: the hit"), || get(&url("/api/modules/0/program/state")).1, |st| st["breakpoint"] == 2);
         assert_eq!((st["pc"].as_u64(), st["accumulator"].as_i64()), (Some(2), Some(11 * round - 10)), "round {round}: {st}");
         assert_ne!(st["mode"], "running");
         let (_, st) = post(&url("/api/modules/0/program/continue"), json!({}));

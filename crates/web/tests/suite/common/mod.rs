@@ -93,14 +93,16 @@ pub fn ask(s: &mut TcpStream, line: &str) -> Reply {
     Reply::decode(&buf).expect("reply checksum")
 }
 
-/// Polls `f` until it is true, for at most `seconds` of wall time.
-pub fn eventually(seconds: f64, mut f: impl FnMut() -> bool) -> bool {
-    let end = std::time::Instant::now() + std::time::Duration::from_secs_f64(seconds);
-    while std::time::Instant::now() < end {
-        if f() {
-            return true;
+/// Polls `probe` until `ok` takes its value, for at most 10 s of wall
+/// time: the value, or a failure naming `what` and the last value seen.
+pub fn until<T: std::fmt::Debug>(what: &str, mut probe: impl FnMut() -> T, ok: impl Fn(&T) -> bool) -> T {
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    loop {
+        let value = probe();
+        if ok(&value) {
+            return value;
         }
+        assert!(std::time::Instant::now() < end, "waited 10 s for {what}; last saw {value:?}");
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
-    false
 }
