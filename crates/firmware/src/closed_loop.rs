@@ -70,7 +70,7 @@ impl Motor<'_> {
     /// Virtual position minus rotor position, µsteps.
     pub(crate) fn lag(&self) -> f64 {
         let axis = self.axis;
-        (axis.closed_loop.sync_offset - axis.mech_offset) * self.at.shaft_sign()
+        (axis.closed_loop.sync_offset - axis.mech_offset) * self.shaft_sign()
     }
 
     /// The world's load on the carriage now (% of the rated torque).
@@ -107,7 +107,7 @@ impl Motor<'_> {
         let counts = self.encoder_now();
         // The counter and the rotor agreed at `sync_offset`.
         let mech = counts / f64::from(p[cl::ENCODER_RESOLUTION as usize].max(1)) * per_rev;
-        (mech - self.axis.closed_loop.sync_offset) * self.at.shaft_sign()
+        (mech - self.axis.closed_loop.sync_offset) * self.shaft_sign()
     }
 
     /// Torque available at a current scale (% of rated torque).
@@ -244,7 +244,7 @@ impl MotorMut<'_> {
         let p = self.axis.params;
         let units = self.view().units();
         let load = self.view().load();
-        let sign = self.at.shaft_sign();
+        let sign = self.view().shaft_sign();
         let before = self.view().mechanical_position() - moved * sign;
         if self.view().closed_loop_on() {
             let (lo, hi) = (f64::from(p[cl::SCALE_MIN as usize].clamp(0, 100)), f64::from(p[cl::SCALE_MAX as usize].clamp(0, 100)));

@@ -239,7 +239,7 @@ impl MotorMut<'_> {
             alarms.deviation = self.closed_loop_step(moved, dt, slips);
             return alarms;
         }
-        let sign = self.at.shaft_sign();
+        let sign = self.view().shaft_sign();
         if slips {
             self.axis.mech_offset -= moved * sign;
         }
@@ -267,8 +267,9 @@ impl MotorMut<'_> {
     /// turns on, the carriage stands at the end.
     pub(crate) fn keep_within_travel(&mut self) {
         if self.world.travel.is_some() {
+            let sign = self.view().shaft_sign();
             let axis = &mut *self.axis;
-            let mech = axis.motion.x * self.at.shaft_sign() + axis.mech_offset;
+            let mech = axis.motion.x * sign + axis.mech_offset;
             axis.mech_offset += self.world.within_travel(mech) - mech;
         }
     }

@@ -20,9 +20,11 @@ pub mod motion;
 mod motor;
 mod outcome;
 mod parameter_numbers;
+mod phase;
 pub use tmclsim_profile as profile;
 pub mod program;
 pub mod reference_search;
+pub mod sixpoint;
 pub mod snapshot;
 mod state;
 #[cfg(test)]

@@ -6,9 +6,9 @@
 
 use crate::motion::{self, RampMode};
 use crate::motor::{Motor, MotorMut};
-use crate::parameter_numbers::ap;
+use crate::parameter_numbers::{ap, sp};
 use crate::reference_search::{SearchAxis, Switch};
-use tmclsim_profile::MotionUnits;
+use tmclsim_profile::{MotionController, MotionUnits};
 
 impl Motor<'_> {
     /// AP 1: the position counter.
@@ -26,7 +26,24 @@ impl Motor<'_> {
                 ramp_div: self.axis.params[ap::RAMP_DIVISOR as usize].clamp(0, 13) as u32,
             },
             MotionUnits::Pps => motion::Units::Pps,
+            MotionUnits::Sixpoint => motion::Units::Sixpoint {
+                fclk: self.at.features().motion_clock_hz,
+                internal: self.axis.params[sp::UNIT_MODE as usize] == 0,
+            },
         }
+    }
+
+    /// The sixPoint motion controller drives this axis: its own rows
+    /// number the soft stop, the switch polarities and swap, and the
+    /// shaft's direction (docs/behaviour.md rule 108).
+    pub(crate) fn six_point(&self) -> bool {
+        self.at.features().motion_controller == MotionController::Sixpoint
+    }
+
+    /// −1 with the motor's direction reversed (GP 90; AP 251 on a
+    /// sixPoint module), else 1.
+    pub(crate) fn shaft_sign(&self) -> f64 {
+        if self.six_point() { if self.axis.params[sp::REVERSE_SHAFT as usize] == 1 { -1.0 } else { 1.0 } } else { self.at.shaft_sign() }
     }
 
     /// AP 3: the actual speed in the module's velocity units.
@@ -47,7 +64,7 @@ impl Motor<'_> {
 
     /// Mechanical position of the carriage for a motor position.
     pub(crate) fn mech(&self, x: f64) -> f64 {
-        x * self.at.shaft_sign() + self.axis.mech_offset
+        x * self.shaft_sign() + self.axis.mech_offset
     }
 
     /// Logical switch states (after GP 79 polarity): (left, right, home).
@@ -58,13 +75,24 @@ impl Motor<'_> {
     /// The switch states with the motor at `x`.
     pub(crate) fn switches_at(&self, x: f64) -> (bool, bool, bool) {
         let w = self.world;
-        let invert = self.at.switches_inverted();
-        if !w.has_switch_positions() {
+        let (left, right, home) = if !w.has_switch_positions() {
             // Only levels driven by hand: the same everywhere.
-            return (w.forced_left.unwrap_or(false) ^ invert, w.forced_right.unwrap_or(false) ^ invert, w.forced_home.unwrap_or(false));
+            (w.forced_left.unwrap_or(false), w.forced_right.unwrap_or(false), w.forced_home.unwrap_or(false))
+        } else {
+            let m = self.mech(x);
+            (w.left_pressed(m), w.right_pressed(m), w.home_pressed(m))
+        };
+        if self.six_point() {
+            // Each switch has its polarity (AP 25 left, AP 24 right); AP 14
+            // swaps what the two inputs mean.
+            let p = &self.axis.params;
+            let (left, right) = if p[sp::SWAP_SWITCHES as usize] == 1 { (right, left) } else { (left, right) };
+            let left = left ^ (p[sp::LEFT_SWITCH_POLARITY as usize] == 1);
+            let right = right ^ (p[sp::RIGHT_SWITCH_POLARITY as usize] == 1);
+            return (left, right, home);
         }
-        let m = self.mech(x);
-        (w.left_pressed(m) ^ invert, w.right_pressed(m) ^ invert, w.home_pressed(m))
+        let invert = self.at.switches_inverted();
+        (left ^ invert, right ^ invert, home)
     }
 
     /// What the switches stop with the motor at `x` (AP 12/13, AP 149).
@@ -78,7 +106,7 @@ impl Motor<'_> {
         motion::Stops {
             block_positive: right && p[ap::RIGHT_SWITCH_DISABLE as usize] == 0,
             block_negative: left && p[ap::LEFT_SWITCH_DISABLE as usize] == 0,
-            soft: p[ap::SOFT_STOP as usize] == 1,
+            soft: p[if self.six_point() { sp::SOFT_STOP } else { ap::SOFT_STOP } as usize] == 1,
         }
     }
 
@@ -132,6 +160,8 @@ impl Motor<'_> {
             ap::LOAD_VALUE => axis.driver.load_value,
             ap::ENCODER_POSITION if self.at.features().encoder != tmclsim_profile::Encoder::None => self.encoder_position(),
             ap::DRIVER_ERROR_FLAGS => self.driver_flags(),
+            // The measured speed: µsteps per second, whatever the unit mode.
+            sp::MEASURED_SPEED if self.six_point() => motion.v as i32,
             _ => axis.params[param as usize],
         }
     }
@@ -144,7 +174,7 @@ impl Motor<'_> {
             return (edges, 0);
         }
         let offset = self.axis.mech_offset;
-        let sign = self.at.shaft_sign();
+        let sign = self.shaft_sign();
         let mut count = 0;
         for m in self.world.thresholds().take(edges.len()) {
             edges[count] = (m - offset) * sign;
@@ -170,7 +200,7 @@ impl MotorMut<'_> {
     /// does not move; the target stays where AP 0 says.
     pub(crate) fn set_counter(&mut self, value: i32) {
         let target = self.axis.target_word;
-        let sign = self.at.shaft_sign();
+        let sign = self.view().shaft_sign();
         let axis = &mut *self.axis;
         let mech = axis.motion.x * sign + axis.mech_offset;
         axis.motion.x = f64::from(value);

@@ -11,6 +11,14 @@
 //! known in closed form, so advancing an hour of virtual time costs a handful
 //! of phases, not millions of ticks. Positions are kept unwrapped in `f64`
 //! and snapped to the exact target on arrival.
+//!
+//! The sixPoint ramp of the TMC5130/TMC5160 modules plans its phases in
+//! [`crate::sixpoint`] on the same machinery.
+
+pub use crate::phase::Stops;
+use crate::phase::{EPS_LAND, EPS_POS, EPS_VEL, Phase, Sgn, Shape};
+use crate::sixpoint::Now;
+pub use crate::sixpoint::SixPoint;
 
 /// The TMC429's clock in Hz: velocities and accelerations in internal units
 /// scale with it (pulse and ramp divisors, AP 154 and AP 153).
@@ -69,6 +77,29 @@ pub enum Units {
     },
     /// Microsteps per second (per second²), as written.
     Pps,
+    /// The TMC5130/TMC5160's (docs/behaviour.md rule 104): a value is
+    /// what the module writes into the chip's register, VMAX-like
+    /// `v·f_CLK/2^24` µsteps/s and AMAX-like `a·f_CLK²/2^41` µsteps/s².
+    /// With `internal` (AP 255 = 0) the values are the registers; else
+    /// (pps) the module turns a step rate into the nearest register
+    /// value (an acceleration into at least 1) and a register back into
+    /// the nearest step rate.
+    Sixpoint {
+        /// The chip's clock, Hz.
+        fclk: u32,
+        /// AP 255 = 0: the chip's internal units.
+        internal: bool,
+    },
+}
+
+/// µsteps per second of one sixPoint velocity unit at `fclk`.
+fn six_point_velocity_unit(fclk: f64) -> f64 {
+    fclk * pow2(-24)
+}
+
+/// µsteps per second² of one sixPoint acceleration unit at `fclk`.
+fn six_point_accel_unit(fclk: f64) -> f64 {
+    fclk * fclk * pow2(-41)
 }
 
 impl Units {
@@ -77,7 +108,7 @@ impl Units {
     pub fn max_value(self) -> i32 {
         match self {
             Units::Tmc429 { .. } => 2047,
-            Units::Pps => i32::MAX,
+            Units::Pps | Units::Sixpoint { .. } => i32::MAX,
         }
     }
 
@@ -86,6 +117,11 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, .. } => velocity_pps(v, pulse_div),
             Units::Pps => v,
+            Units::Sixpoint { fclk, internal } => {
+                let unit = six_point_velocity_unit(f64::from(fclk));
+                let register = if internal { v } else { (v / unit).round() };
+                register * unit
+            }
         }
     }
 
@@ -94,6 +130,12 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, .. } => velocity_internal(pps, pulse_div),
             Units::Pps => pps,
+            Units::Sixpoint { fclk, internal } => {
+                // The chip's velocity register holds whole units (towards zero).
+                let unit = six_point_velocity_unit(f64::from(fclk));
+                let register = (pps / unit + pps.sgn() * 1e-9).trunc();
+                if internal { register } else { (register * unit).round() }
+            }
         }
     }
 
@@ -102,6 +144,11 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, ramp_div } => accel_pps2(a, ramp_div, pulse_div),
             Units::Pps => a,
+            Units::Sixpoint { fclk, internal } => {
+                let unit = six_point_accel_unit(f64::from(fclk));
+                let register = if internal { a } else { (a / unit).round().max(if a > 0.0 { 1.0 } else { 0.0 }) };
+                register * unit
+            }
         }
     }
 
@@ -110,6 +157,10 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, ramp_div } => accel_internal(pps2, ramp_div, pulse_div),
             Units::Pps => pps2,
+            Units::Sixpoint { fclk, internal } => {
+                let value = pps2 / six_point_accel_unit(f64::from(fclk));
+                if internal { value } else { pps2 }
+            }
         }
     }
 
@@ -119,6 +170,7 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, ramp_div } => accel_pps2(positioning_accel(a, ramp_div, pulse_div), ramp_div, pulse_div),
             Units::Pps => f64::from(a),
+            Units::Sixpoint { .. } => self.accel_pps2(f64::from(a)),
         }
     }
 }
@@ -135,24 +187,6 @@ fn floor_i64(x: f64) -> i64 {
 fn ceil_i64(x: f64) -> i64 {
     let t = x as i64;
     if (t as f64) < x { t.saturating_add(1) } else { t }
-}
-
-/// Sign of a velocity or distance: −1, 0 or +1 (`f64::signum` gives +1
-/// for 0).
-trait Sgn {
-    fn sgn(self) -> f64;
-}
-
-impl Sgn for f64 {
-    fn sgn(self) -> f64 {
-        if self > 0.0 {
-            1.0
-        } else if self < 0.0 {
-            -1.0
-        } else {
-            0.0
-        }
-    }
 }
 
 /// What happened during one `advance`.
@@ -204,60 +238,19 @@ pub struct Ramp {
     pub accel_velocity: f64,
     /// AP 2 in µsteps/s.
     pub target_velocity: f64,
+    /// The sixPoint ramp's other values on a sixPoint module; `None`: the
+    /// TMC429's trapezoid (docs/behaviour.md rule 104).
+    pub six: Option<SixPoint>,
 }
 
-/// What the stop switches allow right now.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Stops {
-    /// Positive motion is blocked (right switch active and enabled).
-    pub block_positive: bool,
-    /// Negative motion is blocked (left switch active and enabled).
-    pub block_negative: bool,
-    /// AP 149: decelerate instead of stopping at once.
-    pub soft: bool,
-}
-
-impl Stops {
-    fn blocks(&self, dir: f64) -> bool {
-        (dir > 0.0 && self.block_positive) || (dir < 0.0 && self.block_negative)
+impl Ramp {
+    /// The standstill after a stop before the motor moves again, seconds
+    /// (the sixPoint ramp wait; none on the TMC429).
+    fn zero_wait(&self) -> f64 {
+        self.six.map_or(0.0, |s| s.zero_wait)
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Shape {
-    /// Constant acceleration (µsteps/s²).
-    Accel(f64),
-    /// Soft-mode approach: `d(t) = d0·e^(−kt)` towards the target.
-    Exponential { k: f64 },
-    /// An immediate change of velocity (hard stop, stop-speed steps).
-    Jump(f64),
-}
-
-#[derive(Clone, Copy, Debug)]
-struct Phase {
-    shape: Shape,
-    /// Seconds; `INFINITY` for "until something changes".
-    duration: f64,
-    /// At the end of the phase the motor stands on its target.
-    arrives: bool,
-}
-
-impl Phase {
-    fn accel(a: f64, duration: f64) -> Phase {
-        Phase { shape: Shape::Accel(a), duration: duration.max(0.0), arrives: false }
-    }
-
-    fn jump(v: f64) -> Phase {
-        Phase { shape: Shape::Jump(v), duration: 0.0, arrives: false }
-    }
-}
-
-const EPS_POS: f64 = 1e-6;
-const EPS_VEL: f64 = 1e-9;
-/// A braking ramp that ends this close to the target (µsteps) ends on it:
-/// ramps split into many steps (a step per millisecond, a switch edge)
-/// collect float dust.
-const EPS_LAND: f64 = 1e-2;
 /// Phases one `advance` may walk through; a guard against float dust.
 const MAX_PHASES: usize = 64;
 
@@ -276,11 +269,14 @@ pub struct Motion {
     pub target: f64,
     /// The motor was stopped by a stop switch and has not moved since.
     pub stopped_by_switch: bool,
+    /// Seconds of the ramp wait left before the motor may move again
+    /// (sixPoint TZEROWAIT, from its last stop).
+    pub zero_wait: f64,
 }
 
 impl Default for Motion {
     fn default() -> Self {
-        Motion { x: 0.0, v: 0.0, a: 0.0, mode: RampMode::Position, target: 0.0, stopped_by_switch: false }
+        Motion { x: 0.0, v: 0.0, a: 0.0, mode: RampMode::Position, target: 0.0, stopped_by_switch: false, zero_wait: 0.0 }
     }
 }
 
@@ -354,12 +350,14 @@ impl Motion {
                     step.crossed = Some(th);
                     if was_moving && self.v == 0.0 {
                         step.stopped_at = Some(elapsed);
+                        self.zero_wait = ramp.zero_wait();
                     }
                     break;
                 }
             }
             if was_moving && self.v == 0.0 {
                 step.stopped_at = Some(elapsed);
+                self.zero_wait = ramp.zero_wait();
             }
         }
         if self.v != 0.0 {
@@ -418,6 +416,10 @@ impl Motion {
                 self.v = v;
                 self.a = 0.0;
             }
+            Shape::Wait => {
+                self.a = 0.0;
+                self.zero_wait = (self.zero_wait - t).max(0.0);
+            }
             Shape::Exponential { k } => {
                 let f = (-k * t).exp();
                 let d = self.target - self.x;
@@ -454,7 +456,7 @@ impl Motion {
                     if lo > 1e-12 { lo } else { hi }
                 }
             }
-            Shape::Jump(_) => return None,
+            Shape::Jump(_) | Shape::Wait => return None,
             Shape::Exponential { k } => {
                 let d0 = self.target - self.x;
                 let d1 = self.target - th;
@@ -470,6 +472,14 @@ impl Motion {
     /// The phase the ramp generator is in now; `None` when standing still
     /// with nothing to do.
     fn plan(&self, ramp: &Ramp, stops: &Stops) -> Option<Phase> {
+        if let Some(six) = &ramp.six {
+            let now = Now { x: self.x, v: self.v, target: self.target, zero_wait: self.zero_wait };
+            return if self.mode == RampMode::Velocity {
+                six.plan_velocity(&now, ramp.target_velocity, ramp.accel_velocity, stops)
+            } else {
+                six.plan_position(&now, ramp.vmax, ramp.accel_position, stops)
+            };
+        }
         match self.mode {
             RampMode::Velocity => self.plan_velocity(ramp, stops),
             RampMode::Position | RampMode::Soft => self.plan_position(ramp, stops),
@@ -649,7 +659,7 @@ mod tests {
     }
 
     fn ramp(vmax: f64, a: f64, vmin: f64) -> Ramp {
-        Ramp { vmax, vmin, accel_position: a, accel_velocity: a, target_velocity: 0.0 }
+        Ramp { vmax, vmin, accel_position: a, accel_velocity: a, target_velocity: 0.0, six: None }
     }
 
     fn run_to_target(m: &mut Motion, r: &Ramp, step: f64) -> f64 {

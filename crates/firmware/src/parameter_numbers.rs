@@ -105,3 +105,37 @@ pub mod gp {
     /// and GIO.
     pub const SUPPRESS_REPLY: u8 = 255;
 }
+
+/// Axis parameter numbers of the sixPoint modules (TMC5130/TMC5160) that
+/// the TMC429 modules number otherwise or lack: the sixPoint motion
+/// controller's own rows (docs/behaviour.md rules 104–110).
+pub mod sp {
+    /// Swap the left and right limit switches.
+    pub const SWAP_SWITCHES: u8 = 14;
+    /// A1: the acceleration below V1.
+    pub const A1: u8 = 15;
+    /// V1: where A1 gives way to AMAX, DMAX to D1.
+    pub const V1: u8 = 16;
+    /// DMAX: the deceleration above V1.
+    pub const DMAX: u8 = 17;
+    /// D1: the deceleration below V1.
+    pub const D1: u8 = 18;
+    /// VSTART: the speed a move starts at.
+    pub const VSTART: u8 = 19;
+    /// VSTOP: the speed at which the motor stops.
+    pub const VSTOP: u8 = 20;
+    /// TZEROWAIT: the standstill after a stop, in 512 clock cycles.
+    pub const RAMP_WAIT: u8 = 21;
+    /// Right limit switch polarity (1: inverted).
+    pub const RIGHT_SWITCH_POLARITY: u8 = 24;
+    /// Left limit switch polarity (1: inverted).
+    pub const LEFT_SWITCH_POLARITY: u8 = 25;
+    /// Soft stop at a limit switch (1: decelerate).
+    pub const SOFT_STOP: u8 = 26;
+    /// The measured speed, pps.
+    pub const MEASURED_SPEED: u8 = 29;
+    /// Reverse the motor's direction.
+    pub const REVERSE_SHAFT: u8 = 251;
+    /// Unit mode: 0 the chip's internal units, 1 pps.
+    pub const UNIT_MODE: u8 = 255;
+}

@@ -136,6 +136,14 @@ pub enum FeatureProblem {
         /// The row's name.
         name: String,
     },
+    /// `motion_units` and `motion_controller` do not go together: the
+    /// sixPoint controller has the sixPoint units, and only it.
+    Units {
+        /// The profile's motion controller.
+        controller: crate::features::MotionController,
+        /// The profile's units.
+        units: crate::features::MotionUnits,
+    },
     /// `version_text` is not 8 ASCII characters.
     VersionText {
         /// The text as the profile gives it.
@@ -203,8 +211,15 @@ impl fmt::Display for FeatureProblem {
                 f.write_str("features.encoder_deviation_stop needs an encoder (features.encoder is \"none\")")
             }
             FeatureProblem::QuantityInPps { number, name } => {
-                write!(f, "axis parameter {number} ({name}) has a `quantity` (TMC429 units), but features.motion_units is \"pps\"")
+                write!(f, "axis parameter {number} ({name}) has a `quantity` (TMC429 units), but features.motion_units is not \"tmc429\"")
             }
+            FeatureProblem::Units { controller, units } => write!(
+                f,
+                "features.motion_units = \"{}\" does not go with features.motion_controller = \"{}\": \
+                 the sixpoint controller takes motion_units = \"sixpoint\", and only it does",
+                units.name(),
+                controller.name()
+            ),
             FeatureProblem::VersionText { text } => {
                 write!(f, "module.version_text \"{text}\" must be 8 ASCII characters (the 136 type 0 reply)")
             }

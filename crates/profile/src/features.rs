@@ -73,6 +73,46 @@ pub enum MotionUnits {
     Tmc429,
     /// Microsteps per second and per second², as written: no divisors.
     Pps,
+    /// The sixPoint modules' (TMC5130/TMC5160): AP 255 (unit mode) 1
+    /// selects pps and pps² as written, 0 the chip's internal units
+    /// (`v·f_CLK/2^24` µsteps/s, `a·f_CLK²/2^41` µsteps/s², with
+    /// `motion_clock_hz`; docs/behaviour.md rule 104).
+    Sixpoint,
+}
+
+impl MotionUnits {
+    /// The name a profile's `[features]` table gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionUnits::Tmc429 => "tmc429",
+            MotionUnits::Pps => "pps",
+            MotionUnits::Sixpoint => "sixpoint",
+        }
+    }
+}
+
+impl MotionController {
+    /// The name a profile's `[features]` table gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionController::Tmc429 => "tmc429",
+            MotionController::Sixpoint => "sixpoint",
+        }
+    }
+}
+
+/// The motion controller a module's axes run on: the part of the
+/// firmware that turns the ramp parameters into motion.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotionController {
+    /// The TMC429 (and TMC428): a trapezoid with AP 4, AP 5 and the stop
+    /// speed AP 130, soft and velocity modes by AP 138.
+    #[default]
+    Tmc429,
+    /// The TMC5130/TMC5160 sixPoint ramp: VSTART, A1 to V1, AMAX to VMAX,
+    /// DMAX to V1, D1 to VSTOP (AP 15…21), docs/behaviour.md rules 104–110.
+    Sixpoint,
 }
 
 /// The global parameters (bank 0) holding a module's own CAN identifiers.
@@ -190,6 +230,9 @@ pub struct Features {
     /// The units of velocities and accelerations. Absent: the TMC429's.
     #[serde(default)]
     pub motion_units: MotionUnits,
+    /// The motion controller part. Absent: the TMC429.
+    #[serde(default)]
+    pub motion_controller: MotionController,
 }
 
 fn yes_no(b: bool) -> String {
@@ -276,6 +319,15 @@ impl Features {
                 match self.motion_units {
                     MotionUnits::Tmc429 => "TMC429 internal units (pulse and ramp divisors, AP 154/153)",
                     MotionUnits::Pps => "pps and pps² (microsteps per second, per second²)",
+                    MotionUnits::Sixpoint => "pps and pps² with AP 255 = 1, the chip's internal units with AP 255 = 0",
+                }
+                .to_string(),
+            ),
+            (
+                "motion_controller",
+                match self.motion_controller {
+                    MotionController::Tmc429 => "TMC429 (trapezoid, AP 4/5/130, modes by AP 138)",
+                    MotionController::Sixpoint => "sixPoint (TMC5130/TMC5160: VSTART, A1, V1, AMAX, VMAX, DMAX, D1, VSTOP)",
                 }
                 .to_string(),
             ),

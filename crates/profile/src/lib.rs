@@ -15,7 +15,9 @@ mod features;
 
 pub use bootloader::Bootloader;
 pub use error::{FeatureProblem, ParameterProblem, ProfileError};
-pub use features::{CanIds, EepromMagic, Encoder, ErrorFlags, Features, MotionUnits, ReferenceSearchFamily, StallDetection};
+pub use features::{
+    CanIds, EepromMagic, Encoder, ErrorFlags, Features, MotionController, MotionUnits, ReferenceSearchFamily, StallDetection,
+};
 
 use serde::Deserialize;
 use std::sync::Arc;
@@ -762,10 +764,14 @@ fn check_features(profile: &Profile) -> Result<(), FeatureProblem> {
     if f.encoder_deviation_stop && f.encoder == Encoder::None {
         return Err(FeatureProblem::DeviationStopWithoutEncoder);
     }
-    if f.motion_units == MotionUnits::Pps
+    if f.motion_units != MotionUnits::Tmc429
         && let Some(p) = profile.axis_parameters().find(|p| p.quantity.is_some())
     {
         return Err(FeatureProblem::QuantityInPps { number: p.number, name: p.name.clone() });
+    }
+    let sixpoint = f.motion_controller == MotionController::Sixpoint;
+    if (f.motion_units == MotionUnits::Sixpoint) != sixpoint {
+        return Err(FeatureProblem::Units { controller: f.motion_controller, units: f.motion_units });
     }
     if let Some(text) = &profile.module.version_text
         && (text.len() != 8 || !text.is_ascii())
@@ -1085,10 +1091,23 @@ mod feature_tests {
             let p = Profile::built_in(name).unwrap();
             let pps = p.features.motion_units == MotionUnits::Pps;
             assert_eq!(pps, name == "tmcm-1310", "{name}");
-            // TMC429 modules mark their velocity rows; a pps module has no
-            // such row: its values are microsteps per second as written.
-            assert_eq!(p.axis_parameter(4).unwrap().quantity.is_some(), !pps, "{name}");
+            // TMC429 modules mark their velocity rows; a pps or sixPoint
+            // module has no such row: its values are microsteps per second
+            // as written (or the chip's units, by AP 255).
+            let tmc429 = p.features.motion_units == MotionUnits::Tmc429;
+            assert_eq!(p.axis_parameter(4).unwrap().quantity.is_some(), tmc429, "{name}");
+            let sixpoint = p.features.motion_controller == MotionController::Sixpoint;
+            assert_eq!(p.features.motion_units == MotionUnits::Sixpoint, sixpoint, "{name}");
         }
+        // The sixPoint units belong to the sixPoint controller, and it to them.
+        let e = Profile::from_toml(&with_features("tmcm-1310", "motion_controller = \"sixpoint\"")).unwrap_err().to_string();
+        assert!(e.contains("motion_units = \"pps\" does not go with features.motion_controller = \"sixpoint\""), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-1310", "\nmotion_units = \"pps\"", "\nmotion_units = \"sixpoint\""))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("motion_units = \"sixpoint\" does not go with features.motion_controller = \"tmc429\""), "{e}");
+        let e = Profile::from_toml(&with_features("tmcm-1310", "motion_controller = \"tmc5072\"")).unwrap_err().to_string();
+        assert!(e.contains("tmc5072"), "{e}");
         let e = Profile::from_toml(&with_features("tmcm-1141", "motion_units = \"pps\"")).unwrap_err().to_string();
         assert!(e.contains("axis parameter 2 (") && e.contains("motion_units"), "{e}");
         let e = Profile::from_toml(&with_features("tmcm-1141", "motion_units = \"rpm\"")).unwrap_err().to_string();
@@ -1209,7 +1228,7 @@ mod feature_tests {
         let readme = include_str!("../../../profiles/README.md");
         let p = Profile::built_in("tmcm-351").unwrap();
         let list = p.features.list();
-        assert_eq!(list.len(), 18);
+        assert_eq!(list.len(), 19);
         for (key, value) in &list {
             let row =
                 if matches!(*key, "can" | "ethercat" | "error_flags") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };
@@ -1221,6 +1240,7 @@ mod feature_tests {
         assert_eq!(get("full_scale_current_ma"), "2800 mA RMS");
         assert_eq!(get("motion_clock_hz"), "16000000 Hz");
         assert!(get("motion_units").starts_with("TMC429"));
+        assert!(get("motion_controller").starts_with("TMC429"));
         assert!(get("baud_rates").contains("codes 0…11"));
     }
 }

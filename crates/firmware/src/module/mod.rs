@@ -139,7 +139,7 @@ impl Module {
     /// mechanical position) without moving the motor: the position counter
     /// keeps its value, as when a carriage is pushed by hand.
     pub fn place_carriage(&mut self, axis: usize, position: f64) {
-        let sign = self.surroundings().shaft_sign();
+        let sign = self.motor_view(axis).shaft_sign();
         let a = &mut self.axes[axis];
         a.mech_offset = position - a.motion.x * sign;
     }
@@ -320,8 +320,10 @@ impl Module {
                 }
             }
             // The carriage stays where it is; the position counter restarts at 0.
-            let sign = self.surroundings().shaft_sign();
-            let mech = old_axes.get(motor as usize).map_or(self.world.axes[motor as usize].start, |a| a.motion.x * sign + a.mech_offset);
+            let mech = old_axes.get(motor as usize).map_or(self.world.axes[motor as usize].start, |a| {
+                let sign = Motor { axis: a, world: &self.world.axes[motor as usize], at: self.surroundings() }.shaft_sign();
+                a.motion.x * sign + a.mech_offset
+            });
             let mut axis = Axis::new(params, coordinates, mech, self.now_ns);
             // ROR and ROL take the speeds AP 2 (target speed) takes.
             if let Some(p) = profile.axis_parameter(crate::parameter_numbers::ap::TARGET_SPEED) {

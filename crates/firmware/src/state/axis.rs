@@ -2,8 +2,8 @@
 //! the per-axis state of the reference search, the driver and the closed
 //! loop.
 
-use crate::motion::{self, Motion, Ramp, RampMode, Units};
-use crate::parameter_numbers::ap;
+use crate::motion::{self, Motion, Ramp, RampMode, SixPoint, Units};
+use crate::parameter_numbers::{ap, sp};
 use crate::reference_search::ReferenceSearch;
 use std::cell::Cell;
 use tmclsim_protocol::Status;
@@ -157,12 +157,35 @@ impl Axis {
                 None => vmax = slow.max(1.0),
             }
         }
+        let six = match units {
+            Units::Sixpoint { fclk, .. } => Some(self.six_point(units, f64::from(fclk))),
+            _ => None,
+        };
         Ramp {
             vmax: units.velocity_pps(vmax),
             vmin: units.velocity_pps(value(ap::MIN_SPEED)),
             accel_position: units.positioning_accel_pps2(a.max(1)),
             accel_velocity: units.accel_pps2(f64::from(a.max(1))),
             target_velocity: units.velocity_pps(target_velocity),
+            six,
+        }
+    }
+
+    /// The sixPoint ramp's values (AP 15…21) in µsteps and seconds; an
+    /// acceleration of 0 acts as the smallest one, so that every ramp
+    /// ends (docs/behaviour.md rule 105).
+    fn six_point(&self, units: Units, fclk: f64) -> SixPoint {
+        let p = &self.params;
+        let value = |n: u8| f64::from(p[n as usize].max(0));
+        let accel = |n: u8| units.accel_pps2(value(n).max(1.0));
+        SixPoint {
+            vstart: units.velocity_pps(value(sp::VSTART)),
+            a1: accel(sp::A1),
+            v1: units.velocity_pps(value(sp::V1)),
+            dmax: accel(sp::DMAX),
+            d1: accel(sp::D1),
+            vstop: units.velocity_pps(value(sp::VSTOP)),
+            zero_wait: value(sp::RAMP_WAIT) * 512.0 / fclk,
         }
     }
 
@@ -176,10 +199,10 @@ impl Axis {
 }
 
 /// The axis parameters a plain ramp comes from (AP 4, 2, 130, 5, 154,
-/// 153), as their words: the ramp worked out for them stays valid while
-/// they are the same.
+/// 153; the sixPoint's 15…21 and its unit mode 255), as their words: the
+/// ramp worked out for them stays valid while they are the same.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct RampKey([i32; 6]);
+pub(crate) struct RampKey([i32; 14]);
 
 impl RampKey {
     fn of(p: &[i32; 256]) -> RampKey {
@@ -190,6 +213,14 @@ impl RampKey {
             p[ap::MAX_ACCELERATION as usize],
             p[ap::PULSE_DIVISOR as usize],
             p[ap::RAMP_DIVISOR as usize],
+            p[sp::A1 as usize],
+            p[sp::V1 as usize],
+            p[sp::DMAX as usize],
+            p[sp::D1 as usize],
+            p[sp::VSTART as usize],
+            p[sp::VSTOP as usize],
+            p[sp::RAMP_WAIT as usize],
+            p[sp::UNIT_MODE as usize],
         ])
     }
 }
@@ -262,7 +293,7 @@ mod tests {
     fn end_overrides_leaves_the_rest() {
         let mut a = axis();
         a.rfs = ReferenceSearch::new(1);
-        a.ramp_override = Some(Ramp { vmax: 1.0, vmin: 0.0, accel_position: 1.0, accel_velocity: 1.0, target_velocity: 0.0 });
+        a.ramp_override = Some(Ramp { vmax: 1.0, vmin: 0.0, accel_position: 1.0, accel_velocity: 1.0, target_velocity: 0.0, six: None });
         a.closed_loop.torque_mode = true;
         a.notify_on_arrival = true;
         a.end_overrides();

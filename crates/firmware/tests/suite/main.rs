@@ -22,6 +22,7 @@ mod resync;
 mod rust_source;
 mod sibling_modules;
 mod single_axis_family;
+mod sixpoint;
 mod tmcm_1310;
 mod tmcm_351;
 mod world_lines;

@@ -26,6 +26,7 @@ fn closed_form(vmax: u32, a: u32, vmin: u32, rd: u32, pd: u32, distance: f64) ->
         accel_position: motion::accel_pps2(motion::positioning_accel(a, rd, pd), rd, pd),
         accel_velocity: 0.0,
         target_velocity: 0.0,
+        six: None,
     };
     Motion::closed_form_duration(distance, &ramp)
 }

@@ -9,7 +9,7 @@
 use crate::closed_loop::cl;
 use crate::module::Module;
 use crate::motion::RampMode;
-use crate::parameter_numbers::{ap, gp};
+use crate::parameter_numbers::{ap, gp, sp};
 use crate::state::parameters::{axis_spec, global_spec, takes};
 use tmclsim_protocol::Status;
 
@@ -72,7 +72,16 @@ impl Module {
         let closed_loop = self.profile.features.closed_loop;
         let encoder = self.profile.features.encoder != tmclsim_profile::Encoder::None;
         let mut motor = self.motor_view_mut(m);
+        let six_point = motor.view().six_point();
         match param {
+            // The shaft turns the other way from now on; the carriage stays
+            // where it is (docs/behaviour.md rule 108).
+            sp::REVERSE_SHAFT if six_point => {
+                let mech = motor.view().mechanical_position();
+                motor.axis.params[param as usize] = value;
+                let sign = motor.view().shaft_sign();
+                motor.axis.mech_offset = mech - motor.axis.motion.x * sign;
+            }
             ap::TARGET_POSITION => motor.set_target(value),
             ap::ACTUAL_POSITION => motor.set_counter(value),
             ap::RAMP_MODE => {

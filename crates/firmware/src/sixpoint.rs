@@ -1,0 +1,262 @@
+//! The TMC5130/TMC5160 sixPoint ramp generator, the motion controller of
+//! the modules whose profile says `motion_controller = "sixpoint"`
+//! (docs/behaviour.md rules 104–110).
+//!
+//! A positioning move starts at VSTART, accelerates with A1 up to V1 and
+//! with AMAX up to VMAX, cruises, decelerates with DMAX down to V1 and with
+//! D1 down to VSTOP, where the motor stops on its target. V1 = 0 leaves
+//! A1 and D1 out. After every stop the motor stands for the ramp wait time
+//! (TZEROWAIT) before it moves again. Velocity mode ramps with AMAX
+//! both ways.
+//!
+//! Like the TMC429's trapezoid ([`crate::motion`]), the ramp is planned in
+//! phases of constant acceleration whose ends are known in closed form,
+//! so that an hour of motion costs a handful of phases; the values are the
+//! chip's register values (`Units::Sixpoint`), and a move is snapped onto
+//! its target microstep on arrival.
+
+use crate::phase::{EPS_LAND, EPS_POS, EPS_VEL, Phase, Sgn, Shape, Stops};
+
+/// Where the motor is when a phase is planned: position, velocity and
+/// target (µsteps, µsteps/s) and the ramp wait left (s).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Now {
+    pub x: f64,
+    pub v: f64,
+    pub target: f64,
+    pub zero_wait: f64,
+}
+
+/// The sixPoint ramp's own values beside VMAX, AMAX and the target speed
+/// of the motion's ramp, in µsteps/s, µsteps/s² and seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SixPoint {
+    /// VSTART (AP 19): the speed a move starts at.
+    pub vstart: f64,
+    /// A1 (AP 15): the acceleration below V1.
+    pub a1: f64,
+    /// V1 (AP 16): where A1 gives way to AMAX and DMAX to D1; 0 leaves A1
+    /// and D1 out.
+    pub v1: f64,
+    /// DMAX (AP 17): the deceleration above V1.
+    pub dmax: f64,
+    /// D1 (AP 18): the deceleration below V1.
+    pub d1: f64,
+    /// VSTOP (AP 20): the speed at which the motor stops.
+    pub vstop: f64,
+    /// TZEROWAIT (AP 21) in seconds: the standstill after a stop before the
+    /// motor moves again.
+    pub zero_wait: f64,
+}
+
+/// A piece of the braking distance `b(w) = α·w² + β` for speeds
+/// `lo < w ≤ hi`.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    lo: f64,
+    hi: f64,
+    alpha: f64,
+    beta: f64,
+}
+
+impl SixPoint {
+    /// True when A1 and D1 have their phases (V1 > 0).
+    fn has_v1(&self) -> bool {
+        self.v1 > 0.0
+    }
+
+    /// The acceleration that speeds the motor up from `u` and the speed at
+    /// which that acceleration ends (V1, or VMAX).
+    fn speeding_up(&self, u: f64, amax: f64, vmax: f64) -> (f64, f64) {
+        if self.has_v1() && u < self.v1 - EPS_VEL && u < vmax - EPS_VEL { (self.a1, self.v1.min(vmax)) } else { (amax, vmax) }
+    }
+
+    /// The deceleration that slows the motor down from `u` and the speed at
+    /// which it ends (V1, or `floor`).
+    fn slowing_down(&self, u: f64, floor: f64) -> (f64, f64) {
+        if !self.has_v1() {
+            (self.dmax, floor)
+        } else if u > self.v1 + EPS_VEL {
+            // Below VSTOP (or the floor) the motor never slows: D1 has no
+            // part when V1 lies there.
+            (self.dmax, self.v1.max(floor))
+        } else {
+            (self.d1, floor)
+        }
+    }
+
+    /// The braking distance from `u` down to VSTOP, piece by piece: DMAX
+    /// above V1, D1 below it (DMAX throughout when V1 = 0).
+    fn pieces(&self) -> [Piece; 3] {
+        let vs = self.vstop;
+        let none = Piece { lo: 0.0, hi: vs, alpha: 0.0, beta: 0.0 };
+        if self.has_v1() && self.v1 > vs {
+            let lower = Piece { lo: vs, hi: self.v1, alpha: 1.0 / (2.0 * self.d1), beta: -vs * vs / (2.0 * self.d1) };
+            let below_v1 = (self.v1 * self.v1 - vs * vs) / (2.0 * self.d1);
+            let upper = Piece {
+                lo: self.v1,
+                hi: f64::INFINITY,
+                alpha: 1.0 / (2.0 * self.dmax),
+                beta: below_v1 - self.v1 * self.v1 / (2.0 * self.dmax),
+            };
+            [none, lower, upper]
+        } else {
+            // V1 = 0, or V1 at or below VSTOP: DMAX all the way down.
+            let dec = self.dmax;
+            let only = Piece { lo: vs, hi: f64::INFINITY, alpha: 1.0 / (2.0 * dec), beta: -vs * vs / (2.0 * dec) };
+            [none, only, only]
+        }
+    }
+
+    /// The braking distance from `u` to VSTOP (0 at or below VSTOP).
+    pub fn brake(&self, u: f64) -> f64 {
+        let u = u.abs();
+        let p = self.pieces().into_iter().find(|p| u <= p.hi).unwrap_or(self.pieces()[2]);
+        (p.alpha * u * u + p.beta).max(0.0)
+    }
+
+    /// The speed `w ≥ u` at which accelerating with `acc` from `u` and then
+    /// braking to VSTOP covers exactly `d`: where the braking point lies.
+    fn peak(&self, u: f64, acc: f64, d: f64) -> f64 {
+        let k = 1.0 / (2.0 * acc);
+        for p in self.pieces() {
+            // k·(w² − u²) + α·w² + β = d
+            let w2 = (d - p.beta + k * u * u) / (k + p.alpha);
+            let w = w2.max(0.0).sqrt();
+            if w <= p.hi && w >= p.lo {
+                return w.max(u);
+            }
+        }
+        u
+    }
+
+    /// The phase that brings a motor moving at `v` (either way) down to
+    /// standstill: DMAX to V1, D1 to VSTOP, then the stop.
+    fn braking(&self, v: f64) -> Phase {
+        let w = v.abs();
+        if w <= self.vstop + EPS_VEL {
+            return Phase::jump(0.0);
+        }
+        let (dec, end) = self.slowing_down(w, self.vstop);
+        Phase::accel(-v.sgn() * dec, (w - end) / dec)
+    }
+
+    /// Velocity mode: AMAX towards the target speed, either way; a reversal
+    /// passes through standstill and the ramp wait.
+    pub(crate) fn plan_velocity(&self, m: &Now, target_velocity: f64, amax: f64, stops: &Stops) -> Option<Phase> {
+        let a = amax;
+        let mut vt = target_velocity;
+        if stops.blocks(vt.sgn()) || stops.blocks(m.v.sgn()) {
+            if m.v == 0.0 {
+                return None;
+            }
+            if !stops.soft {
+                return Some(Phase::jump(0.0));
+            }
+            return Some(self.braking(m.v));
+        }
+        if m.v == 0.0 {
+            if vt == 0.0 {
+                return None;
+            }
+            if m.zero_wait > 0.0 {
+                return Some(Phase::wait(m.zero_wait));
+            }
+        } else if vt.sgn() != m.v.sgn() {
+            // A reversal (or a stop): down to standstill first.
+            vt = 0.0;
+        }
+        let dv = vt - m.v;
+        if dv.abs() < EPS_VEL {
+            if m.v != vt {
+                return Some(Phase::jump(vt));
+            }
+            return if vt == 0.0 { None } else { Some(Phase::accel(0.0, f64::INFINITY)) };
+        }
+        Some(Phase::accel(a * dv.sgn(), dv.abs() / a))
+    }
+
+    /// Positioning mode: the six points towards the target.
+    pub(crate) fn plan_position(&self, m: &Now, vmax: f64, amax: f64, stops: &Stops) -> Option<Phase> {
+        let delta = m.target - m.x;
+        let d = delta.abs();
+        if d < EPS_POS && m.v.abs() <= self.vstop + EPS_VEL {
+            if m.v == 0.0 && delta == 0.0 {
+                return None;
+            }
+            return Some(Phase { shape: Shape::Accel(0.0), duration: 0.0, arrives: true });
+        }
+        // Direction towards the target; at the target with speed, the
+        // motor overshoots and comes back.
+        let dir = if d < EPS_POS { -m.v.sgn() } else { delta.sgn() };
+        if stops.blocks(dir) || stops.blocks(m.v.sgn()) {
+            if m.v == 0.0 {
+                return None;
+            }
+            if !stops.soft {
+                return Some(Phase::jump(0.0));
+            }
+            return Some(self.braking(m.v));
+        }
+        if m.v == 0.0 {
+            if m.zero_wait > 0.0 {
+                return Some(Phase::wait(m.zero_wait));
+            }
+            if self.vstart > 0.0 {
+                return Some(Phase::jump(dir * self.vstart));
+            }
+        }
+        let u = m.v * dir;
+        if u < -EPS_VEL {
+            // Moving away from the target: down to standstill first.
+            return Some(self.braking(m.v));
+        }
+        let u = u.max(0.0);
+        let b = self.brake(u);
+        if d <= b + EPS_POS {
+            if u > self.vstop + EPS_VEL {
+                let (dec, end) = self.slowing_down(u, self.vstop);
+                let segment = (u * u - end * end) / (2.0 * dec);
+                if d < b - EPS_LAND && d < segment {
+                    // A target moved closer: it comes before the ramp's
+                    // end; the motor passes it and comes back.
+                    let t_target = (u - (u * u - 2.0 * dec * d).max(0.0).sqrt()) / dec;
+                    return Some(Phase::accel(-dir * dec, t_target));
+                }
+                let arrives = end <= self.vstop + EPS_VEL;
+                return Some(Phase { shape: Shape::Accel(-dir * dec), duration: (u - end) / dec, arrives });
+            }
+            // At or below VSTOP: on to the target at this speed.
+            if u > EPS_VEL {
+                return Some(Phase { shape: Shape::Accel(0.0), duration: d / u, arrives: true });
+            }
+        }
+        if u > vmax + EPS_VEL {
+            // VMAX lowered while moving: down to it with the acceleration
+            // values, AMAX above V1 and A1 below (rule 106).
+            let (acc, end) = if self.has_v1() && u <= self.v1 + EPS_VEL {
+                (self.a1, vmax)
+            } else if self.has_v1() {
+                (amax, self.v1.max(vmax))
+            } else {
+                (amax, vmax)
+            };
+            return Some(Phase::accel(-dir * acc, (u - end) / acc));
+        }
+        if u < vmax - EPS_VEL {
+            let (acc, end) = self.speeding_up(u, amax, vmax);
+            let w = self.peak(u, acc, d);
+            if w <= self.vstop + EPS_VEL {
+                // The target comes before the motor is faster than VSTOP.
+                let t = (-u + (u * u + 2.0 * acc * d).sqrt()) / acc;
+                return Some(Phase { shape: Shape::Accel(dir * acc), duration: t, arrives: true });
+            }
+            return Some(Phase::accel(dir * acc, (w.min(end) - u) / acc));
+        }
+        if m.v != dir * vmax {
+            // Remove float dust from the acceleration phase.
+            return Some(Phase::jump(dir * vmax));
+        }
+        Some(Phase::accel(0.0, (d - self.brake(vmax)) / vmax))
+    }
+}
