@@ -18,7 +18,7 @@
 //!   carriage does not.
 
 use crate::motor::{Alarms, Motor, MotorMut};
-use crate::parameter_numbers::ap;
+use crate::parameter_numbers::{ap, sp};
 use tmclsim_profile::StallDetection;
 
 /// Full steps per second at which the motor has no torque left.
@@ -44,6 +44,24 @@ pub fn prescaler_factor(p: i32) -> f64 {
 pub const STANDSTILL_NS: u64 = 65_536_000;
 
 pub use crate::state::axis::Driver;
+
+/// How a sixPoint module's driver (TMC5130/TMC5160) runs the motor at its
+/// speed now (docs/behaviour.md rule 111); a TMC429 module's driver is
+/// always in spreadCycle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Chopper {
+    /// stealthChop: silent, no stallGuard2 reading, no coolStep, no stall
+    /// stop (AP 187 ≠ 0, at or below the speed of AP 186).
+    StealthChop,
+    /// spreadCycle: stallGuard2 measures, coolStep regulates, a stall stops.
+    SpreadCycle,
+    /// Above the high-speed threshold (AP 22): no stallGuard2, no coolStep
+    /// (fullstep with AP 28, the fast chopper with AP 27).
+    HighSpeed,
+    /// dcStep above its minimum speed (AP 23): the motor slows under a load
+    /// it cannot carry instead of losing steps.
+    DcStep,
+}
 
 impl Motor<'_> {
     /// The driver is switched off (no torque).
@@ -87,6 +105,39 @@ impl Motor<'_> {
             | i32::from(still) << 7
     }
 
+    /// The driver's mode at the motor's speed now (rule 111).
+    pub(crate) fn chopper(&self) -> Chopper {
+        if !self.six_point() {
+            return Chopper::SpreadCycle;
+        }
+        let p = &self.axis.params;
+        let units = self.units();
+        let speed = self.axis.motion.v.abs();
+        // A threshold of 0 is off; else the speed it names, in the module's units.
+        let above = |n: u8| p[n as usize] > 0 && speed >= units.velocity_pps(f64::from(p[n as usize]));
+        if above(sp::DCSTEP_MIN_SPEED) {
+            Chopper::DcStep
+        } else if above(sp::HIGH_SPEED_THRESHOLD) {
+            Chopper::HighSpeed
+        } else if p[sp::PWM_GRADIENT as usize] != 0 && !above(sp::PWM_THRESHOLD_SPEED) {
+            Chopper::StealthChop
+        } else {
+            Chopper::SpreadCycle
+        }
+    }
+
+    /// The TMC5160's global current scaler (AP 178) as a share of the
+    /// current: 0 is full scale, 1…255 in 256ths; 1 elsewhere.
+    fn global_scale(&self) -> f64 {
+        if !self.six_point() {
+            return 1.0;
+        }
+        match self.axis.params[sp::GLOBAL_SCALER as usize] {
+            0 => 1.0,
+            g => f64::from(g.clamp(1, 255)) / 256.0,
+        }
+    }
+
     /// Current scale in effect (0…31): coolStep's, or the current setting's.
     pub(crate) fn current_scale(&self) -> f64 {
         match self.axis.driver.cool_scale {
@@ -112,7 +163,7 @@ impl Motor<'_> {
             return 1.0;
         }
         let fullsteps = axis.motion.v.abs() / axis.microsteps();
-        let available = (scale + 1.0) / 32.0 * (1.0 - fullsteps / CORNER_FULLSTEPS).max(0.0) * 100.0;
+        let available = (scale + 1.0) / 32.0 * self.global_scale() * (1.0 - fullsteps / CORNER_FULLSTEPS).max(0.0) * 100.0;
         if available <= 0.0 {
             return if load > 0.0 { -1.0 } else { 1.0 };
         }
@@ -195,8 +246,11 @@ impl MotorMut<'_> {
             (p[ap::STOP_ON_STALL as usize], p[ap::STALL_THRESHOLD as usize], p[ap::MAX_ENCODER_DEVIATION as usize]);
         let features = self.at.features();
         let off = self.view().driver_off();
+        // stallGuard2 and coolStep work in spreadCycle only (rule 111).
+        let chopper = self.view().chopper();
+        let spread = chopper == Chopper::SpreadCycle;
         // coolStep regulates above its threshold speed, when enabled.
-        let semin = if features.coolstep { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
+        let semin = if features.coolstep && spread { p[ap::SMART_ENERGY_HYSTERESIS_START as usize] } else { 0 };
         let cool = semin > 0 && moving && self.view().actual_speed().abs() >= p[ap::SMART_ENERGY_THRESHOLD_SPEED as usize];
         if cool {
             self.cool_step(moved, off, semin);
@@ -209,7 +263,7 @@ impl MotorMut<'_> {
             let view = self.view();
             view.margin(view.current_scale(), off)
         };
-        if features.stall_detection == StallDetection::Stallguard2 {
+        if features.stall_detection == StallDetection::Stallguard2 && spread {
             if moving {
                 self.axis.driver.load_value = self.view().stallguard(margin);
             }
@@ -240,7 +294,11 @@ impl MotorMut<'_> {
             return alarms;
         }
         let sign = self.view().shaft_sign();
-        if slips {
+        if slips && chopper == Chopper::DcStep && !off {
+            // dcStep: the motor keeps step with what it can move; the
+            // position counter counts only the steps made (rule 111).
+            self.axis.motion.x -= moved;
+        } else if slips {
             self.axis.mech_offset -= moved * sign;
         }
         self.keep_within_travel();

@@ -134,6 +134,16 @@ pub mod sp {
     pub const SOFT_STOP: u8 = 26;
     /// The measured speed, pps.
     pub const MEASURED_SPEED: u8 = 29;
+    /// The speed above which the driver runs in high-speed mode.
+    pub const HIGH_SPEED_THRESHOLD: u8 = 22;
+    /// dcStep's minimum speed.
+    pub const DCSTEP_MIN_SPEED: u8 = 23;
+    /// stealthChop is off above this speed.
+    pub const PWM_THRESHOLD_SPEED: u8 = 186;
+    /// stealthChop's PWM gradient; 0 switches stealthChop off.
+    pub const PWM_GRADIENT: u8 = 187;
+    /// The TMC5160's global current scaler.
+    pub const GLOBAL_SCALER: u8 = 178;
     /// Reverse the motor's direction.
     pub const REVERSE_SHAFT: u8 = 251;
     /// Unit mode: 0 the chip's internal units, 1 pps.
