@@ -162,7 +162,10 @@ def test_motor_api(serve, link, class_name, profile):
             assert motor.actual_position == 777
             settings = motor.drive_settings
             for attribute, ap in (("max_current", "MaxCurrent"), ("standby_current", "StandbyCurrent"), ("boost_current", "BoostCurrent")):
-                if hasattr(motor.AP, ap):
+                # PyTrinamic reads the standby current only for a class that
+                # names MaxCurrent (its TMCM1270 class says RunCurrent): its
+                # getter answers None there without asking the module.
+                if hasattr(motor.AP, ap) and (ap != "StandbyCurrent" or hasattr(motor.AP, "MaxCurrent")):
                     setattr(settings, attribute, 100)
                     assert getattr(settings, attribute) == 100, f"{profile} {attribute}"
             if hasattr(motor.AP, "MicrostepResolution"):

@@ -10,6 +10,10 @@ use tmclsim_firmware::{Bus, Module, Profile};
 use tmclsim_protocol::Request;
 use tmclsim_protocol::mnemonic::parse_line;
 
+/// The modules the in-process and motion rows measure: the TMC429
+/// family's and the sixPoint family's (each row names its module).
+const BENCH_MODULES: [&str; 2] = ["tmcm-1141", "tmcm-1260"];
+
 /// The command mix every measurement uses.
 const MIX: &[&str] = &["GAP 1, 0", "SAP 4, 0, 1500", "GGP 66, 0", "GIO 0, 0", "MVP ABS, 0, 5000", "GAP 8, 0"];
 
@@ -54,24 +58,28 @@ pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
 
 /// Every row of the table, stage by stage.
 fn measure(args: &crate::BenchArgs, frames: &[[u8; 9]]) -> Result<(), String> {
-    // In-process, one core.
+    // In-process, one core: a TMC429 module and a sixPoint module (the
+    // TMCM-1260's ramp, the same command mix).
     stage("in-process handle_frame");
-    let mut m = Module::built_in("tmcm-1141")?;
-    let n = args.in_process;
-    let t = Instant::now();
-    let mut sink = 0u64;
-    for i in 0..n {
-        if let Some(r) = m.handle_frame(&frames[i % frames.len()]) {
-            sink = sink.wrapping_add(u64::from(r[7]));
+    for module in BENCH_MODULES {
+        let mut m = Module::built_in(module)?;
+        let n = args.in_process;
+        let t = Instant::now();
+        let mut sink = 0u64;
+        for i in 0..n {
+            if let Some(r) = m.handle_frame(&frames[i % frames.len()]) {
+                sink = sink.wrapping_add(u64::from(r[7]));
+            }
         }
+        let dt = t.elapsed();
+        std::hint::black_box(sink);
+        row!(
+            "| in-process `handle_frame`, {} | {n} | {:.1} M commands/s ({:.1} ns each) |",
+            m.profile().module.name,
+            n as f64 / dt.as_secs_f64() / 1e6,
+            dt.as_nanos() as f64 / n as f64
+        );
     }
-    let dt = t.elapsed();
-    std::hint::black_box(sink);
-    row!(
-        "| in-process `handle_frame` | {n} | {:.1} M commands/s ({:.1} ns each) |",
-        n as f64 / dt.as_secs_f64() / 1e6,
-        dt.as_nanos() as f64 / n as f64
-    );
 
     stage("programs in virtual time");
     programs()?;
@@ -179,16 +187,32 @@ fn programs() -> Result<(), String> {
     let motion = asm(FIRST_STEPS)?;
     let (n, wall) = run_program(&profile, &motion, 3_600_000_000_000)?;
     row!("| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |", 3600.0 / wall, wall * 1e3);
-    // A busy motion loop: GAP/COMP/JC polling while the motor moves.
-    let polling = asm(
-        "Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n",
-    )?;
-    let (n, wall) = run_program(&profile, &polling, 600_000_000_000)?;
-    row!(
-        "| VM, polling motion loop (GAP 8/JC), 10 min of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
-        n as f64 / wall / 1e6,
-        600.0 / wall
-    );
+    // A busy motion loop: GAP/COMP/JC polling while the motor moves, on
+    // each motion controller.
+    for module in BENCH_MODULES {
+        let profile = tmclsim_firmware::Profile::built_in(module)?;
+        let asm = |src: &str| {
+            tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d))
+        };
+        let polling = asm(
+            "Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n",
+        )?;
+        let (n, wall) = run_program(&profile, &polling, 600_000_000_000)?;
+        row!(
+            "| VM, polling motion loop (GAP 8/JC), 10 min of virtual time, {} | {n} | {:.1} M instructions/s, {:.0}× real time |",
+            profile.module.name,
+            n as f64 / wall / 1e6,
+            600.0 / wall
+        );
+        // Virtual time alone with a move in progress: a host's GAP now and
+        // then, the motor running back and forth.
+        let wall = moving_module(&profile)?;
+        row!(
+            "| motion, 1 h of virtual time with moves in progress, {} | 3600 s | {:.0} simulated s per wall s |",
+            profile.module.name,
+            3600.0 / wall
+        );
+    }
     // The assembler.
     let mut src = String::from("Speed = 1000\nAccel = Speed / 2 + 3\n");
     let lines = 50_000;
@@ -200,6 +224,28 @@ fn programs() -> Result<(), String> {
     let wall = t.elapsed().as_secs_f64();
     row!("| assembler ({} instructions) | {lines} lines | {:.2} M lines/s |", p.instructions.len(), f64::from(lines) / wall / 1e6);
     Ok(())
+}
+
+/// An hour of virtual time on a module of its own whose motor moves back
+/// and forth all the time (a move of 10 million µsteps each way at the
+/// profile's default ramp, a host's GAP 1 every 10 ms): the wall time in
+/// seconds.
+fn moving_module(profile: &Arc<Profile>) -> Result<f64, String> {
+    let mut bus = Bus::single(Module::new(profile.clone()));
+    let frame = |line: &str| Request::new(1, parse_line(line).unwrap()).encode();
+    let (out, back, gap, reached) = (frame("MVP ABS, 0, 10000000"), frame("MVP ABS, 0, 0"), frame("GAP 1, 0"), frame("GAP 8, 0"));
+    let t = Instant::now();
+    let mut outward = true;
+    bus.handle_frame(&out);
+    for _ in 0..360_000 {
+        bus.advance(10_000_000);
+        bus.handle_frame(&gap);
+        if bus.handle_frame(&reached).replies.first().is_some_and(|r| r[7] == 1) {
+            outward = !outward;
+            bus.handle_frame(if outward { &out } else { &back });
+        }
+    }
+    Ok(t.elapsed().as_secs_f64())
 }
 
 /// Runs `program` on a module of its own for `ns` of virtual time: the

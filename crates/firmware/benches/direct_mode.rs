@@ -20,15 +20,17 @@ fn bench(c: &mut Criterion) {
         ("mix GAP/SAP/GGP/GIO/MVP", &["GAP 1, 0", "SAP 4, 0, 1500", "GGP 66, 0", "GIO 0, 0", "MVP ABS, 0, 5000", "GAP 8, 0"][..]),
     ] {
         let fs = frames(lines);
-        let mut m = Module::built_in("tmcm-1141").unwrap();
-        let mut i = 0;
-        g.bench_function(name, |b| {
-            b.iter(|| {
-                let f = &fs[i % fs.len()];
-                i += 1;
-                black_box(m.handle_frame(black_box(f)))
+        for module in ["tmcm-1141", "tmcm-1260"] {
+            let mut m = Module::built_in(module).unwrap();
+            let mut i = 0;
+            g.bench_function(format!("{name}, {module}"), |b| {
+                b.iter(|| {
+                    let f = &fs[i % fs.len()];
+                    i += 1;
+                    black_box(m.handle_frame(black_box(f)))
+                });
             });
-        });
+        }
     }
     g.finish();
     // Programs: 1000 instructions (25 ms of virtual time at 25 µs each)
@@ -52,11 +54,27 @@ fn bench(c: &mut Criterion) {
         g.bench_function(name, |b| b.iter(|| bus.advance(black_box(25_000_000))));
     }
     g.finish();
-    c.bench_function("advance 1 ms while moving", |b| {
-        let mut bus = Bus::single(Module::built_in("tmcm-1141").unwrap());
-        bus.handle_frame(&frames(&["ROR 0, 1000"])[0]);
-        b.iter(|| bus.advance(black_box(1_000_000)));
-    });
+    // The TMC429 family's and the sixPoint family's motion controllers.
+    for (module, rotate) in [("tmcm-1141", "ROR 0, 1000"), ("tmcm-1260", "ROR 0, 50000")] {
+        c.bench_function(&format!("advance 1 ms while moving, {module}"), |b| {
+            let mut bus = Bus::single(Module::built_in(module).unwrap());
+            bus.handle_frame(&frames(&[rotate])[0]);
+            b.iter(|| bus.advance(black_box(1_000_000)));
+        });
+        c.bench_function(&format!("advance 1 ms during a move, {module}"), |b| {
+            let mut bus = Bus::single(Module::built_in(module).unwrap());
+            let (out, back, reached) = (frames(&["MVP ABS, 0, 1000000"])[0], frames(&["MVP ABS, 0, 0"])[0], frames(&["GAP 8, 0"])[0]);
+            bus.handle_frame(&out);
+            let mut outward = true;
+            b.iter(|| {
+                bus.advance(black_box(1_000_000));
+                if bus.handle_frame(&reached).replies.first().is_some_and(|r| r[7] == 1) {
+                    outward = !outward;
+                    bus.handle_frame(if outward { &out } else { &back });
+                }
+            });
+        });
+    }
 }
 
 criterion_group!(benches, bench);

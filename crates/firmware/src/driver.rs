@@ -199,12 +199,30 @@ impl Motor<'_> {
         let still_ms = (self.at.now_ns().saturating_sub(since)) / 1_000_000;
         // Freewheeling and the power down delay count in their rows' units
         // (the TMCM-1141: both 10 ms; the TMCM-351: ms and 10 ms).
-        let freewheel = p[ap::FREEWHEELING as usize].max(0) as u64 * self.at.ms_per_unit(ap::FREEWHEELING);
+        // On a sixPoint module AP 204 is the chip's standstill option
+        // (freewheeling or coil short while the standby current is 0), no
+        // delay (rule 111).
+        let freewheel =
+            if self.six_point() { 0 } else { p[ap::FREEWHEELING as usize].max(0) as u64 * self.at.ms_per_unit(ap::FREEWHEELING) };
         if freewheel > 0 && still_ms >= freewheel {
             return 0;
         }
         let delay = p[ap::POWER_DOWN_DELAY as usize].max(0) as u64 * self.at.ms_per_unit(ap::POWER_DOWN_DELAY);
-        if still_ms >= delay { standby } else { run }
+        if still_ms < delay {
+            return run;
+        }
+        // The sixPoint driver's power-down ramp (AP 31, IHOLDDELAY): one
+        // current step of 32 each AP 31 × 2^18 clock cycles (rule 111).
+        let step_ms = if self.six_point() {
+            f64::from(p[sp::POWER_DOWN_RAMP as usize].clamp(0, 15)) * 262_144_000.0 / f64::from(self.at.features().motion_clock_hz)
+        } else {
+            0.0
+        };
+        if step_ms > 0.0 && run > standby {
+            let steps = ((still_ms - delay) as f64 / step_ms).floor() as u32;
+            return run.saturating_sub(steps.saturating_mul(8)).max(standby);
+        }
+        standby
     }
 
     /// The driver has something to look at often while the motor moves
@@ -298,6 +316,17 @@ impl MotorMut<'_> {
             // dcStep: the motor keeps step with what it can move; the
             // position counter counts only the steps made (rule 111).
             self.axis.motion.x -= moved;
+            // With its stall detection on (AP 33), a motor that cannot
+            // move is a stall: the stallGuard2 flag, and the stop on
+            // stall above AP 181.
+            if self.axis.params[sp::DCSTEP_STALLGUARD as usize] != 0 {
+                self.axis.driver.load_value = 0;
+                if stall_speed > 0 && self.view().actual_speed().abs() >= stall_speed {
+                    self.axis.stop_now();
+                    self.axis.params[ap::EXTENDED_ERROR_FLAGS as usize] |= features.error_flags.stall;
+                    alarms.stall = true;
+                }
+            }
         } else if slips {
             self.axis.mech_offset -= moved * sign;
         }

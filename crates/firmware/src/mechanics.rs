@@ -8,7 +8,7 @@ use crate::motion::{self, RampMode};
 use crate::motor::{Motor, MotorMut};
 use crate::parameter_numbers::{ap, sp};
 use crate::reference_search::{SearchAxis, Switch};
-use tmclsim_profile::{MotionController, MotionUnits};
+use tmclsim_profile::{LimitSwitchRows, MotionController, MotionUnits};
 
 impl Motor<'_> {
     /// AP 1: the position counter.
@@ -103,9 +103,12 @@ impl Motor<'_> {
         }
         let (left, right, _) = self.switches_at(x);
         let p = &self.axis.params;
+        // AP 12/13 disable the switches, or on some modules enable them.
+        let enable = self.at.features().limit_switch_rows == LimitSwitchRows::Enable;
+        let stops = |n: u8| (p[n as usize] != 0) == enable;
         motion::Stops {
-            block_positive: right && p[ap::RIGHT_SWITCH_DISABLE as usize] == 0,
-            block_negative: left && p[ap::LEFT_SWITCH_DISABLE as usize] == 0,
+            block_positive: right && stops(ap::RIGHT_SWITCH_DISABLE),
+            block_negative: left && stops(ap::LEFT_SWITCH_DISABLE),
             soft: p[if self.six_point() { sp::SOFT_STOP } else { ap::SOFT_STOP } as usize] == 1,
         }
     }

@@ -92,6 +92,12 @@ pub enum Units {
     },
 }
 
+/// The largest velocity register value of the TMC5130/TMC5160 (VMAX, 23
+/// bits less 512): a larger value is taken as this one.
+const SIX_POINT_VMAX: f64 = 8_388_096.0;
+/// The largest acceleration register value (AMAX, A1, DMAX, D1: 16 bits).
+const SIX_POINT_AMAX: f64 = 65_535.0;
+
 /// µsteps per second of one sixPoint velocity unit at `fclk`.
 fn six_point_velocity_unit(fclk: f64) -> f64 {
     fclk * pow2(-24)
@@ -120,7 +126,7 @@ impl Units {
             Units::Sixpoint { fclk, internal } => {
                 let unit = six_point_velocity_unit(f64::from(fclk));
                 let register = if internal { v } else { (v / unit).round() };
-                register * unit
+                register.clamp(-SIX_POINT_VMAX, SIX_POINT_VMAX) * unit
             }
         }
     }
@@ -147,7 +153,7 @@ impl Units {
             Units::Sixpoint { fclk, internal } => {
                 let unit = six_point_accel_unit(f64::from(fclk));
                 let register = if internal { a } else { (a / unit).round().max(if a > 0.0 { 1.0 } else { 0.0 }) };
-                register * unit
+                register.min(SIX_POINT_AMAX) * unit
             }
         }
     }

@@ -142,6 +142,10 @@ pub mod sp {
     pub const PWM_THRESHOLD_SPEED: u8 = 186;
     /// stealthChop's PWM gradient; 0 switches stealthChop off.
     pub const PWM_GRADIENT: u8 = 187;
+    /// The power-down ramp: IHOLDDELAY, 2^18 clock cycles per current step.
+    pub const POWER_DOWN_RAMP: u8 = 31;
+    /// dcStep's stall detection (DC_SG; 0: off).
+    pub const DCSTEP_STALLGUARD: u8 = 33;
     /// The TMC5160's global current scaler.
     pub const GLOBAL_SCALER: u8 = 178;
     /// Reverse the motor's direction.

@@ -101,6 +101,19 @@ impl MotionController {
     }
 }
 
+/// What AP 12 (right) and AP 13 (left) say of the stop switches.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LimitSwitchRows {
+    /// 1 disables the switch: it no longer stops the motor (the TMCM-1141
+    /// manual's "right/left limit switch disable").
+    #[default]
+    Disable,
+    /// 1 enables the automatic stop at the switch, 0 leaves the switch
+    /// without effect on the motor ("automatic right/left stop").
+    Enable,
+}
+
 /// The motion controller a module's axes run on: the part of the
 /// firmware that turns the ramp parameters into motion.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
@@ -233,6 +246,9 @@ pub struct Features {
     /// The motion controller part. Absent: the TMC429.
     #[serde(default)]
     pub motion_controller: MotionController,
+    /// What AP 12 and 13 say of the stop switches. Absent: they disable.
+    #[serde(default)]
+    pub limit_switch_rows: LimitSwitchRows,
 }
 
 fn yes_no(b: bool) -> String {
@@ -320,6 +336,14 @@ impl Features {
                     MotionUnits::Tmc429 => "TMC429 internal units (pulse and ramp divisors, AP 154/153)",
                     MotionUnits::Pps => "pps and pps² (microsteps per second, per second²)",
                     MotionUnits::Sixpoint => "pps and pps² with AP 255 = 1, the chip's internal units with AP 255 = 0",
+                }
+                .to_string(),
+            ),
+            (
+                "limit_switch_rows",
+                match self.limit_switch_rows {
+                    LimitSwitchRows::Disable => "AP 12/13 = 1 disables the right/left stop switch",
+                    LimitSwitchRows::Enable => "AP 12/13 = 1 enables the automatic stop at the right/left switch",
                 }
                 .to_string(),
             ),

@@ -16,7 +16,8 @@ mod features;
 pub use bootloader::Bootloader;
 pub use error::{FeatureProblem, ParameterProblem, ProfileError};
 pub use features::{
-    CanIds, EepromMagic, Encoder, ErrorFlags, Features, MotionController, MotionUnits, ReferenceSearchFamily, StallDetection,
+    CanIds, EepromMagic, Encoder, ErrorFlags, Features, LimitSwitchRows, MotionController, MotionUnits, ReferenceSearchFamily,
+    StallDetection,
 };
 
 use serde::Deserialize;
@@ -1228,7 +1229,7 @@ mod feature_tests {
         let readme = include_str!("../../../profiles/README.md");
         let p = Profile::built_in("tmcm-351").unwrap();
         let list = p.features.list();
-        assert_eq!(list.len(), 19);
+        assert_eq!(list.len(), 20);
         for (key, value) in &list {
             let row =
                 if matches!(*key, "can" | "ethercat" | "error_flags") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };

@@ -23,6 +23,8 @@ mod rust_source;
 mod sibling_modules;
 mod single_axis_family;
 mod sixpoint;
+mod sixpoint_family;
+mod sixpoint_module;
 mod tmcm_1310;
 mod tmcm_351;
 mod world_lines;
