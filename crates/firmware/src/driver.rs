@@ -84,6 +84,17 @@ impl Motor<'_> {
         let Some(counts_per_rev) = self.world.encoder_counts else { return axis.encoder_offset as i32 };
         let microsteps_per_rev = self.world.fullsteps_per_rev * axis.microsteps();
         let counts = self.mechanical_position() / microsteps_per_rev * counts_per_rev;
+        if self.at.features().encoder == tmclsim_profile::Encoder::Abn {
+            // The chip adds its ENC_CONST per count: the module sets it to
+            // full steps × microsteps / counts per revolution (rule 112).
+            let factor = match self.at.features().encoder_scale {
+                Some(s) if axis.params[s.resolution as usize] > 0 => {
+                    f64::from(axis.params[s.fullsteps as usize].max(0)) * axis.microsteps() / f64::from(axis.params[s.resolution as usize])
+                }
+                _ => 1.0,
+            };
+            return ((counts.floor() * factor).round() as i64 + axis.encoder_offset) as i32;
+        }
         let p = axis.params[ap::ENCODER_PRESCALER as usize];
         let sign = if p & PRESCALER_REVERSED != 0 { -1.0 } else { 1.0 };
         ((counts * sign * prescaler_factor(p)).round() as i64 + axis.encoder_offset) as i32

@@ -107,6 +107,15 @@ pub enum FeatureProblem {
         /// The parameter number it names.
         number: u8,
     },
+    /// A feature names an axis parameter the profile lacks.
+    MissingAxisParameter {
+        /// The features key (`encoder_scale.resolution`, …).
+        key: &'static str,
+        /// The parameter number it names.
+        number: u8,
+    },
+    /// `encoder_scale` on a module whose encoder is not `abn`.
+    ScaleWithoutAbnEncoder,
     /// `baud_rates` lists no rate.
     NoBaudRates,
     /// `baud_rates` has another length than GP 65 has codes.
@@ -201,6 +210,10 @@ impl fmt::Display for FeatureProblem {
             FeatureProblem::MissingParameter { key, number } => {
                 write!(f, "features.{key} names global parameter {number}, which the profile does not have (bank 0)")
             }
+            FeatureProblem::MissingAxisParameter { key, number } => {
+                write!(f, "features.{key} names axis parameter {number}, which the profile does not have")
+            }
+            FeatureProblem::ScaleWithoutAbnEncoder => f.write_str("features.encoder_scale needs features.encoder = \"abn\""),
             FeatureProblem::NoBaudRates => f.write_str("features.baud_rates is empty: it needs at least the rate of code 0"),
             FeatureProblem::BaudRates { rates, parameter, name, min, max } => {
                 write!(f, "features.baud_rates has {rates} rates, but GP {parameter} ({name}) takes codes {min}…{max}")

@@ -59,6 +59,24 @@ pub enum Encoder {
     /// An incremental a/b/n or an absolute SSI encoder, chosen by AP 201
     /// (closed-loop modules).
     AbnSsi,
+    /// An incremental a/b/n encoder on the TMC5130/TMC5160's encoder
+    /// interface: AP 209 is the chip's encoder position, the counts
+    /// scaled as `encoder_scale` says (docs/behaviour.md rule 112).
+    Abn,
+}
+
+/// The axis parameters an `abn` encoder's scale comes from: the encoder's
+/// counts per revolution and the motor's full steps per revolution. The
+/// module scales the counts to microsteps with them
+/// (`fullsteps × microsteps / resolution`; a resolution of 0: one a
+/// microstep a count).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderScale {
+    /// The axis parameter of the encoder's counts per revolution.
+    pub resolution: u8,
+    /// The axis parameter of the motor's full steps per revolution.
+    pub fullsteps: u8,
 }
 
 /// The units of a module's velocity and acceleration parameters (AP 2…5,
@@ -200,6 +218,10 @@ pub struct Features {
     pub coolstep: bool,
     /// The encoder input.
     pub encoder: Encoder,
+    /// How an `abn` encoder's counts become AP 209. `None`: one count is
+    /// one unit of AP 209.
+    #[serde(default)]
+    pub encoder_scale: Option<EncoderScale>,
     /// AP 212: the motor stops when position counter and encoder drift
     /// apart further than it allows.
     pub encoder_deviation_stop: bool,
@@ -285,8 +307,19 @@ impl Features {
                     Encoder::None => "none",
                     Encoder::Tmc423 => "incremental, TMC423 interface",
                     Encoder::AbnSsi => "incremental a/b/n or absolute SSI",
+                    Encoder::Abn => "incremental a/b/n on the sixPoint chip's encoder interface",
                 }
                 .to_string(),
+            ),
+            (
+                "encoder_scale",
+                match self.encoder_scale {
+                    Some(s) => format!(
+                        "AP 209 in microsteps: AP {} full steps × microsteps / AP {} counts per revolution",
+                        s.fullsteps, s.resolution
+                    ),
+                    None => "one count is one unit of AP 209".to_string(),
+                },
             ),
             ("encoder_deviation_stop", yes_no(self.encoder_deviation_stop)),
             ("chopper_off_disables_driver", yes_no(self.chopper_off_disables_driver)),

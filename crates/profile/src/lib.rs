@@ -16,8 +16,8 @@ mod features;
 pub use bootloader::Bootloader;
 pub use error::{FeatureProblem, ParameterProblem, ProfileError};
 pub use features::{
-    CanIds, EepromMagic, Encoder, ErrorFlags, Features, LimitSwitchRows, MotionController, MotionUnits, ReferenceSearchFamily,
-    StallDetection,
+    CanIds, EepromMagic, Encoder, EncoderScale, ErrorFlags, Features, LimitSwitchRows, MotionController, MotionUnits,
+    ReferenceSearchFamily, StallDetection,
 };
 
 use serde::Deserialize;
@@ -742,6 +742,16 @@ fn check_features(profile: &Profile) -> Result<(), FeatureProblem> {
             return Err(FeatureProblem::MissingParameter { key, number: n });
         }
     }
+    if let Some(scale) = f.encoder_scale {
+        if f.encoder != Encoder::Abn {
+            return Err(FeatureProblem::ScaleWithoutAbnEncoder);
+        }
+        for (key, n) in [("encoder_scale.resolution", scale.resolution), ("encoder_scale.fullsteps", scale.fullsteps)] {
+            if profile.axis_parameter(n).is_none() {
+                return Err(FeatureProblem::MissingAxisParameter { key, number: n });
+            }
+        }
+    }
     if f.baud_rates.is_empty() {
         return Err(FeatureProblem::NoBaudRates);
     }
@@ -1100,6 +1110,11 @@ mod feature_tests {
             let sixpoint = p.features.motion_controller == MotionController::Sixpoint;
             assert_eq!(p.features.motion_units == MotionUnits::Sixpoint, sixpoint, "{name}");
         }
+        // An encoder scale names rows the profile has, on an abn encoder.
+        let e = Profile::from_toml(&replacing("tmcm-6214", "resolution = 210", "resolution = 250")).unwrap_err().to_string();
+        assert!(e.contains("encoder_scale.resolution names axis parameter 250"), "{e}");
+        let e = Profile::from_toml(&replacing("tmcm-6214", "\nencoder = \"abn\"", "\nencoder = \"tmc423\"")).unwrap_err().to_string();
+        assert!(e.contains("encoder_scale needs features.encoder = \"abn\""), "{e}");
         // The sixPoint units belong to the sixPoint controller, and it to them.
         let e = Profile::from_toml(&with_features("tmcm-1310", "motion_controller = \"sixpoint\"")).unwrap_err().to_string();
         assert!(e.contains("motion_units = \"pps\" does not go with features.motion_controller = \"sixpoint\""), "{e}");
@@ -1229,10 +1244,13 @@ mod feature_tests {
         let readme = include_str!("../../../profiles/README.md");
         let p = Profile::built_in("tmcm-351").unwrap();
         let list = p.features.list();
-        assert_eq!(list.len(), 20);
+        assert_eq!(list.len(), 21);
         for (key, value) in &list {
-            let row =
-                if matches!(*key, "can" | "ethercat" | "error_flags") { format!("| `[features.{key}]` |") } else { format!("| `{key}` |") };
+            let row = if matches!(*key, "can" | "ethercat" | "error_flags" | "encoder_scale") {
+                format!("| `[features.{key}]` |")
+            } else {
+                format!("| `{key}` |")
+            };
             assert!(readme.contains(&row), "{key} has no row in the README's features table");
             assert!(!value.is_empty(), "{key}");
         }

@@ -291,3 +291,39 @@ fn ap_204_is_no_freewheeling_delay_here() {
     m.advance(10_000 * MS);
     assert_eq!(send(&mut m, "GAP 180, 0"), 10, "the standby current, not switched off");
 }
+
+#[test]
+fn the_encoder_counts_microsteps_with_its_resolution() {
+    // The TMCM-6214: AP 210 is the encoder's resolution, AP 202 the
+    // motor's full steps; the world's encoder has 2000 counts a turn.
+    let mut m = BusOfOne::built_in("tmcm-6214");
+    send(&mut m, "MVP ABS, 0, 51200");
+    until(&mut m, 20_000, |m| send(m, "GAP 8, 0") == 1).expect("arrives");
+    assert_eq!(send(&mut m, "GAP 209, 0"), 2000, "resolution 0: the counts themselves (one turn)");
+    send(&mut m, "SAP 210, 0, 2000");
+    assert_eq!(send(&mut m, "GAP 209, 0"), 51_200, "2000 counts a turn: microsteps, as AP 1");
+    send(&mut m, "SAP 209, 0, 0");
+    send(&mut m, "MVP REL, 0, -25600");
+    until(&mut m, 20_000, |m| send(m, "GAP 8, 0") == 1).expect("arrives");
+    assert_eq!(send(&mut m, "GAP 209, 0"), -25_600, "set, then counted on");
+    // The TMCM-1260's AP 210 is no resolution: the counts as they are.
+    let mut m = module();
+    send(&mut m, "MVP ABS, 0, 51200");
+    until(&mut m, 20_000, |m| send(m, "GAP 8, 0") == 1).expect("arrives");
+    assert_eq!(send(&mut m, "GAP 209, 0"), 2000);
+}
+
+#[test]
+fn an_encoder_deviation_stops_the_motor() {
+    let mut m = BusOfOne::built_in("tmcm-6214");
+    send(&mut m, "SAP 210, 0, 2000");
+    send(&mut m, "SAP 212, 0, 1000");
+    send(&mut m, "SAP 6, 0, 255");
+    send(&mut m, "ROR 0, 20000");
+    m.advance(500 * MS);
+    // The carriage is held: the encoder stands, the counter goes on.
+    load(&mut m, 150.0);
+    let stopped = until(&mut m, 1000, |m| send(m, "GAP 3, 0") == 0);
+    assert!(stopped.is_some(), "stopped on the deviation");
+    assert_eq!(send(&mut m, "GAP 207, 0") & 2, 2, "the deviation bit");
+}
