@@ -217,3 +217,26 @@ fn the_firmware_state_is_kept_in_the_eeprom_image() {
     assert_eq!(Eeprom::from_json(&e.to_json()).unwrap().firmware, Firmware::Invalid);
     assert!(Module::with_eeprom(tmclsim_firmware::Profile::built_in("tmcm-1141").unwrap(), e).in_bootloader());
 }
+
+#[test]
+fn every_sixpoint_module_updates_through_its_bootloader() {
+    for name in tmclsim_firmware::Profile::names() {
+        let profile = tmclsim_firmware::Profile::built_in(name).unwrap();
+        if profile.features.motion_controller != tmclsim_profile::MotionController::Sixpoint {
+            continue;
+        }
+        let digits = profile.module.type_number.to_string();
+        let [major, minor] = profile.module.firmware;
+        let mut m = BusOfOne::built_in(name);
+        send(&mut m, "SAP 15, 0, 4321");
+        send(&mut m, "STAP 15, 0");
+        assert_eq!(version_text(&mut m, 1), format!("{digits}V{major}{minor:02}"), "{name}");
+        enter(&mut m, 1);
+        assert_eq!(version_text(&mut m, 1), format!("{digits}B100"), "{name}: the bootloader's text");
+        let f = facts(&m);
+        write_image(&mut m, &image(&f, [major, minor + 1]));
+        assert!(ask(&mut m, 1, 205, 0, 0, 0).is_none(), "{name}: BOOT_START_APPL");
+        assert_eq!(version_text(&mut m, 1), format!("{digits}V{major}{:02}", minor + 1), "{name}: the new version");
+        assert_eq!(send(&mut m, "GAP 15, 0"), 4321, "{name}: the stored A1 is kept");
+    }
+}
