@@ -242,3 +242,50 @@ def test_the_reference_search_tool_runs_in_the_page(playground, page):
     final = text(page, "rfs-position")
     tab(page, "motion")
     wait_text(page, "ro-position", f"t === '{final}'")
+
+
+def test_a_sixpoint_module_of_the_list_turns_in_pps_in_the_page(playground, page):
+    """A TMC5160 module added from the built-in profiles: speeds in pps
+    (its unit mode 1), the sixPoint ramp's rows in the grid with their
+    units, a reference search at a speed typed in pps (docs/ide.md,
+    Units)."""
+    open_app(page, playground.url)
+    page.select_option("[data-testid=units]", "pps")
+    page.select_option("[data-testid=add-profile]", "tmcm-1260")
+    page.click("[data-testid=add-go]")
+    wait_text(page, "module-title", "t.startsWith('TMCM-1260')")
+    tab(page, "motion")
+    page.fill("[data-testid=rot-speed]", "1000")
+    page.click("[data-testid=ror]")
+    wait_text(page, "motion-log", "t.includes('ROR 0, 1000') && t.includes('[100]')")
+    wait_text(page, "ro-speed", "t === '1000'")
+    page.select_option("[data-testid=units]", "rpm")
+    # 1000 pps of a 200-step motor at 256 microsteps.
+    wait_text(page, "ro-speed", "t === '1.17188'")
+    page.click("[data-testid=mst]")
+    wait_text(page, "ro-speed", "t === '0'")
+
+    page.select_option("[data-testid=units]", "pps")
+    tab(page, "params")
+    for number, unit in {15: "pps/s", 16: "pps", 17: "pps/s", 18: "pps/s", 19: "pps", 20: "pps", 21: "512 clocks"}.items():
+        wait_text(page, f"row-ap-0-{number}", f"t.includes('{unit}')")
+    page.locator("[data-testid=row-ap-0-21]").scroll_into_view_if_needed()
+    wait_text(page, "value-ap-0-15", "t === '51200'")
+    shot(page, "playground-sixpoint-parameters")
+
+    # The reference search tool takes its speed in pps.
+    tab(page, "world")
+    page.select_option("[data-testid=place-which]", "left")
+    page.fill("[data-testid=place-at]", "-5000")
+    page.click("[data-testid=place-go]")
+    wait_text(page, "world-show", "t.includes('place 0 left -5000') && !t.includes('error')")
+    tab(page, "tools")
+    page.select_option("[data-testid=rfs-mode]", "1")
+    page.fill("[data-testid=rfs-search-speed]", "2000")
+    page.click("[data-testid=rfs-start]")
+    page.locator("[data-testid=rfs-position]").wait_for(timeout=30000)
+    assert text(page, "tools-message") == "", text(page, "tools-message")
+    ask = "(l) => JSON.parse(window.tmclsimPage.request('POST', '/api/modules/1/command', JSON.stringify({line: l}))).value"
+    assert page.evaluate(ask, "GAP 194, 0") == 2000
+    events = page.locator("[data-testid=rfs-event]").all_inner_texts()
+    assert any("left switch pressed" in e for e in events), events

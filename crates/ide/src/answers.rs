@@ -31,10 +31,32 @@ pub fn exchange(target: &dyn Target, id: usize, ins: Instruction) -> Result<Valu
     let m = entry(target, id)?;
     let (address, profile) = (m.address, m.profile.clone());
     let raw = target.request(id, ins)?;
-    Ok(described(address, profile.as_deref(), ins, &raw))
+    let unit = profile.as_deref().and_then(|p| unit_now(target, id, p, ins));
+    Ok(described(address, profile.as_deref(), ins, &raw, unit))
 }
 
-fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8; FRAME_LEN]) -> Value {
+/// The unit a sixPoint module's velocity or acceleration row addressed by
+/// SAP or GAP is in: pps and pps² (as its profile says) unless the motor's
+/// unit mode (AP 255, read now) is 0, the chip's registers
+/// (docs/behaviour.md rule 104). `None` for any other row or module.
+fn unit_now(target: &dyn Target, id: usize, profile: &Profile, ins: Instruction) -> Option<&'static str> {
+    if !matches!(ins.opcode, opcode::SAP | opcode::GAP) {
+        return None;
+    }
+    let (quantity, "sixpoint") = crate::profile_json::quantity(profile, profile.axis_parameter(ins.kind)?)? else {
+        return None;
+    };
+    let (replies, _) = target.observe(id, &[Instruction::new(opcode::GAP, 255, ins.motor, 0)]).ok()?;
+    let mode = replies.first().filter(|raw| raw[2] >= 100).map(|raw| i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]))?;
+    Some(match (mode, quantity) {
+        (0, "velocity") => "int (v·f_CLK/2^24 pps)",
+        (0, _) => "int (a·f_CLK²/2^41 pps²)",
+        (_, "velocity") => "pps",
+        _ => "pps²",
+    })
+}
+
+fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8; FRAME_LEN], unit: Option<&str>) -> Value {
     let value = i32::from_be_bytes([raw[4], raw[5], raw[6], raw[7]]);
     if ins.opcode == opcode::FIRMWARE_VERSION && ins.kind == 0 {
         // The reply is text from its second byte on: no status, no value.
@@ -48,7 +70,7 @@ fn described(address: u8, profile: Option<&Profile>, ins: Instruction, raw: &[u8
     json!({
         "request": hex(&Request::new(address, ins).encode()), "reply": hex(raw),
         "status": raw[2], "status_text": tmclsim_protocol::Status::text(raw[2]), "value": value,
-        "text": crate::reply::describe(ins, raw, address, profile),
+        "text": crate::reply::describe_in(ins, raw, address, profile, unit),
     })
 }
 

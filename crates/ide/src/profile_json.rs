@@ -1,11 +1,80 @@
 //! A module's profile as the app shows it: parameter tables with access,
 //! range, default and its source, ports, commands, the reference search
 //! modes by name, and what the unit conversion needs (which rows are
-//! velocities and accelerations, the motion controller's clock).
+//! velocities and accelerations and in which units, the motion
+//! controller's clock, the axis parameters a conversion reads).
 
 use serde_json::{Value, json};
-use tmclsim_profile::{Parameter, PortDirection, Profile, Quantity};
+use tmclsim_profile::{MotionUnits, Parameter, PortDirection, Profile, Quantity};
 use tmclsim_profile::{ReferenceSearchFamily, StallDetection};
+
+/// The velocities of a sixPoint module whose unit AP 255 (unit mode)
+/// selects (docs/behaviour.md rules 104, 108, 111): target and actual
+/// speed (AP 2, 3), VMAX (4), V1 (16), VSTART (19), VSTOP (20), the
+/// driver's threshold speeds (high speed 22, dcStep 23, stop on stall 181,
+/// coolStep 182, stealthChop 186) and the reference search speeds (194,
+/// 195). AP 29 (measured speed) is pps in either mode.
+const SIXPOINT_VELOCITIES: [u8; 13] = [2, 3, 4, 16, 19, 20, 22, 23, 181, 182, 186, 194, 195];
+
+/// The accelerations of a sixPoint module whose unit AP 255 selects: AMAX
+/// (AP 5), A1 (15), DMAX (17), D1 (18).
+const SIXPOINT_ACCELERATIONS: [u8; 4] = [5, 15, 17, 18];
+
+/// The name a profile gives a quantity.
+fn quantity_name(q: Quantity) -> &'static str {
+    match q {
+        Quantity::Velocity => "velocity",
+        Quantity::Acceleration => "acceleration",
+    }
+}
+
+/// A velocity or an acceleration by the profile's unit of the row: what a
+/// pps module's rows (and a sixPoint module's that are pps in either unit
+/// mode) say they are.
+fn quantity_by_unit(p: &Parameter) -> Option<&'static str> {
+    match p.unit.as_deref()? {
+        "pps" => Some("velocity"),
+        "pps²" | "pps^2" | "pps/s" => Some("acceleration"),
+        _ => None,
+    }
+}
+
+/// What an axis parameter's value is for the app's unit conversion: the
+/// quantity (`"velocity"`, `"acceleration"`) and the units it is in
+/// (`"tmc429"`: the TMC429's with the motor's divisors; `"pps"`: pps and
+/// pps² as written; `"sixpoint"`: as AP 255 selects). On a TMC429 module
+/// the profile's `quantity` says it; on a pps module the row's unit (pps,
+/// pps²); on a sixPoint module the rows of the sixPoint roles, and the
+/// other rows in pps by their unit.
+pub fn quantity(profile: &Profile, p: &Parameter) -> Option<(&'static str, &'static str)> {
+    match profile.features.motion_units {
+        MotionUnits::Tmc429 => p.quantity.map(|q| (quantity_name(q), "tmc429")),
+        MotionUnits::Pps => quantity_by_unit(p).map(|q| (q, "pps")),
+        MotionUnits::Sixpoint => {
+            if SIXPOINT_VELOCITIES.contains(&p.number) {
+                Some(("velocity", "sixpoint"))
+            } else if SIXPOINT_ACCELERATIONS.contains(&p.number) {
+                Some(("acceleration", "sixpoint"))
+            } else {
+                quantity_by_unit(p).map(|q| (q, "pps"))
+            }
+        }
+    }
+}
+
+/// The axis parameters a conversion of the motor's velocities and
+/// accelerations reads, by role, those the profile has: the microstep
+/// resolution (AP 140, for rpm) and, in TMC429 units, the ramp and pulse
+/// divisors (AP 153, 154), in sixPoint units the unit mode (AP 255).
+fn conversion(profile: &Profile) -> Value {
+    let roles: &[(&str, u8)] = match profile.features.motion_units {
+        MotionUnits::Tmc429 => &[("microsteps", 140), ("ramp_divisor", 153), ("pulse_divisor", 154)],
+        MotionUnits::Pps => &[("microsteps", 140)],
+        MotionUnits::Sixpoint => &[("microsteps", 140), ("unit_mode", 255)],
+    };
+    let has = |n: u8| profile.axis_parameters().any(|p| p.number == n);
+    Value::Object(roles.iter().filter(|(_, n)| has(*n)).map(|(k, n)| (k.to_string(), json!(n))).collect())
+}
 
 fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
     let a = &p.access;
@@ -20,14 +89,21 @@ fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
         "min": p.min, "max": p.max, "default": p.default, "default_source": source,
         "note": p.note, "storable": a.eeprom, "ranges": p.ranges,
         "snake": crate::names::snake(p.label()),
-        "quantity": p.quantity.map(|q| match q {
-            Quantity::Velocity => "velocity",
-            Quantity::Acceleration => "acceleration",
-        }),
+        "quantity": p.quantity.map(quantity_name),
+        "quantity_units": p.quantity.map(|_| "tmc429"),
     });
     if let Some(b) = bank {
         v["bank"] = json!(b);
     }
+    v
+}
+
+/// An axis parameter's row: with its quantity as the conversion takes it.
+fn axis_parameter(profile: &Profile, p: &Parameter) -> Value {
+    let mut v = parameter(p, None);
+    let q = quantity(profile, p);
+    v["quantity"] = json!(q.map(|(q, _)| q));
+    v["quantity_units"] = json!(q.map(|(_, u)| u));
     v
 }
 
@@ -107,7 +183,7 @@ fn tuning(profile: &Profile) -> Value {
 pub fn of(profile: &Profile) -> Value {
     let m = &profile.module;
     let commands: Vec<&str> = m.opcodes.iter().filter_map(|&o| tmclsim_protocol::opcode::mnemonic(o)).collect();
-    let axis: Vec<Value> = profile.axis_parameters().map(|p| parameter(p, None)).collect();
+    let axis: Vec<Value> = profile.axis_parameters().map(|p| axis_parameter(profile, p)).collect();
     let global: Vec<Value> = (0..=3u8).flat_map(|b| profile.global_parameters(b).map(move |p| parameter(p, Some(b)))).collect();
     let port = |d: PortDirection| -> Vec<Value> {
         profile
@@ -121,6 +197,9 @@ pub fn of(profile: &Profile) -> Value {
         "name": m.name, "axes": m.axes, "program_memory": m.program_memory,
         "user_variables": m.user_variables, "commands": commands,
         "motion_clock_hz": profile.features.motion_clock_hz,
+        "motion_units": profile.features.motion_units.name(),
+        "motion_controller": profile.features.motion_controller.name(),
+        "conversion": conversion(profile),
         "axis_parameters": axis, "global_parameters": global,
         "inputs": port(PortDirection::Input), "outputs": port(PortDirection::Output),
         "tuning": tuning(profile),
@@ -131,6 +210,7 @@ pub fn of(profile: &Profile) -> Value {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::Arc;
     use tmclsim_firmware::{Bus, Module};
     use tmclsim_protocol::{Instruction, Reply, Request, opcode};
 
@@ -171,6 +251,187 @@ mod tests {
         assert!(q.features.stall_detection != StallDetection::Stallguard2 && !q.features.coolstep);
         let t = &of(&q)["tuning"];
         assert!(t["stallguard2"].is_null() && t["coolstep"].is_null());
+    }
+
+    fn row(json: &Value, number: u8) -> &Value {
+        json["axis_parameters"].as_array().unwrap().iter().find(|r| r["number"] == number).unwrap_or_else(|| panic!("no AP {number}"))
+    }
+
+    /// (quantity, units) of every axis parameter that has one.
+    fn quantities(json: &Value) -> Vec<(u64, String, String)> {
+        json["axis_parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|r| !r["quantity"].is_null())
+            .map(|r| (r["number"].as_u64().unwrap(), r["quantity"].as_str().unwrap().into(), r["quantity_units"].as_str().unwrap().into()))
+            .collect()
+    }
+
+    /// A sixPoint module made from the TMCM-1141's profile: the sixPoint
+    /// motion controller and units, without the TMC429's rows (AP 130,
+    /// 135, 138, 149, 153, 154) and quantities, with the speeds and
+    /// accelerations in the chip's ranges (AP 2–5), the ramp rows
+    /// (AP 15–21), the driver's threshold speeds (22, 23, 186), the
+    /// measured speed (29) and the unit mode (255).
+    fn sixpoint_profile() -> Arc<Profile> {
+        let text = include_str!("../../../profiles/tmcm-1141.toml");
+        let mut sections: Vec<String> = text.split("\n[").map(str::to_string).collect();
+        let gone = [2, 3, 4, 5, 130, 135, 138, 149, 153, 154].map(|n| format!("[axis_parameter]]\nnumber = {n}\n"));
+        sections.retain(|s| !gone.iter().any(|g| s.starts_with(g.as_str())));
+        let mut text = sections.join("\n[").lines().filter(|l| !l.starts_with("quantity =")).collect::<Vec<_>>().join("\n");
+        text = text.replace("[features]\n", "[features]\nmotion_controller = \"sixpoint\"\nmotion_units = \"sixpoint\"\n");
+        let rows: [(u8, &str, i64, &str); 17] = [
+            (2, "Target velocity", 8_388_096, "pps"),
+            (3, "Actual velocity", 8_388_096, "pps"),
+            (4, "Maximum positioning velocity", 8_388_096, "pps"),
+            (5, "Maximum acceleration", 7_629_278, "pps²"),
+            (15, "Acceleration A1", 7_629_278, "pps²"),
+            (16, "Velocity V1", 1_048_575, "pps"),
+            (17, "Maximum deceleration", 7_629_278, "pps²"),
+            (18, "Deceleration D1", 7_629_278, "pps²"),
+            (19, "Start velocity (VSTART)", 262_143, "pps"),
+            (20, "Stop velocity (VSTOP)", 262_143, "pps"),
+            (21, "Ramp wait time (TZEROWAIT)", 65_535, "512 clocks"),
+            (22, "High speed threshold (THIGH)", 8_388_096, "pps"),
+            (23, "Minimum dcStep speed (VDCMIN)", 8_388_096, "pps"),
+            (29, "Measured speed", 8_388_096, "pps"),
+            (186, "PWM threshold speed", 8_388_096, "pps"),
+            (187, "PWM gradient", 255, ""),
+            (255, "Unit mode", 1, ""),
+        ];
+        for (number, name, max, unit) in rows {
+            let default = if number == 255 { 1 } else { 0 };
+            let min = if number <= 3 { -max } else { 0 };
+            let unit = if unit.is_empty() { String::new() } else { format!("unit = \"{unit}\"\n") };
+            text.push_str(&format!(
+                "\n[[axis_parameter]]\nnumber = {number}\nname = \"{name}\"\naccess = \"RW\"\nmin = {min}\nmax = {max}\ndefault = {default}\n\
+                 default_source = \"assumed\"\n{unit}source = \"a test\"\n"
+            ));
+        }
+        Arc::new(Profile::from_toml(&text).unwrap())
+    }
+
+    /// On a sixPoint module the velocities and accelerations are the rows
+    /// whose unit AP 255 selects (the ramp's, the threshold speeds, the
+    /// reference search speeds), converted with the unit mode and the
+    /// microstep resolution; the measured speed is pps either way; the ramp
+    /// wait and the positions are no quantity.
+    #[test]
+    fn a_sixpoint_module_says_which_rows_follow_the_unit_mode() {
+        let json = of(&sixpoint_profile());
+        assert_eq!((json["motion_units"].as_str(), json["motion_controller"].as_str()), (Some("sixpoint"), Some("sixpoint")));
+        assert_eq!(json["conversion"], json!({"microsteps": 140, "unit_mode": 255}));
+        let velocities =
+            [2, 3, 4, 16, 19, 20, 22, 23, 181, 182, 186, 194, 195].map(|n| (n, "velocity".to_string(), "sixpoint".to_string()));
+        let accelerations = [5, 15, 17, 18].map(|n| (n, "acceleration".to_string(), "sixpoint".to_string()));
+        let mut expected: Vec<_> = velocities.into_iter().chain(accelerations).chain([(29, "velocity".into(), "pps".into())]).collect();
+        expected.sort();
+        let mut got = quantities(&json);
+        got.sort();
+        assert_eq!(got, expected);
+        assert_eq!((row(&json, 21)["quantity"].clone(), row(&json, 21)["unit"].as_str()), (Value::Null, Some("512 clocks")));
+    }
+
+    /// The conversion the app makes of a sixPoint module's values is the
+    /// module's: in unit mode 0 a velocity v runs at v·f_CLK/2^24 pps (the
+    /// measured speed, AP 29, is pps) and an acceleration a speeds the
+    /// motor up by a·f_CLK²/2^41 pps per second; in unit mode 1 both are
+    /// pps as written.
+    #[test]
+    fn a_sixpoint_module_s_units_are_the_firmware_s() {
+        let profile = sixpoint_profile();
+        let clock = f64::from(of(&profile)["motion_clock_hz"].as_u64().unwrap() as u32);
+        let measured = |mode: i32, v: i32, a: i32, seconds: f64| {
+            let mut bus = Bus::single(Module::new(profile.clone()));
+            for (n, x) in [(255, mode), (5, a)] {
+                value(&mut bus, Instruction::new(opcode::SAP, n, 0, x));
+            }
+            value(&mut bus, Instruction::new(opcode::ROR, 0, 0, v));
+            bus.advance((seconds * 1e9) as u64);
+            (value(&mut bus, Instruction::new(opcode::GAP, 29, 0, 0)), value(&mut bus, Instruction::new(opcode::GAP, 3, 0, 0)))
+        };
+        // Unit mode 0: 100 000 units are 95 367 pps; 1000 units of
+        // acceleration 116 415 pps², 11 642 pps after 0.1 s.
+        let (pps, speed) = measured(0, 100_000, 1000, 2.0);
+        assert!((f64::from(pps) - 100_000.0 * clock / 2f64.powi(24)).abs() <= 1.0, "{pps}");
+        assert!((f64::from(speed) - 100_000.0).abs() <= 1.0, "AP 3 in the chip's units: {speed}");
+        let (pps, _) = measured(0, 100_000, 1000, 0.1);
+        assert!((f64::from(pps) - 1000.0 * clock * clock / 2f64.powi(41) * 0.1).abs() <= 2.0, "{pps}");
+        // Unit mode 1: pps as written.
+        let (pps, speed) = measured(1, 20_000, 100_000, 1.0);
+        assert!((f64::from(pps) - 20_000.0).abs() <= 1.0 && (f64::from(speed) - 20_000.0).abs() <= 1.0, "{pps} {speed}");
+    }
+
+    /// A pps module (the TMCM-1310): its rows in pps and pps² by their
+    /// unit, converted with the microstep resolution only; AP 153 and 154
+    /// (supply voltage and current there) are no divisors.
+    #[test]
+    fn a_pps_module_s_speeds_are_pps_by_their_unit() {
+        let json = of(&Profile::built_in("tmcm-1310").unwrap());
+        assert_eq!((json["motion_units"].as_str(), json["motion_controller"].as_str()), (Some("pps"), Some("tmc429")));
+        assert_eq!(json["conversion"], json!({"microsteps": 140}));
+        for n in [2, 3, 4, 181, 194, 195] {
+            assert_eq!(
+                (row(&json, n)["quantity"].as_str(), row(&json, n)["quantity_units"].as_str()),
+                (Some("velocity"), Some("pps")),
+                "AP {n}"
+            );
+        }
+        assert_eq!(row(&json, 5)["quantity"], "acceleration");
+        assert!(row(&json, 1)["quantity"].is_null());
+        let rows = json["axis_parameters"].as_array().unwrap();
+        assert!(rows.iter().filter(|r| r["number"] == 153 || r["number"] == 154).all(|r| r["quantity"].is_null()));
+    }
+
+    /// A TMC429 module as before: the profile's quantities, converted with
+    /// the microstep resolution and the ramp and pulse divisors.
+    #[test]
+    fn a_tmc429_module_s_quantities_are_the_profile_s() {
+        let p = Profile::built_in("tmcm-1141").unwrap();
+        let json = of(&p);
+        assert_eq!(json["motion_units"], "tmc429");
+        assert_eq!(json["conversion"], json!({"microsteps": 140, "ramp_divisor": 153, "pulse_divisor": 154}));
+        let from_profile: Vec<_> = p
+            .axis_parameters()
+            .filter_map(|r| r.quantity.map(|q| (u64::from(r.number), quantity_name(q).to_string(), "tmc429".to_string())))
+            .collect();
+        assert_eq!(quantities(&json), from_profile);
+        assert_eq!(row(&json, 130)["quantity"], "velocity");
+    }
+
+    /// The tuning tools' roles have the same numbers on a sixPoint module;
+    /// and every built-in sixPoint profile agrees with the roles above:
+    /// the rows that follow the unit mode say pps or pps², and of the
+    /// others only the measured speed does.
+    #[test]
+    fn the_tuning_roles_and_the_sixpoint_rows_agree_with_the_profiles() {
+        let json = of(&sixpoint_profile());
+        let t = &json["tuning"];
+        assert_eq!(t["stallguard2"], json!({"threshold": 174, "filter": 173, "stop_speed": 181, "load": 206, "stall_flag": 207}));
+        assert_eq!(t["coolstep"]["threshold_speed"], 182);
+        assert_eq!(t["coolstep"]["actual_current"], 180);
+        assert_eq!(t["reference_search"]["search_speed"], 194);
+        for name in Profile::names() {
+            let p = Profile::built_in(name).unwrap();
+            if p.features.motion_units != MotionUnits::Sixpoint {
+                continue;
+            }
+            for r in p.axis_parameters() {
+                let role = SIXPOINT_VELOCITIES.contains(&r.number) || SIXPOINT_ACCELERATIONS.contains(&r.number);
+                let by_unit = quantity_by_unit(r);
+                if role {
+                    let expected = if SIXPOINT_VELOCITIES.contains(&r.number) { "velocity" } else { "acceleration" };
+                    assert_eq!(by_unit, Some(expected), "{name} AP {} ({}) says {:?}", r.number, r.name, r.unit);
+                } else {
+                    assert!(by_unit.is_none() || r.number == 29, "{name} AP {} ({}) says {:?}", r.number, r.name, r.unit);
+                }
+            }
+            let t = &of(&p)["tuning"];
+            for (role, number) in t["stallguard2"].as_object().into_iter().chain(t["coolstep"].as_object()).flatten() {
+                assert!(p.axis_parameters().any(|r| json!(r.number) == *number), "{name}: {role} AP {number}");
+            }
+        }
     }
 
     #[test]

@@ -49,6 +49,12 @@ pub fn memory_word(raw: &[u8; FRAME_LEN], address: u8) -> Result<Instruction, u8
 
 /// One line (or two) for the reply to `ins`.
 pub fn describe(ins: Instruction, raw: &[u8; FRAME_LEN], address: u8, profile: Option<&Profile>) -> String {
+    describe_in(ins, raw, address, profile, None)
+}
+
+/// [`describe`], with the parameter's value in `unit` rather than the
+/// profile's (a sixPoint module's speed in the unit its unit mode selects).
+pub fn describe_in(ins: Instruction, raw: &[u8; FRAME_LEN], address: u8, profile: Option<&Profile>, unit: Option<&str>) -> String {
     match shape(ins, address, raw) {
         Shape::Version => return format!("version {}", String::from_utf8_lossy(&raw[1..])),
         Shape::Memory => {
@@ -68,7 +74,7 @@ pub fn describe(ins: Instruction, raw: &[u8; FRAME_LEN], address: u8, profile: O
             None => text,
         };
     }
-    let parameter = profile.and_then(|p| parameter(p, ins));
+    let parameter = profile.and_then(|p| parameter(p, ins)).map(|(name, u)| (name, unit.map(str::to_string).or(u)));
     if ins.opcode == opcode::FIRMWARE_VERSION {
         let v = r.value as u32;
         return format!("module type {}, firmware V{}.{:02}", v >> 16, (v >> 8) & 0xFF, v & 0xFF);

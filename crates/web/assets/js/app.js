@@ -11,7 +11,7 @@ import { IoPanel } from "./io.js";
 import { ProgramPanel } from "./program.js";
 import { WorldPanel } from "./world.js";
 import { ToolsPanel } from "./tools.js";
-import { unitControls } from "./units.js";
+import { unitControls, showModule } from "./units.js";
 
 const panels = {
   direct: new DirectPanel(),
@@ -76,6 +76,7 @@ async function pick(modules, info, id) {
   if (mine !== picks) return;
   if (live) live.close();
   const ctx = { id, module: mod, profile, info, virtual: mod.virtual, resubscribe: () => resubscribe(ctx) };
+  showModule(profile);
   for (const p of Object.values(panels)) p.setModule(ctx);
   // The title names the module the panels now act on: a command typed as
   // soon as it shows goes to that module.

@@ -6,7 +6,7 @@
 // panel (µsteps, a speed, a 0…1023 load, a 0…31 current, switches 0/1)
 // has its own axis. Every panel exports PNG and CSV.
 import { el, axisOptions, download, motorSelector } from "./api.js";
-import { factor, unitName, onUnits, divisorReads, DIVISORS } from "./units.js";
+import { factor, unitName, onUnits, conversionReads, conversionNumbers, unit as chosenUnit } from "./units.js";
 
 const COLORS = ["#0b6bcb", "#e67e22", "#1e8e3e", "#8e44ad", "#c0392b", "#16697a", "#7f8c8d"];
 const REDRAW_MS = 100;
@@ -110,7 +110,12 @@ export class ChartsPanel {
   /** The scale group of a series: one axis per group in a panel. */
   group(s) {
     const r = s.row;
-    if (r?.quantity) return { key: r.quantity, label: unitName(r.quantity) };
+    if (r?.quantity) {
+      // In internal units a sixPoint module's speeds and its measured speed
+      // (pps either way) may differ: each on its own axis then.
+      const key = chosenUnit() === "internal" ? `${r.quantity}:${r.quantity_units}` : r.quantity;
+      return { key, label: unitName(r.quantity, r.quantity_units) };
+    }
     if (r && r.min === 0 && r.max === 1) return { key: "0/1", label: "0/1", bool: true };
     if (!r) return { key: "0/1", label: "0/1", bool: true };
     const range = r.min <= -(2 ** 31) && r.max >= 2 ** 31 - 1 ? "" : ` ${r.min}…${r.max}`;
@@ -139,11 +144,12 @@ export class ChartsPanel {
         s.group = this.group(s);
       }
     }
-    // The divisors of every motor whose speeds are drawn come along with
-    // each sample, so that each sample converts with its own.
+    // The conversion reads (divisors, unit mode, microsteps) of every motor
+    // whose speeds are drawn come along with each sample, so that each
+    // sample converts with its own.
     const series = this.panels.flatMap((x) => x.series);
     const motors = [...new Set(series.filter((s) => s.row?.quantity).map((s) => s.index))];
-    this.subscribed = [...series, ...motors.flatMap((m) => divisorReads(p, m))].filter((s, i, all) => all.findIndex((x) => keyOf(x) === keyOf(s)) === i);
+    this.subscribed = [...series, ...motors.flatMap((m) => conversionReads(p, m))].filter((s, i, all) => all.findIndex((x) => keyOf(x) === keyOf(s)) === i);
     for (const s of this.subscribed) if (!this.store.has(keyOf(s))) this.store.set(keyOf(s), new Array(this.t.length).fill(null));
     this.draw();
   }
@@ -245,10 +251,12 @@ export class ChartsPanel {
     const raw = this.store.get(s.key).slice(from);
     const q = s.row?.quantity;
     if (!q) return raw;
-    const d = Object.fromEntries(DIVISORS.map((n) => [n, this.store.get(`ap:${s.index}:${n}`)]));
+    const p = this.ctx.profile;
+    const numbers = conversionNumbers(p);
+    const d = Object.fromEntries(numbers.map((n) => [n, this.store.get(`ap:${s.index}:${n}`)]));
     return raw.map((v, i) => {
       if (v == null) return null;
-      const f = factor(q, this.ctx.profile?.motion_clock_hz, Object.fromEntries(DIVISORS.map((n) => [n, d[n]?.[from + i]])));
+      const f = factor(q, s.row.quantity_units, p, Object.fromEntries(numbers.map((n) => [n, d[n]?.[from + i]])));
       return f == null ? null : v * f;
     });
   }
@@ -268,7 +276,7 @@ export class ChartsPanel {
    * column per signal (in the chosen unit); a gap is an empty cell. */
   csv(panels, name) {
     const series = panels.flatMap((x) => x.series);
-    const unit = (s) => (s.row?.quantity ? ` [${unitName(s.row.quantity)}]` : "");
+    const unit = (s) => (s.row?.quantity ? ` [${unitName(s.row.quantity, s.row.quantity_units)}]` : "");
     const head = ["t_s", ...series.map((s) => (s.label + unit(s)).replace(/,/g, ";"))].join(",");
     const columns = series.map((s) => this.values(s));
     const lines = this.t.map((t, i) => [t.toFixed(6), ...columns.map((d) => d[i] ?? "")].join(","));

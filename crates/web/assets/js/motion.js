@@ -1,9 +1,10 @@
 // Motion: rotate, stop, move absolute/relative with a speed; the axis's
 // position, speed and switches from the live stream (the reference search
 // is among the tools, tools.js). Speeds are shown and entered in the
-// page's unit, converted with the motor's divisors as last read.
+// page's unit, converted as the module's motion units say, with the motor's
+// conversion reads (divisors, unit mode, microsteps) as last read.
 import { post, el, m, axisOptions, motorSelector } from "./api.js";
-import { factor, show as inUnit, toInternal, divisorReads, divisorsOf } from "./units.js";
+import { factor, show as inUnit, toInternal, conversionReads, conversionOf, conversionNames, learn } from "./units.js";
 
 // AP 1 actual, AP 0 target position, AP 3 actual speed, AP 8 position
 // reached, AP 11 / 10 / 9 left, right and home switch.
@@ -16,8 +17,9 @@ export class MotionPanel {
     motorSelector(this.axis, () => this.ctx?.resubscribe());
     // A speed typed in the page's unit, as the internal value sent.
     const internal = (x) => {
-      const v = toInternal(Number(x), "velocity", this.ctx.profile?.motion_clock_hz, this.divisors);
-      if (v == null) this.log.append(el("div", { class: "err", text: "the motor's divisors (AP 140, 153, 154) are not read yet: no conversion" }));
+      const p = this.ctx.profile;
+      const v = toInternal(Number(x), "velocity", p?.motion_units, p, this.reads);
+      if (v == null) this.log.append(el("div", { class: "err", text: `the motor's ${conversionNames(p)} are not read yet: no conversion` }));
       return v;
     };
     const speed = () => internal(document.getElementById("rot-speed").value);
@@ -44,6 +46,7 @@ export class MotionPanel {
 
   setModule(ctx) {
     this.ctx = ctx;
+    this.reads = {};
     const p = ctx.profile;
     axisOptions(this.axis, ctx.profile);
     const has = new Set(p ? p.axis_parameters.map((r) => r.number) : READOUT);
@@ -52,14 +55,16 @@ export class MotionPanel {
 
   signals() {
     const index = Number(this.axis.value || 0);
-    return [...(this.readout ?? []).map((number) => ({ kind: "ap", number, index })), ...divisorReads(this.ctx?.profile, index)];
+    return [...(this.readout ?? []).map((number) => ({ kind: "ap", number, index })), ...conversionReads(this.ctx?.profile, index)];
   }
 
   onSample(t, values, msg, signals) {
     const v = {};
     signals.forEach((s, i) => (v[s.number] = values[i]));
-    this.divisors = divisorsOf(signals, values, signals[0]?.index);
-    const f = factor("velocity", this.ctx.profile?.motion_clock_hz, this.divisors);
+    const p = this.ctx.profile;
+    this.reads = conversionOf(p, signals, values, signals[0]?.index);
+    learn(this.reads);
+    const f = factor("velocity", p?.motion_units, p, this.reads);
     const show = (id, x) => (document.getElementById(id).textContent = x ?? "–");
     show("ro-position", v[1]);
     show("ro-target", v[0]);

@@ -2,9 +2,10 @@
 // live values, edited with validation against the range (SAP/SGP), stored
 // and restored (STAP/RSAP, STGP/RSGP). Values that change flash. Speeds and
 // accelerations are shown and typed in the page's unit, converted with the
-// motor's divisors read with the rows.
+// motor's conversion reads (divisors, unit mode, microsteps) read with the
+// rows.
 import { post, el, m, axisOptions, motorSelector } from "./api.js";
-import { factor, show, toInternal, unitName, onUnits, divisorReads, divisorsOf } from "./units.js";
+import { factor, show, toInternal, unitName, onUnits, conversionReads, conversionOf, conversionNames } from "./units.js";
 
 const POLL_MS = 300;
 const INT_MIN = -2147483648;
@@ -49,6 +50,7 @@ export class ParamsPanel {
 
   setModule(ctx) {
     this.ctx = ctx;
+    this.reads = {};
     axisOptions(this.axis, ctx.profile);
     this.draw();
   }
@@ -84,13 +86,13 @@ export class ParamsPanel {
         const writable = r.access.includes("W");
         input.disabled = set.disabled = !writable;
         // The typed value, in internal units (null: not a value).
-        const typedValue = () => (input.value === "" ? null : r.quantity ? toInternal(Number(input.value), r.quantity, p.motion_clock_hz, this.divisors) : Number(input.value));
+        const typedValue = () => (input.value === "" ? null : r.quantity ? toInternal(Number(input.value), r.quantity, r.quantity_units, p, this.reads) : Number(input.value));
         input.addEventListener("input", () => input.classList.toggle("invalid", input.value !== "" && !inRange(r, typedValue())));
         const doSet = async () => {
           const v = typedValue();
           if (v === null || !inRange(r, v)) {
-            const where = r.quantity ? `${range.textContent} ${unitName(r.quantity)}` : `${r.min}…${r.max}${r.ranges.length ? " (" + r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") + ")" : ""}`;
-            this.say(v === null && input.value !== "" ? `${r.name}: the motor's divisors are not read yet` : `${r.name}: ${input.value} is outside ${where}`, true);
+            const where = r.quantity ? `${range.textContent} ${unitName(r.quantity, r.quantity_units, this.reads)}` : `${r.min}…${r.max}${r.ranges.length ? " (" + r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") + ")" : ""}`;
+            this.say(v === null && input.value !== "" ? `${r.name}: the motor's ${conversionNames(p)} are not read yet` : `${r.name}: ${input.value} is outside ${where}`, true);
             input.classList.add("invalid");
             return;
           }
@@ -116,7 +118,7 @@ export class ParamsPanel {
         }
         const range = el("td", { class: "range", title: `${r.min}…${r.max}` });
         const def = el("td", { class: "default", title: r.note ?? "" }, el("span"), " ", el("span", { class: `src src-${r.default_source}`, text: r.default_source }));
-        const unit = el("td", { text: r.quantity ? unitName(r.quantity) : (r.unit ?? "") });
+        const unit = el("td", { class: "unit-cell", text: r.quantity ? unitName(r.quantity, r.quantity_units, this.reads) : (r.unit ?? "") });
         const rangeText = r.ranges.length ? r.ranges.map(([a, b]) => `${a}…${b}`).join(", ") : r.min === INT_MIN && r.max === INT_MAX ? "signed 32 bit" : `${r.min}…${r.max}`;
         const tr = el("tr", { "data-testid": `row-${kind}-${index}-${r.number}` },
           el("td", { class: "num", text: String(r.number) }),
@@ -129,7 +131,7 @@ export class ParamsPanel {
           def,
           el("td", { class: "actions" }, input, " ", set),
           extra);
-        const row = { r, kind, index, value, tr, readable: r.access.includes("R"), range, rangeText, def: def.firstChild };
+        const row = { r, kind, index, value, tr, readable: r.access.includes("R"), range, rangeText, def: def.firstChild, unit };
         this.rows.push(row);
         this.inUnit(row);
         this.observer.observe(tr);
@@ -140,13 +142,19 @@ export class ParamsPanel {
     this.poll();
   }
 
-  /** Range and default of a row, in the page's unit for a speed or an
-   * acceleration (as read with the last divisors). */
+  /** A row's factor: 1 for a value that is no speed or acceleration. */
+  factor(r) {
+    return r.quantity ? factor(r.quantity, r.quantity_units, this.ctx.profile, this.reads) : 1;
+  }
+
+  /** Range, default and unit of a row, in the page's unit for a speed or
+   * an acceleration (as read with the last conversion reads). */
   inUnit(x) {
-    const f = x.r.quantity ? factor(x.r.quantity, this.ctx.profile.motion_clock_hz, this.divisors) : 1;
+    const f = this.factor(x.r);
     const conv = (v) => (f === 1 ? String(v) : show(f == null ? null : v * f));
     x.range.textContent = f === 1 ? x.rangeText : `${conv(x.r.min)}…${conv(x.r.max)}`;
     x.def.textContent = conv(x.r.default);
+    if (x.r.quantity) x.unit.textContent = unitName(x.r.quantity, x.r.quantity_units, this.reads);
   }
 
   answer(r, a) {
@@ -165,17 +173,18 @@ export class ParamsPanel {
     if (!rows.length) return;
     this.polling = true;
     try {
-      // The motor's divisors come with the rows, for the speeds among them.
+      // The motor's conversion reads come with the rows, for the speeds
+      // among them.
       const motor = rows[0].kind === "ap" ? rows[0].index : null;
-      const extra = motor === null ? [] : divisorReads(this.ctx.profile, motor);
+      const extra = motor === null ? [] : conversionReads(this.ctx.profile, motor);
       const reads = [...extra, ...rows.map((x) => ({ kind: x.kind, number: x.r.number, index: x.index }))];
       const a = await post(m(this.ctx.id, "read"), { reads });
       if (!a.values) return;
-      this.divisors = divisorsOf(extra, a.values, motor);
+      if (motor !== null) this.reads = conversionOf(this.ctx.profile, extra, a.values, motor);
       const values = a.values.slice(extra.length);
       rows.forEach((x, i) => {
         if (x.r.quantity) this.inUnit(x);
-        const f = x.r.quantity ? factor(x.r.quantity, this.ctx.profile.motion_clock_hz, this.divisors) : 1;
+        const f = this.factor(x.r);
         const text = values[i] === null ? "error" : f === 1 ? String(values[i]) : show(f == null ? null : values[i] * f);
         if (x.value.textContent !== text) {
           const changed = x.value.textContent !== "–";

@@ -7,7 +7,7 @@
 // virtual module the coolStep tool steps the world's load; on a module
 // reached over a link it records what the module reports.
 import { get, post, el, m, axisOptions, motorSelector } from "./api.js";
-import { factor, show, toInternal, divisorReads, divisorsOf, unitName } from "./units.js";
+import { factor, show, toInternal, conversionReads, conversionOf, conversionNames, unitName } from "./units.js";
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const STATUS_MS = 500;
@@ -153,23 +153,25 @@ export class ToolsPanel {
     return r.values;
   }
 
-  /** Speeds typed in the page's unit to internal values and back, with the
-   * motor's divisors read now. */
+  /** Speeds typed in the page's unit to the module's values and back, in
+   * its motion units with the motor's conversion reads (divisors, unit
+   * mode, microsteps) read now. */
   async speeds() {
-    const reads = divisorReads(this.ctx.profile, this.motor());
+    const p = this.ctx.profile;
+    const reads = conversionReads(p, this.motor());
     const r = reads.length ? await post(m(this.ctx.id, "read"), { reads }) : { values: [] };
     if (r.error) throw new Error(r.error);
-    const d = divisorsOf(reads, r.values, this.motor());
-    const clock = this.ctx.profile.motion_clock_hz;
-    const f = factor("velocity", clock, d);
-    if (f == null) throw new Error("the motor's divisors (AP 140, 153, 154) could not be read: no speed conversion");
+    const d = conversionOf(p, reads, r.values, this.motor());
+    const f = factor("velocity", p.motion_units, p, d);
+    if (f == null) throw new Error(`the motor's ${conversionNames(p)} could not be read: no speed conversion`);
     return {
       internal: (id) => {
-        const v = toInternal(Number(document.getElementById(id).value), "velocity", clock, d);
+        const v = toInternal(Number(document.getElementById(id).value), "velocity", p.motion_units, p, d);
         if (!Number.isFinite(v) || v < 0) throw new Error(`${id}: give a speed ≥ 0`);
         return v;
       },
       shown: (v) => Number(show(v * f)),
+      unit: unitName("velocity", p.motion_units, d),
     };
   }
 
@@ -223,7 +225,7 @@ export class ToolsPanel {
     const apply = document.getElementById("sg-apply");
     apply.disabled = true;
     this.suggestion = null;
-    const unit = unitName("velocity");
+    const unit = u.unit;
     const bySpeed = [];
     const byThreshold = new Map();
     const drawSpeed = xyChart(document.getElementById("sg-chart-speed"), `Load value at threshold ${threshold0}`, `speed (${unit})`, [{ label: "load value", scale: "0…1023", points: true }]);

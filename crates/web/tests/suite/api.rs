@@ -52,6 +52,9 @@ fn the_profile_says_what_the_unit_conversion_needs() {
     assert_eq!(quantity(5), "acceleration");
     assert_eq!(quantity(1), Value::Null, "a position is neither");
     assert_eq!(quantity(154), Value::Null, "the pulse divisor is neither");
+    // In the TMC429's units, with the motor's microsteps and divisors.
+    assert_eq!(p["motion_units"], "tmc429");
+    assert_eq!(p["conversion"], json!({"microsteps": 140, "ramp_divisor": 153, "pulse_divisor": 154}));
 }
 
 #[test]
