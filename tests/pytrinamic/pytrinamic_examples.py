@@ -2,7 +2,9 @@
 distribution on PyPI, run unchanged against a served module: where they
 come from, how they run (at speed 1 as written, in virtual time through
 `tmclsim clock`), and what "the same printed results" means. Shared by
-test_examples_in_virtual_time.py and scripts/bench_host_clock.py.
+test_examples_in_virtual_time.py, test_sixpoint_demos.py (the sixPoint
+modules' demos, from the same source distribution) and
+scripts/bench_host_clock.py.
 
 The scripts call `ConnectionManager()` without arguments: PyTrinamic then
 reads the connection from the command line, so
@@ -111,9 +113,15 @@ def pinned_version():
 
 def examples_dir(python=sys.executable):
     """The directory of the TMCM-1140 examples in PyTrinamic's source
-    distribution: downloaded with pip from the package registry into
-    target/pytrinamic-sdist (scripts/test's preparation does it; here only
-    when that did not run) and unpacked there, once."""
+    distribution (`sdist_dir`)."""
+    return sdist_dir(python) / EXAMPLES
+
+
+def sdist_dir(python=sys.executable):
+    """PyTrinamic's source distribution, unpacked: downloaded with pip from
+    the package registry into target/pytrinamic-sdist (scripts/test's
+    preparation does it; here only when that did not run) and unpacked
+    there, once."""
     version = pinned_version()
     cache = ROOT / "target" / "pytrinamic-sdist"
     tree = cache / f"pytrinamic-{version}"
@@ -138,7 +146,7 @@ def examples_dir(python=sys.executable):
             except OSError:
                 if not tree.is_dir():
                     raise
-    return tree / EXAMPLES
+    return tree
 
 
 def clock_command(tmclsim, python, speed):
@@ -159,13 +167,19 @@ class Run:
     wall: float
 
 
-def run_example(command, script, tcp, timeout):
+def run_example(command, script, tcp, timeout, connection=None, env=None):
     """Runs `command + [script, connection arguments]` in the script's
     directory with enter presses on stdin; its wall time is from the start
-    of the process to its end. On timeout the whole process group (the
-    clock's interpreter too) is killed and TimeoutExpired raised."""
+    of the process to its end. The connection arguments are PyTrinamic's
+    `--interface socket_serial_tmcl --port TCP`, or the list `connection`
+    (e.g. serial_tmcl on the pty); `env`, when given, is the process's
+    environment. On timeout the whole process group (the clock's
+    interpreter too) is killed and TimeoutExpired raised, with what the
+    process printed."""
     script = pathlib.Path(script)
-    args = [*command, script.name, "--interface", "socket_serial_tmcl", "--port", tcp]
+    if connection is None:
+        connection = ["--interface", "socket_serial_tmcl", "--port", tcp]
+    args = [*command, script.name, *connection]
     start = time.monotonic()
     proc = subprocess.Popen(
         args,
@@ -175,12 +189,13 @@ def run_example(command, script, tcp, timeout):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        env=env,
     )
     try:
         stdout, stderr = proc.communicate(ENTER_PRESSES, timeout=timeout)
-    except subprocess.TimeoutExpired:
+    except subprocess.TimeoutExpired as e:
         os.killpg(proc.pid, signal.SIGKILL)
-        proc.communicate()
+        e.stdout, e.stderr = proc.communicate()
         raise
     return Run(proc.returncode, stdout, stderr, time.monotonic() - start)
 

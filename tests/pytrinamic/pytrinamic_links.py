@@ -9,14 +9,20 @@ from pytrinamic.connections import ConnectionManager
 LINKS = ["tcp", "pty"]
 
 
-def connect(served, link):
-    """PyTrinamic's connection to the served module over `link` (tcp, or the
-    pty at the module's default 9600 baud)."""
+def connection_arguments(served, link):
+    """PyTrinamic's connection arguments for the served module's `link`
+    (tcp, or the pty at the module's default 9600 baud)."""
     if link == "tcp":
         args = f"--interface socket_serial_tmcl --port {served.tcp}"
     else:
         args = f"--interface serial_tmcl --port {served.pty_link} --data-rate 9600"
-    return ConnectionManager(args.split()).connect()
+    return args.split()
+
+
+def connect(served, link):
+    """PyTrinamic's connection to the served module over `link` (tcp, or the
+    pty at the module's default 9600 baud)."""
+    return ConnectionManager(connection_arguments(served, link)).connect()
 
 
 def wait_until(predicate, timeout=20.0, what=None, seen=None):

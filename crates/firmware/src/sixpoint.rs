@@ -77,8 +77,8 @@ impl SixPoint {
         if !self.has_v1() {
             (self.dmax, floor)
         } else if u > self.v1 + EPS_VEL {
-            // Below VSTOP (or the floor) the motor never slows: D1 has no
-            // part when V1 lies there.
+            // DMAX down to V1; with V1 at or below the floor (VSTOP, a
+            // lowered VMAX) DMAX all the way, and D1 has no part.
             (self.dmax, self.v1.max(floor))
         } else {
             (self.d1, floor)
@@ -111,7 +111,8 @@ impl SixPoint {
     /// The braking distance from `u` to VSTOP (0 at or below VSTOP).
     pub fn brake(&self, u: f64) -> f64 {
         let u = u.abs();
-        let p = self.pieces().into_iter().find(|p| u <= p.hi).unwrap_or(self.pieces()[2]);
+        let pieces = self.pieces();
+        let p = pieces.into_iter().find(|p| u <= p.hi).unwrap_or(pieces[2]);
         (p.alpha * u * u + p.beta).max(0.0)
     }
 

@@ -461,3 +461,35 @@ fn not_comparable_readings_are_listed_only_when_they_differ() {
         assert!(out.contains("result: 0 differences, 3 not comparable (1 of them the same), 0 match"), "{out}");
     }
 }
+
+#[test]
+#[cfg_attr(windows, ignore = "a clean stop needs Ctrl-C in the child, which Wine does not deliver to another process")]
+fn a_sixpoint_session_checks_clean_on_the_module_its_136_names() {
+    // A TMCM-1260 (the sixPoint ramp): the ramp written, a move polled to
+    // its end, the version; checked with --module auto.
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("sixpoint.jsonl");
+    let server = Server::start(&["--module", "tmcm-1260", "--tcp", "127.0.0.1:0"]);
+    let rec = recorder(&["--tcp", &server.tcp()], &trace);
+    let mut host = Host::connect(&rec.printed("listen"));
+    assert_eq!(&host.raw(frame("#136 0 0 0"))[1..], b"1260V144");
+    for (n, v) in [(4, 40_000), (5, 30_000), (15, 5_000), (16, 10_000), (17, 20_000), (18, 5_000), (19, 5_000), (20, 5_000)] {
+        assert_eq!(host.value(&format!("SAP {n}, 0, {v}")), v);
+    }
+    host.value("MVP ABS, 0, 20000");
+    let start = Instant::now();
+    while host.value("GAP 8, 0") == 0 {
+        host.value("GAP 1, 0");
+        assert!(start.elapsed() < Duration::from_secs(10), "the motor never arrived");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert_eq!(host.value("GAP 1, 0"), 20_000);
+    assert_eq!(host.value("GAP 16, 0"), 10_000);
+    drop(host);
+    assert_eq!(stop(rec), Some(0));
+    let (code, out) = check(&trace, &["--module", "auto", "--time-tolerance", "100"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("result: 0 differences"), "{out}");
+    assert!(out.contains("TMCM-1260"), "{out}");
+    server.stop();
+}

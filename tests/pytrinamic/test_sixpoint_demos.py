@@ -1,0 +1,437 @@
+"""Software nobody here wrote, on the sixPoint modules (TMC5130/TMC5160):
+PyTrinamic's own demo scripts for the TMCM-1210, 1211, 1240, 1241, 1260,
+1270, 1276, 1278, 6212 and 6214, from its source distribution on PyPI
+(pytrinamic_examples.sdist_dir), unchanged, against served modules at
+speed 1, as a user runs them against the real ones.
+
+- rotate_demo.py of every module: rotates, stops, doubles the distance,
+  moves back to 0. It ends at 0 on every motor it drives.
+- six_point_ramp_demo.py (TMCM-1210, 1211, 1276, 1278, 6214): sets the
+  sixPoint ramp (VSTART, A1, V1, AMAX, VMAX, DMAX, D1, VSTOP, the ramp
+  wait), moves to 100 000 and back to 0 while sampling position and
+  velocity, and plots them. The sampled velocity shows each phase with its
+  own slope, the cruise at VMAX, the ramp wait between the moves
+  (`ramp_phases`), and the motor ends at 0.
+- stop_switch_demo.py (TMCM-1276, 1278): rotates until the right stop
+  switch stops the motor, then rotates back (sixpoint_stop_switch_world.toml).
+- StallGuard2_demo.py (TMCM-1240, 1241, 6214): calibrates stallGuard2, then
+  waits until a load stops the motor (sixpoint_stallguard2_world.toml).
+
+A demo that names its own connection (PCAN, a serial port chosen
+interactively) gets the served module's: run_demo.py runs it with every
+ConnectionManager given the test's arguments, the pty with serial_tmcl
+for the demos written for a serial line (USB, PyTrinamic's default, or
+serial_tmcl), TCP for the ones written for CAN. Its plot goes to PNG and
+JSON files (run_demo.py) instead of a window. Each demo must run to its
+end: exit status 0, no traceback, no TMCL status error.
+"""
+
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+from dataclasses import dataclass
+
+import pytest
+from pytrinamic_examples import HERE, DownloadFailed, run_example, sdist_dir
+from pytrinamic_links import connect, connection_arguments, wait_until
+from tmclsim_binary import tmclsim_binary
+
+MODULES = [1210, 1211, 1240, 1241, 1260, 1270, 1276, 1278, 6212, 6214]
+ROTATE = "rotate_demo.py"
+SIX_POINT = "six_point_ramp_demo.py"
+STOP_SWITCH = "stop_switch_demo.py"
+STALLGUARD2 = "StallGuard2_demo.py"
+# The modules whose examples have the demo besides rotate_demo.py.
+SIX_POINT_MODULES = [1210, 1211, 1276, 1278, 6214]
+STOP_SWITCH_MODULES = [1276, 1278]
+STALLGUARD2_MODULES = [1240, 1241, 6214]
+DEMOS = (
+    [(m, ROTATE) for m in MODULES]
+    + [(m, SIX_POINT) for m in SIX_POINT_MODULES]
+    + [(m, STOP_SWITCH) for m in STOP_SWITCH_MODULES]
+    + [(m, STALLGUARD2) for m in STALLGUARD2_MODULES]
+)
+RUNNER = HERE / "run_demo.py"
+STOP_SWITCH_WORLD = HERE / "sixpoint_stop_switch_world.toml"
+STALLGUARD2_WORLD = HERE / "sixpoint_stallguard2_world.toml"
+# The world files' numbers the checks use (the files explain them).
+RIGHT_SWITCH = (100000, 120000)
+TIGHT_SPOT = (40000, 40200)
+
+# A demo that takes longer is killed: at speed 1 they take 6 to 42 s.
+TIMEOUT = 120
+# What a failed run prints as a TMCL status error (PyTrinamic's
+# TMCLReplyStatusError and its reply's description) or a traceback.
+FAILURE = re.compile(r"Traceback|TMCLReply\w*Error|status\W+(error|code)", re.IGNORECASE)
+
+# The sixPoint ramp's fit (`ramp_phases`). A phase's slope is compared with
+# the demo's value within half a register unit of the chip's acceleration
+# (rule 104 rounds pps² to whole register units, a_unit = f_CLK²/2^41, 116
+# pps² at 16 MHz) plus SLOPE_TOLERANCE of the value: the sampling's jitter
+# (the median fit below is within 0.1 % on an idle machine). Mixing the
+# demo's accelerations up (D1 5000 against DMAX 20 000, A1 against AMAX)
+# is off by a factor of 4 or more.
+SLOPE_TOLERANCE = 0.03
+# The fewest samples strictly inside a phase's velocity band (thousands on
+# an idle machine: a sample takes three requests).
+MIN_PHASE_SAMPLES = 20
+# The ramp wait between the two moves is measured between the last moving
+# sample of one and the first of the next: at least the wait minus what a
+# late sample explains, at most the wait plus sampling gaps on a busy
+# machine. Without the wait the gap is one loop turn, milliseconds.
+WAIT_EARLY, WAIT_LATE = 0.1, 0.9
+
+
+@pytest.fixture(scope="session")
+def sdist():
+    """PyTrinamic's source distribution, unpacked."""
+    try:
+        return sdist_dir()
+    except DownloadFailed as e:
+        pytest.skip(f"PyTrinamic's source distribution (with its examples) could not be downloaded from the package registry: {e}")
+
+
+def demo_path(sdist, module, script):
+    return sdist / "examples" / "modules" / f"TMCM{module}" / "TMCL" / script
+
+
+def own_connection(text):
+    """The argument string the demo passes to ConnectionManager, or None
+    (the command line, PyTrinamic's default usb_tmcl)."""
+    m = re.search(r"ConnectionManager\(\s*(?:\"([^\"]*)\"|'([^']*)')?", text)
+    if not m:
+        raise AssertionError("the demo makes no ConnectionManager")
+    given = m.group(1) if m.group(1) is not None else m.group(2)
+    return given
+
+
+def link_for(text):
+    """The served link a demo runs on: the pty (serial_tmcl) when it was
+    written for a serial line (USB, serial_tmcl, PyTrinamic's default),
+    TCP when it was written for CAN."""
+    given = own_connection(text)
+    return "pty" if not given or re.search(r"\b(serial_tmcl|usb_tmcl)\b", given) else "tcp"
+
+
+@dataclass
+class Demo:
+    module: int
+    script: str
+    text: str
+    link: str
+    served: object
+    run: object
+    connections: list
+    figures: object
+
+    def report(self):
+        return (
+            f"TMCM-{self.module} {self.script} over {self.link} (the demo's own connection {self.connections!r}): "
+            f"exit status {self.run.returncode}, {self.run.wall:.1f} s\n"
+            f"--- stdout (last 40 lines)\n" + "\n".join(self.run.stdout.splitlines()[-40:]) + f"\n--- stderr\n{self.run.stderr}"
+        )
+
+    def lines(self):
+        return [line for line in self.run.stdout.splitlines() if line.strip()]
+
+
+def run_demo(sdist, serve, tmp_path, module, script, world="free"):
+    """Serves a TMCM-`module` in `world` and runs the demo through run_demo.py
+    on its link; fails unless it ran to its end without a status error."""
+    path = demo_path(sdist, module, script)
+    text = path.read_text(encoding="utf-8")
+    link = link_for(text)
+    served = serve("--module", f"tmcm-{module}", "--world", str(world))
+    figures = tmp_path / "figures"
+    command = [sys.executable, str(RUNNER), "--figures", str(figures)]
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    try:
+        run = run_example(command, path, served.tcp, TIMEOUT, connection=connection_arguments(served, link), env=env)
+    except subprocess.TimeoutExpired as e:
+        pytest.fail(
+            f"TMCM-{module} {script} over {link} did not end within {TIMEOUT} s (killed); its last output:\n"
+            + "\n".join((e.stdout or "").splitlines()[-20:]) + f"\n--- stderr\n{e.stderr or ''}"
+        )
+    connections = json.loads((figures / "connections.json").read_text()) if (figures / "connections.json").exists() else []
+    demo = Demo(module, script, text, link, served, run, connections, figures)
+    assert run.returncode == 0, demo.report()
+    bad = [line for line in (run.stdout + run.stderr).splitlines() if FAILURE.search(line)]
+    assert not bad, f"{bad}\n{demo.report()}"
+    assert connections, f"the demo made no ConnectionManager through the runner\n{demo.report()}"
+    return demo
+
+
+def read_axis(served, link, axis, *numbers):
+    """Axis parameters of the served module (signed), read after the demo."""
+    with connect(served, link) as interface:
+        return [interface.get_axis_parameter(n, axis, signed=True) for n in numbers]
+
+
+def wait_for_standstill(served, link, axis):
+    """Waits until the motor on `axis` stands (AP 3 is 0); returns its
+    position (AP 1)."""
+    with connect(served, link) as interface:
+        wait_until(lambda: interface.get_axis_parameter(3, axis, signed=True) == 0, what=f"motor {axis} to stand",
+                   seen=lambda: interface.get_axis_parameter(3, axis, signed=True))
+        return interface.get_axis_parameter(1, axis, signed=True)
+
+
+def test_every_demo_is_in_the_source_distribution(sdist):
+    """The demos this suite runs are all there (a newer PyTrinamic that
+    drops or renames one fails here, naming it)."""
+    missing = [f"TMCM{m}/TMCL/{s}" for m, s in DEMOS if not demo_path(sdist, m, s).exists()]
+    assert not missing, f"not in PyTrinamic's source distribution: {missing}"
+
+
+# ---------------------------------------------------------------- rotate
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("module", MODULES, ids=lambda m: f"TMCM-{m}")
+def test_rotate_demo(module, sdist, serve, tmp_path):
+    """rotate_demo.py rotates, stops, doubles the distance and moves back:
+    it reports each step and every motor it drives ends at position 0."""
+    demo = run_demo(sdist, serve, tmp_path, module, ROTATE)
+    out = demo.run.stdout.lower()
+    for step in ("rotating", "stopping", "doubling moved distance", "furthest point reached", "moving back to 0", "reached position 0"):
+        assert step in out, f"no {step!r} in the output\n{demo.report()}"
+    axes = sorted({int(n) for n in re.findall(r"module\.motors\[(\d+)\]", demo.text)})
+    for axis in axes:
+        position, velocity, reached = read_axis(demo.served, demo.link, axis, 1, 3, 8)
+        assert (position, velocity, reached) == (0, 0, 1), f"motor {axis}: position {position}, speed {velocity}, reached {reached}\n{demo.report()}"
+
+
+# ---------------------------------------------------------- sixPoint ramp
+
+
+def demo_parameters(text):
+    """The axis parameters the demo sets by name: {"A1": 5000, …}."""
+    return {name: int(value) for name, value in re.findall(r"set_axis_parameter\(\s*motor\.AP\.(\w+)\s*,\s*(-?\d+)\s*\)", text)}
+
+
+def motion_clock_hz(module):
+    """The module's motion clock, from its profile (`tmclsim profile`)."""
+    out = subprocess.run([tmclsim_binary(), "profile", f"tmcm-{module}"], capture_output=True, text=True, check=True).stdout
+    return int(re.search(r"motion_clock_hz\s+(\d+)", out).group(1))
+
+
+def slope(points):
+    """The slope of (t, v) points, robust against a late sample: the median
+    of the slopes between each point and the one half the phase later."""
+    half = len(points) // 2
+    return statistics.median((points[i + half][1] - points[i][1]) / (points[i + half][0] - points[i][0]) for i in range(len(points) - half))
+
+
+def moves(t, v):
+    """The runs of moving samples (velocity not 0): [[(t, v)…]…]."""
+    runs, run = [], []
+    for ti, vi in zip(t, v):
+        if vi != 0:
+            run.append((ti, vi))
+        elif run:
+            runs.append(run)
+            run = []
+    if run:
+        runs.append(run)
+    return runs
+
+
+def ramp_phases(t, v, p, clock_hz, n_moves):
+    """What is wrong with a sampled sixPoint velocity profile: the demo's
+    `n_moves` moves, each starting at VSTART, A1 up to V1, AMAX up to
+    VMAX, a cruise at VMAX, DMAX down to V1, D1 down to VSTOP; between
+    two moves the ramp wait. `p` holds the demo's parameters by PyTrinamic's
+    names. A phase's samples are the ones strictly inside its velocity
+    band, before the cruise (A1, AMAX) or after it (DMAX, D1). An empty
+    list when the profile is right."""
+    vstart, v1, vmax, vstop = p["StartVelocity"], p["V1"], p["MaxVelocity"], p["StopVelocity"]
+    unit = clock_hz**2 / 2**41
+    phases = [("A1", p["A1"], 1, vstart, v1), ("AMAX", p["MaxAcceleration"], 1, v1, vmax),
+              ("DMAX", p["MaxDeceleration"], -1, v1, vmax), ("D1", p["D1"], -1, vstop, v1)]
+    found = []
+    runs = moves(t, v)
+    if len(runs) != n_moves:
+        return [f"{len(runs)} runs of moving samples, expected {n_moves} moves: " + ", ".join(f"{r[0][0]:.3f}…{r[-1][0]:.3f} s" for r in runs)]
+    for k, run in enumerate(runs):
+        where = f"move {k + 1} ({run[0][0]:.3f}…{run[-1][0]:.3f} s)"
+        direction = 1 if run[0][1] > 0 else -1
+        if any(vi * direction < 0 for _, vi in run):
+            found.append(f"{where}: changes direction without stopping")
+            continue
+        speed = [(ti, abs(vi)) for ti, vi in run]
+        top = max(s for _, s in speed)
+        if abs(top - vmax) > 1:
+            found.append(f"{where}: top speed {top:g}, VMAX is {vmax}")
+        low = min(s for _, s in speed)
+        if low < min(vstart, vstop) - 1:
+            found.append(f"{where}: moves at {low:g}, below VSTART {vstart} and VSTOP {vstop}")
+        if not vstart - 1 <= speed[0][1] < v1:
+            found.append(f"{where}: starts at {speed[0][1]:g}, not between VSTART {vstart} and V1 {v1}")
+        if not vstop - 1 <= speed[-1][1] < v1:
+            found.append(f"{where}: ends at {speed[-1][1]:g}, not between VSTOP {vstop} and V1 {v1}")
+        cruise = [i for i, (_, s) in enumerate(speed) if s >= top - 1]
+        parts = {1: speed[: cruise[0]], -1: speed[cruise[-1] + 1 :]}
+        for name, value, sign, low_band, high_band in phases:
+            points = [(ti, s) for ti, s in parts[sign] if low_band < s < high_band]
+            if len(points) < MIN_PHASE_SAMPLES:
+                found.append(f"{where}: {name}: {len(points)} samples between {low_band} and {high_band}, fewer than {MIN_PHASE_SAMPLES}")
+                continue
+            fitted = sign * slope(points)
+            tolerance = unit / 2 + SLOPE_TOLERANCE * value
+            if abs(fitted - value) > tolerance:
+                found.append(f"{where}: {name}: slope {fitted:.0f} µsteps/s² over {len(points)} samples "
+                             f"({points[0][0]:.3f}…{points[-1][0]:.3f} s), the demo sets {value} (±{tolerance:.0f})")
+    wait = p.get("RampWaitTime", 0) * 512 / clock_hz
+    for a, b in zip(runs, runs[1:]):
+        gap = b[0][0] - a[-1][0]
+        if not wait - WAIT_EARLY <= gap <= wait + WAIT_LATE:
+            found.append(f"standstill {gap:.3f} s between moves ({a[-1][0]:.3f}…{b[0][0]:.3f} s), the ramp wait is {wait:.3f} s")
+    return found
+
+
+def plotted_lines(figures):
+    """The dumped figure's lines by label: {"Velocity": (x, y), …}."""
+    dumps = sorted(figures.glob("figure-*.json"))
+    assert len(dumps) == 1, f"expected one figure shown, found {[d.name for d in dumps]}"
+    found = {}
+    for ax in json.loads(dumps[0].read_text())["axes"]:
+        for line in ax["lines"]:
+            found[line["label"]] = (line["x"], line["y"])
+    return found
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("module", SIX_POINT_MODULES, ids=lambda m: f"TMCM-{m}")
+def test_six_point_ramp_demo(module, sdist, serve, tmp_path):
+    """six_point_ramp_demo.py's sampled velocity shows the sixPoint ramp
+    with the demo's parameters, both ways, with the ramp wait between;
+    the position rests at the first target in the wait and the motor ends
+    at 0."""
+    demo = run_demo(sdist, serve, tmp_path, module, SIX_POINT)
+    assert (demo.figures / "figure-1.png").exists(), demo.report()
+    lines = plotted_lines(demo.figures)
+    t, v = lines["Velocity"]
+    tp, p = lines["Position"]
+    assert tp == t, "the position and the velocity are plotted over different times"
+    params = demo_parameters(demo.text)
+    targets = [int(x) for x in re.findall(r"motor\.move_to\(\s*(-?\d+)\s*\)", demo.text)]
+    assert targets == [100000, 0], targets
+    found = ramp_phases(t, v, params, motion_clock_hz(module), len(targets))
+    # The samples between the moves (the ramp wait): the motor rests on
+    # the first target. A sample reads the position before the velocity:
+    # the first one may have read it just before the motor arrived.
+    runs = moves(t, v)
+    if len(runs) == 2:
+        between = [p[i] for i in range(len(t)) if runs[0][-1][0] < t[i] < runs[1][0][0]]
+        if len(between) < 2 or set(between[1:]) != {float(targets[0])}:
+            found.append(f"the positions at standstill between the moves are {sorted(set(between))[:10]}, not {targets[0]}")
+    position, velocity, reached = read_axis(demo.served, demo.link, 0, 1, 3, 8)
+    if (position, velocity, reached) != (targets[-1], 0, 1):
+        found.append(f"after the demo: position {position}, speed {velocity}, reached {reached}; expected {targets[-1]}, 0, 1")
+    summary = f"{len(t)} samples over {t[-1]:.2f} s; the demo's parameters {params}; plot {demo.figures / 'figure-1.png'}"
+    assert not found, "\n".join(found) + f"\n{summary}\n{demo.report()}"
+
+
+def synthetic_profile(p, clock_hz, d1=None, wait=None, step=0.002):
+    """A six_point_ramp_demo.py run sampled every `step` s: to 100 000 and
+    back with the register values of `p` (rule 104), optionally with
+    another D1 or ramp wait."""
+
+    def register(a):
+        unit = clock_hz**2 / 2**41
+        return max(1, round(a / unit)) * unit
+
+    a1, amax, dmax = register(p["A1"]), register(p["MaxAcceleration"]), register(p["MaxDeceleration"])
+    d1_value = register(d1 if d1 is not None else p["D1"])
+    vstart, v1, vmax, vstop = p["StartVelocity"], p["V1"], p["MaxVelocity"], p["StopVelocity"]
+    pause = wait if wait is not None else p["RampWaitTime"] * 512 / clock_hz
+    # Phase durations and distances of one move of 100 000 µsteps.
+    phases = [(a1, vstart, v1), (amax, v1, vmax), (-dmax, vmax, v1), (-d1_value, v1, vstop)]
+    ramp = [(abs(b - a) / abs(acc), (a + b) / 2 * abs(b - a) / abs(acc)) for acc, a, b in phases]
+    cruise = (100000 - sum(d for _, d in ramp)) / vmax
+    profile = [(ramp[0][0], phases[0]), (ramp[1][0], phases[1]), (cruise, (0, vmax, vmax)), (ramp[2][0], phases[2]), (ramp[3][0], phases[3])]
+    t, v = [], []
+    now = 0.0
+    for sign in (1, -1):
+        start = now
+        for duration, (acc, a, _) in profile:
+            end = start + duration
+            while now < end:
+                t.append(now)
+                v.append(sign * round(a + acc * (now - start)))
+                now += step
+            start = end
+        pause_end = now + pause
+        while now < pause_end:
+            t.append(now)
+            v.append(0)
+            now += step
+    return t, v
+
+
+SIX_POINT_PARAMETERS = {
+    "MaxVelocity": 40000, "MaxAcceleration": 30000, "A1": 5000, "V1": 10000, "MaxDeceleration": 20000,
+    "D1": 5000, "StartVelocity": 5000, "StopVelocity": 5000, "RampWaitTime": 31250,
+}
+
+
+def test_the_ramp_check_tells_a_wrong_phase_apart():
+    """`ramp_phases` passes the demo's ramp in register units (30 000 pps²
+    runs at 30 034) with a late sample, and fails a ramp that brakes with
+    DMAX instead of D1 below V1, one without the ramp wait, and one that
+    never reaches VMAX."""
+    p, clock = SIX_POINT_PARAMETERS, 16_000_000
+    t, v = synthetic_profile(p, clock)
+    assert ramp_phases(t, v, p, clock, 2) == []
+    # A sample that came 30 ms late: the median fit ignores it.
+    late = list(t)
+    late[100] += 0.03
+    assert ramp_phases(late, v, p, clock, 2) == []
+    wrong = ramp_phases(*synthetic_profile(p, clock, d1=p["MaxDeceleration"]), p, clock, 2)
+    assert wrong and all(": D1: " in f for f in wrong), wrong
+    no_wait = ramp_phases(*synthetic_profile(p, clock, wait=0.004), p, clock, 2)
+    assert len(no_wait) == 1 and "ramp wait" in no_wait[0], no_wait
+    slower = {**p, "MaxVelocity": 45000}
+    assert any("top speed" in f for f in ramp_phases(t, v, slower, clock, 2))
+
+
+# ------------------------------------------------------------ stop switch
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("module", STOP_SWITCH_MODULES, ids=lambda m: f"TMCM-{m}")
+def test_stop_switch_demo(module, sdist, serve, tmp_path):
+    """stop_switch_demo.py rotates until the right stop switch stops the
+    motor on it, sees the switch pressed at its first look, and rotates
+    back for 5 s: about 250 000 µsteps back from the switch."""
+    demo = run_demo(sdist, serve, tmp_path, module, STOP_SWITCH, world=STOP_SWITCH_WORLD)
+    assert demo.lines()[1:] == ["Preparing parameters", "Rotating", "Rotating in opposite direction"], demo.report()
+    position = wait_for_standstill(demo.served, demo.link, 0)
+    # Back for at least the demo's 5 s at 50 000 µsteps/s (the ramps up
+    # and down take as long as they give back, both with AMAX, rule 109),
+    # at most 2 s more on a busy machine.
+    back = 5 * 50000
+    stopped_at = (position + back - 500, position + back + 2 * 50000)
+    assert stopped_at[0] <= RIGHT_SWITCH[1] and stopped_at[1] >= RIGHT_SWITCH[0], (
+        f"ends at {position}: the motor stopped at {stopped_at[0]}…{stopped_at[1]}, not on the switch {RIGHT_SWITCH}\n{demo.report()}"
+    )
+
+
+# ------------------------------------------------------------ stallGuard2
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("module", STALLGUARD2_MODULES, ids=lambda m: f"TMCM-{m}")
+def test_stallguard2_demo(module, sdist, serve, tmp_path):
+    """StallGuard2_demo.py calibrates while the motor runs freely and ends
+    when stallGuard2 stops it: at the tight spot, with the stall flag
+    (AP 207 bit 0) set."""
+    demo = run_demo(sdist, serve, tmp_path, module, STALLGUARD2, world=STALLGUARD2_WORLD)
+    assert demo.lines()[-1] == "Motor stopped by StallGuard2!", demo.report()
+    position, velocity, flags = read_axis(demo.served, demo.link, 0, 1, 3, 207)
+    assert velocity == 0 and TIGHT_SPOT[0] <= position <= TIGHT_SPOT[1] and flags & 1, (
+        f"after the demo: position {position} (the tight spot is {TIGHT_SPOT}), speed {velocity}, AP 207 = {flags}\n{demo.report()}"
+    )
