@@ -28,16 +28,19 @@ impl Motor<'_> {
             MotionUnits::Pps => motion::Units::Pps,
             MotionUnits::Sixpoint => motion::Units::Sixpoint {
                 fclk: self.at.features().motion_clock_hz,
-                internal: self.axis.params[sp::UNIT_MODE as usize] == 0,
+                internal: self.at.features().unit_mode.is_some_and(|n| self.axis.params[n as usize] == 0),
+                // The TMC5240's acceleration registers have 18 bits, the
+                // TMC5130/TMC5160's 16.
+                accel_max: if self.at.features().motion_controller == MotionController::Eightpoint { 262_143 } else { 65_535 },
             },
         }
     }
 
-    /// The sixPoint motion controller drives this axis: its own rows
-    /// number the soft stop, the switch polarities and swap, and the
-    /// shaft's direction (docs/behaviour.md rule 108).
+    /// The sixPoint (or eight-point) motion controller drives this axis:
+    /// its family's rows number the soft stop, the switch polarities and
+    /// swap, and the shaft's direction (docs/behaviour.md rules 108, 113).
     pub(crate) fn six_point(&self) -> bool {
-        self.at.features().motion_controller == MotionController::Sixpoint
+        matches!(self.at.features().motion_controller, MotionController::Sixpoint | MotionController::Eightpoint)
     }
 
     /// −1 with the motor's direction reversed (GP 90; AP 251 on a
@@ -124,9 +127,13 @@ impl Motor<'_> {
         }
         let units = self.units();
         if axis.closed_loop.torque_mode || axis.rfs.is_some() {
-            return axis.work_out_ramp(units, axis.closed_loop.torque_mode.then(|| self.torque_mode_velocity()));
+            return axis.work_out_ramp(
+                units,
+                self.at.features().motion_controller,
+                axis.closed_loop.torque_mode.then(|| self.torque_mode_velocity()),
+            );
         }
-        axis.plain_ramp(|| axis.work_out_ramp(units, None))
+        axis.plain_ramp(|| axis.work_out_ramp(units, self.at.features().motion_controller, None))
     }
 
     /// An axis parameter as a read finds it: the measured ones (position,

@@ -87,16 +87,17 @@ pub enum Units {
     Sixpoint {
         /// The chip's clock, Hz.
         fclk: u32,
-        /// AP 255 = 0: the chip's internal units.
+        /// The unit mode is 0: the chip's internal units.
         internal: bool,
+        /// The largest acceleration register value (2^16 − 1 on the
+        /// TMC5130/TMC5160, 2^18 − 1 on the TMC5240).
+        accel_max: u32,
     },
 }
 
 /// The largest velocity register value of the TMC5130/TMC5160 (VMAX, 23
 /// bits less 512): a larger value is taken as this one.
 const SIX_POINT_VMAX: f64 = 8_388_096.0;
-/// The largest acceleration register value (AMAX, A1, DMAX, D1: 16 bits).
-const SIX_POINT_AMAX: f64 = 65_535.0;
 
 /// µsteps per second of one sixPoint velocity unit at `fclk`.
 fn six_point_velocity_unit(fclk: f64) -> f64 {
@@ -123,7 +124,7 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, .. } => velocity_pps(v, pulse_div),
             Units::Pps => v,
-            Units::Sixpoint { fclk, internal } => {
+            Units::Sixpoint { fclk, internal, .. } => {
                 let unit = six_point_velocity_unit(f64::from(fclk));
                 let register = if internal { v } else { (v / unit).round() };
                 register.clamp(-SIX_POINT_VMAX, SIX_POINT_VMAX) * unit
@@ -136,7 +137,7 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, .. } => velocity_internal(pps, pulse_div),
             Units::Pps => pps,
-            Units::Sixpoint { fclk, internal } => {
+            Units::Sixpoint { fclk, internal, .. } => {
                 // The chip's velocity register holds whole units (towards zero).
                 let unit = six_point_velocity_unit(f64::from(fclk));
                 let register = (pps / unit + pps.sgn() * 1e-9).trunc();
@@ -150,10 +151,10 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, ramp_div } => accel_pps2(a, ramp_div, pulse_div),
             Units::Pps => a,
-            Units::Sixpoint { fclk, internal } => {
+            Units::Sixpoint { fclk, internal, accel_max } => {
                 let unit = six_point_accel_unit(f64::from(fclk));
                 let register = if internal { a } else { (a / unit).round().max(if a > 0.0 { 1.0 } else { 0.0 }) };
-                register.min(SIX_POINT_AMAX) * unit
+                register.min(f64::from(accel_max)) * unit
             }
         }
     }
@@ -163,7 +164,7 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, ramp_div } => accel_internal(pps2, ramp_div, pulse_div),
             Units::Pps => pps2,
-            Units::Sixpoint { fclk, internal } => {
+            Units::Sixpoint { fclk, internal, .. } => {
                 let value = pps2 / six_point_accel_unit(f64::from(fclk));
                 if internal { value } else { pps2 }
             }

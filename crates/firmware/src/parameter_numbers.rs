@@ -126,6 +126,12 @@ pub mod sp {
     pub const VSTOP: u8 = 20;
     /// TZEROWAIT: the standstill after a stop, in 512 clock cycles.
     pub const RAMP_WAIT: u8 = 21;
+    /// A2 (eight-point): the acceleration from V1 to V2.
+    pub const A2: u8 = 34;
+    /// V2 (eight-point): where A2 gives way to AMAX, DMAX to D2.
+    pub const V2: u8 = 35;
+    /// D2 (eight-point): the deceleration from V2 to V1.
+    pub const D2: u8 = 36;
     /// Right limit switch polarity (1: inverted).
     pub const RIGHT_SWITCH_POLARITY: u8 = 24;
     /// Left limit switch polarity (1: inverted).

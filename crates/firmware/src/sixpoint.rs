@@ -1,6 +1,8 @@
 //! The TMC5130/TMC5160 sixPoint ramp generator, the motion controller of
 //! the modules whose profile says `motion_controller = "sixpoint"`
-//! (docs/behaviour.md rules 104–110).
+//! (docs/behaviour.md rules 104–110), and the TMC5240's eight-point ramp,
+//! which adds a second knee V2 with its own A2 and D2
+//! (`motion_controller = "eightpoint"`, rule 113).
 //!
 //! A positioning move starts at VSTART, accelerates with A1 up to V1 and
 //! with AMAX up to VMAX, cruises, decelerates with DMAX down to V1 and with
@@ -42,6 +44,13 @@ pub struct SixPoint {
     pub dmax: f64,
     /// D1 (AP 18): the deceleration below V1.
     pub d1: f64,
+    /// A2 (eight-point only): the acceleration from V1 up to V2.
+    pub a2: f64,
+    /// V2 (eight-point only): where A2 gives way to AMAX and DMAX to D2;
+    /// 0 (and the sixPoint ramp) leaves A2 and D2 out.
+    pub v2: f64,
+    /// D2 (eight-point only): the deceleration from V2 down to V1.
+    pub d2: f64,
     /// VSTOP (AP 20): the speed at which the motor stops.
     pub vstop: f64,
     /// TZEROWAIT (AP 21) in seconds: the standstill after a stop before the
@@ -49,9 +58,19 @@ pub struct SixPoint {
     pub zero_wait: f64,
 }
 
+/// A band of speeds `lo ≤ w < hi` and the acceleration and deceleration
+/// the ramp uses in it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Band {
+    lo: f64,
+    hi: f64,
+    up: f64,
+    down: f64,
+}
+
 /// A piece of the braking distance `b(w) = α·w² + β` for speeds
-/// `lo < w ≤ hi`.
-#[derive(Clone, Copy, Debug)]
+/// `lo ≤ w ≤ hi`.
+#[derive(Clone, Copy, Debug, Default)]
 struct Piece {
     lo: f64,
     hi: f64,
@@ -60,59 +79,75 @@ struct Piece {
 }
 
 impl SixPoint {
-    /// True when A1 and D1 have their phases (V1 > 0).
-    fn has_v1(&self) -> bool {
-        self.v1 > 0.0
+    /// The ramp's bands from standstill up: A1/D1 below V1 (when V1 > 0),
+    /// A2/D2 from V1 to V2 (when V2 is above V1), AMAX/DMAX above. How
+    /// many there are.
+    fn bands(&self, amax: f64) -> ([Band; 3], usize) {
+        let mut bands = [Band::default(); 3];
+        let mut n = 0;
+        let mut lo = 0.0;
+        for (knee, up, down) in [(self.v1, self.a1, self.d1), (self.v2, self.a2, self.d2)] {
+            if knee > lo {
+                bands[n] = Band { lo, hi: knee, up, down };
+                n += 1;
+                lo = knee;
+            }
+        }
+        bands[n] = Band { lo, hi: f64::INFINITY, up: amax, down: self.dmax };
+        (bands, n + 1)
     }
 
     /// The acceleration that speeds the motor up from `u` and the speed at
-    /// which that acceleration ends (V1, or VMAX).
+    /// which that acceleration ends (a knee, or VMAX).
     fn speeding_up(&self, u: f64, amax: f64, vmax: f64) -> (f64, f64) {
-        if self.has_v1() && u < self.v1 - EPS_VEL && u < vmax - EPS_VEL { (self.a1, self.v1.min(vmax)) } else { (amax, vmax) }
+        let (bands, n) = self.bands(amax);
+        let b = bands[..n].iter().find(|b| u < b.hi - EPS_VEL).unwrap_or(&bands[n - 1]);
+        (b.up, b.hi.min(vmax))
+    }
+
+    /// The band below `u`: the one a motor slowing down from `u` is in.
+    fn band_below(&self, u: f64, amax: f64) -> Band {
+        let (bands, n) = self.bands(amax);
+        *bands[..n].iter().find(|b| u <= b.hi + EPS_VEL).unwrap_or(&bands[n - 1])
     }
 
     /// The deceleration that slows the motor down from `u` and the speed at
-    /// which it ends (V1, or `floor`).
+    /// which it ends (a knee, or `floor`: VSTOP). Knees at or below the
+    /// floor have no part.
     fn slowing_down(&self, u: f64, floor: f64) -> (f64, f64) {
-        if !self.has_v1() {
-            (self.dmax, floor)
-        } else if u > self.v1 + EPS_VEL {
-            // DMAX down to V1; with V1 at or below the floor (VSTOP, a
-            // lowered VMAX) DMAX all the way, and D1 has no part.
-            (self.dmax, self.v1.max(floor))
-        } else {
-            (self.d1, floor)
-        }
+        let b = self.band_below(u, 0.0);
+        (b.down, b.lo.max(floor))
     }
 
-    /// The braking distance from `u` down to VSTOP, piece by piece: DMAX
-    /// above V1, D1 below it (DMAX throughout when V1 = 0).
-    fn pieces(&self) -> [Piece; 3] {
+    /// The braking distance from `w` down to VSTOP, piece by piece: each
+    /// band above VSTOP with its deceleration. How many pieces there are
+    /// (the first is the standstill below VSTOP).
+    fn pieces(&self) -> ([Piece; 4], usize) {
         let vs = self.vstop;
-        let none = Piece { lo: 0.0, hi: vs, alpha: 0.0, beta: 0.0 };
-        if self.has_v1() && self.v1 > vs {
-            let lower = Piece { lo: vs, hi: self.v1, alpha: 1.0 / (2.0 * self.d1), beta: -vs * vs / (2.0 * self.d1) };
-            let below_v1 = (self.v1 * self.v1 - vs * vs) / (2.0 * self.d1);
-            let upper = Piece {
-                lo: self.v1,
-                hi: f64::INFINITY,
-                alpha: 1.0 / (2.0 * self.dmax),
-                beta: below_v1 - self.v1 * self.v1 / (2.0 * self.dmax),
-            };
-            [none, lower, upper]
-        } else {
-            // V1 = 0, or V1 at or below VSTOP: DMAX all the way down.
-            let dec = self.dmax;
-            let only = Piece { lo: vs, hi: f64::INFINITY, alpha: 1.0 / (2.0 * dec), beta: -vs * vs / (2.0 * dec) };
-            [none, only, only]
+        let mut pieces = [Piece::default(); 4];
+        pieces[0] = Piece { lo: 0.0, hi: vs, alpha: 0.0, beta: 0.0 };
+        let mut n = 1;
+        let mut base = 0.0;
+        let (bands, count) = self.bands(0.0);
+        for b in &bands[..count] {
+            if b.hi <= vs {
+                continue;
+            }
+            let lo = b.lo.max(vs);
+            pieces[n] = Piece { lo, hi: b.hi, alpha: 1.0 / (2.0 * b.down), beta: base - lo * lo / (2.0 * b.down) };
+            n += 1;
+            if b.hi.is_finite() {
+                base += (b.hi * b.hi - lo * lo) / (2.0 * b.down);
+            }
         }
+        (pieces, n)
     }
 
     /// The braking distance from `u` to VSTOP (0 at or below VSTOP).
     pub fn brake(&self, u: f64) -> f64 {
         let u = u.abs();
-        let pieces = self.pieces();
-        let p = pieces.into_iter().find(|p| u <= p.hi).unwrap_or(pieces[2]);
+        let (pieces, n) = self.pieces();
+        let p = pieces[..n].iter().find(|p| u <= p.hi).unwrap_or(&pieces[n - 1]);
         (p.alpha * u * u + p.beta).max(0.0)
     }
 
@@ -120,7 +155,8 @@ impl SixPoint {
     /// braking to VSTOP covers exactly `d`: where the braking point lies.
     fn peak(&self, u: f64, acc: f64, d: f64) -> f64 {
         let k = 1.0 / (2.0 * acc);
-        for p in self.pieces() {
+        let (pieces, n) = self.pieces();
+        for p in &pieces[..n] {
             // k·(w² − u²) + α·w² + β = d
             let w2 = (d - p.beta + k * u * u) / (k + p.alpha);
             let w = w2.max(0.0).sqrt();
@@ -177,7 +213,7 @@ impl SixPoint {
         Some(Phase::accel(a * dv.sgn(), dv.abs() / a))
     }
 
-    /// Positioning mode: the six points towards the target.
+    /// Positioning mode: the six (or eight) points towards the target.
     pub(crate) fn plan_position(&self, m: &Now, vmax: f64, amax: f64, stops: &Stops) -> Option<Phase> {
         let delta = m.target - m.x;
         let d = delta.abs();
@@ -234,15 +270,10 @@ impl SixPoint {
         }
         if u > vmax + EPS_VEL {
             // VMAX lowered while moving: down to it with the acceleration
-            // values, AMAX above V1 and A1 below (rule 106).
-            let (acc, end) = if self.has_v1() && u <= self.v1 + EPS_VEL {
-                (self.a1, vmax)
-            } else if self.has_v1() {
-                (amax, self.v1.max(vmax))
-            } else {
-                (amax, vmax)
-            };
-            return Some(Phase::accel(-dir * acc, (u - end) / acc));
+            // values of the bands it passes, AMAX above V1 and A1 below
+            // (rule 106).
+            let b = self.band_below(u, amax);
+            return Some(Phase::accel(-dir * b.up, (u - b.lo.max(vmax)) / b.up));
         }
         if u < vmax - EPS_VEL {
             let (acc, end) = self.speeding_up(u, amax, vmax);

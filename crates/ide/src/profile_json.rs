@@ -70,10 +70,15 @@ fn conversion(profile: &Profile) -> Value {
     let roles: &[(&str, u8)] = match profile.features.motion_units {
         MotionUnits::Tmc429 => &[("microsteps", 140), ("ramp_divisor", 153), ("pulse_divisor", 154)],
         MotionUnits::Pps => &[("microsteps", 140)],
-        MotionUnits::Sixpoint => &[("microsteps", 140), ("unit_mode", 255)],
+        MotionUnits::Sixpoint => &[("microsteps", 140)],
     };
     let has = |n: u8| profile.axis_parameters().any(|p| p.number == n);
-    Value::Object(roles.iter().filter(|(_, n)| has(*n)).map(|(k, n)| (k.to_string(), json!(n))).collect())
+    let mut roles: serde_json::Map<String, Value> = roles.iter().filter(|(_, n)| has(*n)).map(|(k, n)| (k.to_string(), json!(n))).collect();
+    // The unit mode's row, where the module has one (else always pps).
+    if let Some(n) = profile.features.unit_mode {
+        roles.insert("unit_mode".to_string(), json!(n));
+    }
+    Value::Object(roles)
 }
 
 fn parameter(p: &Parameter, bank: Option<u8>) -> Value {
@@ -280,7 +285,7 @@ mod tests {
         let gone = [2, 3, 4, 5, 130, 135, 138, 149, 153, 154].map(|n| format!("[axis_parameter]]\nnumber = {n}\n"));
         sections.retain(|s| !gone.iter().any(|g| s.starts_with(g.as_str())));
         let mut text = sections.join("\n[").lines().filter(|l| !l.starts_with("quantity =")).collect::<Vec<_>>().join("\n");
-        text = text.replace("[features]\n", "[features]\nmotion_controller = \"sixpoint\"\nmotion_units = \"sixpoint\"\n");
+        text = text.replace("[features]\n", "[features]\nmotion_controller = \"sixpoint\"\nmotion_units = \"sixpoint\"\nunit_mode = 255\n");
         let rows: [(u8, &str, i64, &str); 17] = [
             (2, "Target velocity", 8_388_096, "pps"),
             (3, "Actual velocity", 8_388_096, "pps"),

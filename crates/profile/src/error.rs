@@ -229,7 +229,7 @@ impl fmt::Display for FeatureProblem {
             FeatureProblem::Units { controller, units } => write!(
                 f,
                 "features.motion_units = \"{}\" does not go with features.motion_controller = \"{}\": \
-                 the sixpoint controller takes motion_units = \"sixpoint\", and only it does",
+                 the sixpoint and eightpoint controllers take motion_units = \"sixpoint\", and only they do",
                 units.name(),
                 controller.name()
             ),

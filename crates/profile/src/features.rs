@@ -91,8 +91,9 @@ pub enum MotionUnits {
     Tmc429,
     /// Microsteps per second and per second², as written: no divisors.
     Pps,
-    /// The sixPoint modules' (TMC5130/TMC5160): AP 255 (unit mode) 1
-    /// selects pps and pps² as written, 0 the chip's internal units
+    /// The sixPoint and eight-point modules' (TMC5130/TMC5160/TMC5240):
+    /// pps and pps² turned into the chip's register values, or with the
+    /// unit mode (`unit_mode`'s row) at 0 the registers themselves
     /// (`v·f_CLK/2^24` µsteps/s, `a·f_CLK²/2^41` µsteps/s², with
     /// `motion_clock_hz`; docs/behaviour.md rule 104).
     Sixpoint,
@@ -115,6 +116,7 @@ impl MotionController {
         match self {
             MotionController::Tmc429 => "tmc429",
             MotionController::Sixpoint => "sixpoint",
+            MotionController::Eightpoint => "eightpoint",
         }
     }
 }
@@ -144,6 +146,10 @@ pub enum MotionController {
     /// The TMC5130/TMC5160 sixPoint ramp: VSTART, A1 to V1, AMAX to VMAX,
     /// DMAX to V1, D1 to VSTOP (AP 15…21), docs/behaviour.md rules 104–110.
     Sixpoint,
+    /// The TMC5240 eight-point ramp: the sixPoint ramp with a second knee
+    /// V2 (AP 35) and its A2 (AP 34) and D2 (AP 36), docs/behaviour.md
+    /// rule 113.
+    Eightpoint,
 }
 
 /// The global parameters (bank 0) holding a module's own CAN identifiers.
@@ -268,6 +274,11 @@ pub struct Features {
     /// The motion controller part. Absent: the TMC429.
     #[serde(default)]
     pub motion_controller: MotionController,
+    /// The axis parameter of the unit mode (AP 255: 1 pps, 0 the chip's
+    /// registers) on a module with `motion_units = "sixpoint"`. `None`:
+    /// always pps.
+    #[serde(default)]
+    pub unit_mode: Option<u8>,
     /// What AP 12 and 13 say of the stop switches. Absent: they disable.
     #[serde(default)]
     pub limit_switch_rows: LimitSwitchRows,
@@ -368,10 +379,14 @@ impl Features {
                 match self.motion_units {
                     MotionUnits::Tmc429 => "TMC429 internal units (pulse and ramp divisors, AP 154/153)",
                     MotionUnits::Pps => "pps and pps² (microsteps per second, per second²)",
-                    MotionUnits::Sixpoint => "pps and pps² with AP 255 = 1, the chip's internal units with AP 255 = 0",
+                    MotionUnits::Sixpoint => match self.unit_mode {
+                        Some(_) => "pps and pps² with the unit mode 1, the chip's internal units with 0",
+                        None => "pps and pps², as the chip's registers hold them",
+                    },
                 }
                 .to_string(),
             ),
+            ("unit_mode", self.unit_mode.map_or("none (pps)".to_string(), |n| format!("AP {n}"))),
             (
                 "limit_switch_rows",
                 match self.limit_switch_rows {
@@ -385,6 +400,7 @@ impl Features {
                 match self.motion_controller {
                     MotionController::Tmc429 => "TMC429 (trapezoid, AP 4/5/130, modes by AP 138)",
                     MotionController::Sixpoint => "sixPoint (TMC5130/TMC5160: VSTART, A1, V1, AMAX, VMAX, DMAX, D1, VSTOP)",
+                    MotionController::Eightpoint => "eight-point (TMC5240: VSTART, A1, V1, A2, V2, AMAX, VMAX, DMAX, D2, D1, VSTOP)",
                 }
                 .to_string(),
             ),

@@ -780,9 +780,14 @@ fn check_features(profile: &Profile) -> Result<(), FeatureProblem> {
     {
         return Err(FeatureProblem::QuantityInPps { number: p.number, name: p.name.clone() });
     }
-    let sixpoint = f.motion_controller == MotionController::Sixpoint;
-    if (f.motion_units == MotionUnits::Sixpoint) != sixpoint {
+    let points = matches!(f.motion_controller, MotionController::Sixpoint | MotionController::Eightpoint);
+    if (f.motion_units == MotionUnits::Sixpoint) != points {
         return Err(FeatureProblem::Units { controller: f.motion_controller, units: f.motion_units });
+    }
+    if let Some(n) = f.unit_mode
+        && (f.motion_units != MotionUnits::Sixpoint || profile.axis_parameter(n).is_none())
+    {
+        return Err(FeatureProblem::MissingAxisParameter { key: "unit_mode", number: n });
     }
     if let Some(text) = &profile.module.version_text
         && (text.len() != 8 || !text.is_ascii())
@@ -1107,8 +1112,8 @@ mod feature_tests {
             // as written (or the chip's units, by AP 255).
             let tmc429 = p.features.motion_units == MotionUnits::Tmc429;
             assert_eq!(p.axis_parameter(4).unwrap().quantity.is_some(), tmc429, "{name}");
-            let sixpoint = p.features.motion_controller == MotionController::Sixpoint;
-            assert_eq!(p.features.motion_units == MotionUnits::Sixpoint, sixpoint, "{name}");
+            let points = matches!(p.features.motion_controller, MotionController::Sixpoint | MotionController::Eightpoint);
+            assert_eq!(p.features.motion_units == MotionUnits::Sixpoint, points, "{name}");
         }
         // An encoder scale names rows the profile has, on an abn encoder.
         let e = Profile::from_toml(&replacing("tmcm-6214", "resolution = 210", "resolution = 250")).unwrap_err().to_string();
@@ -1244,7 +1249,7 @@ mod feature_tests {
         let readme = include_str!("../../../profiles/README.md");
         let p = Profile::built_in("tmcm-351").unwrap();
         let list = p.features.list();
-        assert_eq!(list.len(), 21);
+        assert_eq!(list.len(), 22);
         for (key, value) in &list {
             let row = if matches!(*key, "can" | "ethercat" | "error_flags" | "encoder_scale") {
                 format!("| `[features.{key}]` |")

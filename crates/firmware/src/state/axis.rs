@@ -6,6 +6,7 @@ use crate::motion::{self, Motion, Ramp, RampMode, SixPoint, Units};
 use crate::parameter_numbers::{ap, sp};
 use crate::reference_search::ReferenceSearch;
 use std::cell::Cell;
+use tmclsim_profile::MotionController;
 use tmclsim_protocol::Status;
 
 /// One motor axis.
@@ -137,7 +138,7 @@ impl Axis {
     /// their values read in `units`: the target speed is
     /// `torque_velocity` in torque mode (in `units`), the reference
     /// search's while one runs.
-    pub(crate) fn work_out_ramp(&self, units: Units, torque_velocity: Option<f64>) -> Ramp {
+    pub(crate) fn work_out_ramp(&self, units: Units, controller: MotionController, torque_velocity: Option<f64>) -> Ramp {
         let p = &self.params;
         let max = units.max_value();
         let value = |n: u8| f64::from(p[n as usize].clamp(0, max));
@@ -157,8 +158,10 @@ impl Axis {
                 None => vmax = slow.max(1.0),
             }
         }
-        let six = match units {
-            Units::Sixpoint { fclk, .. } => Some(self.six_point(units, f64::from(fclk))),
+        let six = match (controller, units) {
+            (MotionController::Sixpoint | MotionController::Eightpoint, Units::Sixpoint { fclk, .. }) => {
+                Some(self.six_point(units, f64::from(fclk), controller == MotionController::Eightpoint))
+            }
             _ => None,
         };
         Ramp {
@@ -171,10 +174,11 @@ impl Axis {
         }
     }
 
-    /// The sixPoint ramp's values (AP 15…21) in µsteps and seconds; an
+    /// The sixPoint ramp's values (AP 15…21; with `eight`, the
+    /// eight-point ramp's A2, V2, D2, AP 34…36) in µsteps and seconds; an
     /// acceleration of 0 acts as the smallest one, so that every ramp
-    /// ends (docs/behaviour.md rule 105).
-    fn six_point(&self, units: Units, fclk: f64) -> SixPoint {
+    /// ends (docs/behaviour.md rules 105, 113).
+    fn six_point(&self, units: Units, fclk: f64, eight: bool) -> SixPoint {
         let p = &self.params;
         let value = |n: u8| f64::from(p[n as usize].max(0));
         let accel = |n: u8| units.accel_pps2(value(n).max(1.0));
@@ -184,6 +188,9 @@ impl Axis {
             v1: units.velocity_pps(value(sp::V1)),
             dmax: accel(sp::DMAX),
             d1: accel(sp::D1),
+            a2: if eight { accel(sp::A2) } else { 0.0 },
+            v2: if eight { units.velocity_pps(value(sp::V2)) } else { 0.0 },
+            d2: if eight { accel(sp::D2) } else { 0.0 },
             vstop: units.velocity_pps(value(sp::VSTOP)),
             zero_wait: value(sp::RAMP_WAIT) * 512.0 / fclk,
         }
@@ -199,10 +206,11 @@ impl Axis {
 }
 
 /// The axis parameters a plain ramp comes from (AP 4, 2, 130, 5, 154,
-/// 153; the sixPoint's 15…21 and its unit mode 255), as their words: the
+/// 153; the sixPoint's 15…21, the eight-point's 34…36 and the unit mode
+/// 255), as their words: the
 /// ramp worked out for them stays valid while they are the same.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct RampKey([i32; 14]);
+pub(crate) struct RampKey([i32; 17]);
 
 impl RampKey {
     fn of(p: &[i32; 256]) -> RampKey {
@@ -221,6 +229,9 @@ impl RampKey {
             p[sp::VSTOP as usize],
             p[sp::RAMP_WAIT as usize],
             p[sp::UNIT_MODE as usize],
+            p[sp::A2 as usize],
+            p[sp::V2 as usize],
+            p[sp::D2 as usize],
         ])
     }
 }

@@ -1,8 +1,9 @@
-//! The sixPoint ramp (docs/behaviour.md rules 104–107) against its
-//! closed form: for each parameter set the
-//! phases of a move from rest are worked out here on their own (the
-//! peak of a short move by bisection), and the motion sampled every
-//! millisecond of stepped time must lie on them.
+//! The sixPoint ramp (docs/behaviour.md rules 104–107) and the
+//! eight-point ramp (rule 113) against their closed form: for each
+//! parameter set the phases of a move from rest are worked out here on
+//! their own (the speeds a phase ends at listed, the peak of a short move
+//! found by bisection), and the motion sampled every millisecond of
+//! stepped time must lie on them.
 use tmclsim_firmware::motion::{Motion, Ramp, RampMode, SixPoint, Step, Stops, Units};
 
 /// Ramp values as a module's axis parameters give them (pps, pps²,
@@ -18,6 +19,10 @@ struct Set {
     d1: f64,
     vstop: f64,
     wait: f64,
+    /// The eight-point ramp's second knee (0: the sixPoint ramp).
+    a2: f64,
+    v2: f64,
+    d2: f64,
 }
 
 const FCLK: f64 = 16_000_000.0;
@@ -33,7 +38,14 @@ const DEMO: Set = Set {
     d1: 5000.0,
     vstop: 5000.0,
     wait: 31_250.0,
+    a2: 0.0,
+    v2: 0.0,
+    d2: 0.0,
 };
+
+/// PyTrinamic's eight-point demo's values (TMCM-1290, TMCM-3216), as its
+/// names mean them: A2 15 000 up to V2 20 000, D2 10 000 down from it.
+const EIGHT: Set = Set { a2: 15_000.0, v2: 20_000.0, d2: 10_000.0, ..DEMO };
 
 fn ramp(s: Set) -> Ramp {
     Ramp {
@@ -48,6 +60,9 @@ fn ramp(s: Set) -> Ramp {
             v1: s.v1,
             dmax: s.dmax,
             d1: s.d1,
+            a2: s.a2,
+            v2: s.v2,
+            d2: s.d2,
             vstop: s.vstop,
             zero_wait: s.wait * 512.0 / FCLK,
         }),
@@ -57,19 +72,60 @@ fn ramp(s: Set) -> Ramp {
 /// The phases of a move of `d` from rest as (acceleration, duration,
 /// speed at its start), worked out from the definitions alone.
 fn closed_form(s: Set, d: f64) -> Vec<(f64, f64, f64)> {
-    let up = |w: f64| if s.v1 > 0.0 && w < s.v1 { s.a1 } else { s.amax };
-    let down = |w: f64| if s.v1 > 0.0 && w <= s.v1 { s.d1 } else { s.dmax };
+    // The knees, ascending: A1/D1 below V1, A2/D2 from V1 to V2, AMAX/DMAX
+    // above; a knee of 0 (or V2 not above V1) has no band.
+    let mut knees = Vec::new();
+    if s.v1 > 0.0 {
+        knees.push(s.v1);
+    }
+    if s.v2 > s.v1.max(0.0) {
+        knees.push(s.v2);
+    }
+    let band = |w: f64, rising: bool| {
+        // Rising through w: the band w lies in (w < knee); falling: the
+        // band below w (w <= knee).
+        let below = |k: f64| if rising { w < k } else { w <= k };
+        if s.v1 > 0.0 && below(s.v1) {
+            (s.a1, s.d1)
+        } else if s.v2 > s.v1.max(0.0) && below(s.v2) {
+            (s.a2, s.d2)
+        } else {
+            (s.amax, s.dmax)
+        }
+    };
+    let up = |w: f64| band(w, true).0;
+    let down = |w: f64| band(w, false).1;
+    // The speeds a phase ends at between `from` and `to`.
+    let edges = |from: f64, to: f64| {
+        let (lo, hi) = if from < to { (from, to) } else { (to, from) };
+        let mut e: Vec<f64> = knees.iter().copied().filter(|&k| k > lo && k < hi).collect();
+        e.push(to);
+        if from > to {
+            e.sort_by(|a, b| b.total_cmp(a));
+        }
+        e
+    };
     // Distance to speed up from VSTART to w, and to slow from w to VSTOP.
     let rise = |w: f64| {
-        let knee = if s.v1 > 0.0 { s.v1.clamp(s.vstart, w.max(s.vstart)) } else { s.vstart };
-        (knee * knee - s.vstart * s.vstart) / (2.0 * up(s.vstart)) + (w * w - knee * knee).max(0.0) / (2.0 * up(w.max(knee)))
+        let mut v = s.vstart;
+        let mut x = 0.0;
+        for e in edges(s.vstart, w.max(s.vstart)) {
+            x += (e * e - v * v) / (2.0 * up(v));
+            v = e;
+        }
+        x
     };
     let fall = |w: f64| {
         if w <= s.vstop {
             return 0.0;
         }
-        let knee = if s.v1 > 0.0 { s.v1.clamp(s.vstop, w) } else { s.vstop };
-        (w * w - knee * knee) / (2.0 * down(w)) + (knee * knee - s.vstop * s.vstop) / (2.0 * down(knee))
+        let mut v = w;
+        let mut x = 0.0;
+        for e in edges(w, s.vstop) {
+            x += (v * v - e * e) / (2.0 * down(v));
+            v = e;
+        }
+        x
     };
     let mut peak = s.vmax;
     if rise(s.vmax) + fall(s.vmax) > d {
@@ -82,20 +138,20 @@ fn closed_form(s: Set, d: f64) -> Vec<(f64, f64, f64)> {
     }
     let mut phases = Vec::new();
     let mut w = s.vstart;
-    for edge in [s.v1, peak] {
-        if edge > w && edge <= peak {
-            phases.push((up(w), (edge - w) / up(w), w));
-            w = edge;
+    if peak > w {
+        for e in edges(w, peak) {
+            phases.push((up(w), (e - w) / up(w), w));
+            w = e;
         }
     }
     let cruise = d - rise(peak) - fall(peak);
     if cruise > 1e-9 {
         phases.push((0.0, cruise / peak, peak));
     }
-    for edge in [s.v1, s.vstop] {
-        if edge < w && edge >= s.vstop {
-            phases.push((-down(w), (w - edge) / down(w), w));
-            w = edge;
+    if w > s.vstop {
+        for e in edges(w, s.vstop) {
+            phases.push((-down(w), (w - e) / down(w), w));
+            w = e;
         }
     }
     phases
@@ -173,13 +229,71 @@ fn a_table_of_moves_against_the_closed_form() {
         ("V1 below VSTOP: DMAX down to VSTOP", Set { v1: 2_000.0, ..DEMO }, 100_000.0),
         (
             "slow and long",
-            Set { vmax: 1_000.0, amax: 200.0, a1: 100.0, v1: 500.0, dmax: 300.0, d1: 150.0, vstart: 10.0, vstop: 20.0, wait: 0.0 },
+            Set { vmax: 1_000.0, amax: 200.0, a1: 100.0, v1: 500.0, dmax: 300.0, d1: 150.0, vstart: 10.0, vstop: 20.0, wait: 0.0, ..DEMO },
             1_000_000.0,
         ),
     ];
     for (name, s, d) in table {
         check(name, s, d);
     }
+}
+
+#[test]
+fn the_eight_point_move_has_its_eight_points() {
+    let phases = closed_form(EIGHT, 100_000.0);
+    let shape: Vec<(f64, f64)> = phases.iter().map(|p| (p.0, p.2)).collect();
+    assert_eq!(
+        shape,
+        [
+            (5000.0, 5000.0),
+            (15_000.0, 10_000.0),
+            (30_000.0, 20_000.0),
+            (0.0, 40_000.0),
+            (-20_000.0, 40_000.0),
+            (-10_000.0, 20_000.0),
+            (-5000.0, 10_000.0)
+        ],
+        "A1 from VSTART, A2 from V1, AMAX from V2, cruise, DMAX down to V2, D2 down to V1, D1 down to VSTOP"
+    );
+    let table = [
+        ("the demo's eight points", EIGHT, 100_000.0),
+        ("too short for VMAX (peak above V2)", EIGHT, 30_000.0),
+        ("too short for V2 (peak between V1 and V2)", EIGHT, 9_000.0),
+        ("too short for V1", EIGHT, 5_500.0),
+        ("V1 = 0: A2 from VSTART", Set { v1: 0.0, ..EIGHT }, 100_000.0),
+        ("V2 = 0: the sixPoint ramp", Set { v2: 0.0, ..EIGHT }, 100_000.0),
+        ("V2 not above V1: no A2/D2 band", Set { v2: 8000.0, ..EIGHT }, 100_000.0),
+        ("V2 above VMAX: A2 up to VMAX", Set { v2: 60_000.0, ..EIGHT }, 100_000.0),
+    ];
+    for (name, s, d) in table {
+        check(name, s, d);
+    }
+    // V2 = 0 is exactly the sixPoint ramp.
+    let mut six = Motion { target: 77_777.0, ..Motion::default() };
+    let mut eight = six.clone();
+    for _ in 0..10_000 {
+        step(&mut six, &ramp(DEMO), 0.001);
+        step(&mut eight, &ramp(Set { v2: 0.0, ..EIGHT }), 0.001);
+        assert_eq!((six.x, six.v), (eight.x, eight.v));
+    }
+}
+
+#[test]
+fn the_eight_point_soft_stop_brakes_with_dmax_d2_and_d1() {
+    let mut r = ramp(EIGHT);
+    r.target_velocity = 40_000.0;
+    let mut m = Motion { mode: RampMode::Velocity, ..Motion::default() };
+    let blocked = Stops { block_positive: true, block_negative: false, soft: true };
+    step(&mut m, &r, 2.0);
+    assert_eq!(m.v, 40_000.0);
+    m.advance(1.0, &r, &mut |_| blocked, &[], false);
+    assert!((m.v - 20_000.0).abs() < 1e-6, "DMAX down to V2: {}", m.v);
+    m.advance(0.5, &r, &mut |_| blocked, &[], false);
+    assert!((m.v - 15_000.0).abs() < 1e-6, "then D2: {}", m.v);
+    m.advance(0.5, &r, &mut |_| blocked, &[], false);
+    assert!((m.v - 10_000.0).abs() < 1e-6, "D2 down to V1: {}", m.v);
+    m.advance(1.0, &r, &mut |_| blocked, &[], false);
+    assert!((m.v - 5_000.0).abs() < 1e-6, "D1 down to VSTOP: {}", m.v);
 }
 
 #[test]
@@ -326,8 +440,8 @@ fn soft_stop_at_a_switch_uses_the_deceleration_ramp() {
 
 #[test]
 fn units_are_the_chip_s_registers() {
-    let pps = Units::Sixpoint { fclk: 16_000_000, internal: false };
-    let internal = Units::Sixpoint { fclk: 16_000_000, internal: true };
+    let pps = Units::Sixpoint { fclk: 16_000_000, internal: false, accel_max: 65_535 };
+    let internal = Units::Sixpoint { fclk: 16_000_000, internal: true, accel_max: 65_535 };
     let vu = 16e6 / 16_777_216.0;
     let au = 16e6 * 16e6 / 2_199_023_255_552.0;
     // 40000 pps: register 41943, which reads back as 40000.

@@ -81,10 +81,12 @@ export function learn(reads) {
 }
 
 /** The sixPoint unit mode among the reads: true for the chip's registers
- * (AP 255 = 0), false for pps, null while not read. */
+ * (AP 255 = 0), false for pps (also on a module without a unit mode, such
+ * as the eight-point modules), null while not read. */
 function registers(profile, d) {
   const n = profile?.conversion?.unit_mode;
-  const mode = n == null ? null : d?.[n];
+  if (n == null) return false;
+  const mode = d?.[n];
   return mode == null ? null : mode === 0;
 }
 
