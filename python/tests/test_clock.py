@@ -24,6 +24,7 @@ from fractions import Fraction
 
 import pytest
 
+import tmclsim
 from tmclsim import clock
 
 WALL = time.perf_counter
@@ -317,6 +318,38 @@ def test_bad_speeds_are_refused(bad):
     assert clock.installed_speed() == SPEED
 
 
+@pytest.mark.parametrize("outside", [1e9, 1e-4, 1e300, 100_000.5, 0.000999])
+def test_speeds_outside_the_served_range_are_refused(outside):
+    """The clock takes the speeds a served module takes, 0.001…100000:
+    no host clock can run at a speed no module runs at."""
+    with pytest.raises(ValueError, match="outside 0.001…100000"):
+        clock.install(outside)
+    with pytest.raises(ValueError, match="outside 0.001…100000"):
+        with clock.scaled(outside):
+            pass
+    assert clock.installed_speed() is None and time.sleep is REAL_SLEEP
+    # A served module refuses the same speeds, with the same range.
+    with pytest.raises(ValueError, match="outside 0.001…100000"):
+        tmclsim.serve("tmcm-1141", speed=outside)
+
+
+def test_the_range_s_ends_are_taken():
+    for speed in (clock.MIN_SPEED, clock.MAX_SPEED):
+        with clock.scaled(speed):
+            assert clock.installed_speed() == speed
+    assert clock.installed_speed() is None
+
+
+def test_the_command_refuses_a_speed_outside_the_range(tmp_path):
+    script = tmp_path / "script.py"
+    script.write_text("print('ran')\n")
+    for speed in ("1e9", "1e-4", "1e300"):
+        run = subprocess.run([sys.executable, "-m", "tmclsim.clock", "--speed", speed, str(script)], capture_output=True, text=True, timeout=60)
+        assert run.returncode == 2, run
+        assert f"--speed must be a number from 0.001 to 100000, not '{speed}'" in run.stderr, run.stderr
+        assert "ran" not in run.stdout
+
+
 def test_speeds_of_other_number_types_are_taken():
     clock.install(Fraction(5, 2))
     assert clock.installed_speed() == 2.5
@@ -372,6 +405,7 @@ def run_clock(*args, cwd):
 
 HOST = """\
 import json, sys, time
+import tmclsim
 from tmclsim import clock
 
 wall, virtual = clock.real_monotonic(), time.monotonic()

@@ -298,6 +298,13 @@ def _unpatch() -> None:
             setattr(module, name, patched.__wrapped__)
 
 
+#: The speeds a clock takes: the range `tmclsim serve --speed` and
+#: ``tmclsim.serve(speed=…)`` take, so that a host's clock can match every
+#: served module's and no other.
+MIN_SPEED = 0.001
+MAX_SPEED = 100_000
+
+
 def _check_speed(speed) -> float:
     if isinstance(speed, numbers.Real) and not isinstance(speed, bool):
         try:
@@ -305,6 +312,8 @@ def _check_speed(speed) -> float:
         except OverflowError:
             value = math.inf
         if math.isfinite(value) and value > 0:
+            if not MIN_SPEED <= value <= MAX_SPEED:
+                raise ValueError(f"the clock speed {speed!r} is outside {MIN_SPEED}…{MAX_SPEED} (1 = the wall clock's pace)")
             return value
     raise ValueError(f"the clock speed must be a positive finite number (1 = the wall clock's pace), not {speed!r}")
 
@@ -364,7 +373,7 @@ def install_from_environment(environ: Mapping[str, str] = os.environ) -> Optiona
     try:
         speed = _check_speed(float(text))
     except ValueError:
-        raise ValueError(f"{ENVIRONMENT_VARIABLE}={text!r}: the clock speed must be a positive finite number") from None
+        raise ValueError(f"{ENVIRONMENT_VARIABLE}={text!r}: the clock speed must be a number from {MIN_SPEED} to {MAX_SPEED}") from None
     install(speed)
     return speed
 
@@ -378,7 +387,7 @@ for modules served with `tmclsim serve --speed N`: time.sleep, time.monotonic,
 time.time, the threading, queue, select and asyncio timeouts are scaled;
 pyserial's and sockets' timeouts stay on the wall clock.
 
-  --speed N    virtual seconds per wall-clock second (a positive number)
+  --speed N    virtual seconds per wall-clock second (0.001 to 100000)
   SCRIPT       a Python file, run as `python SCRIPT ARGS` would
   -m MODULE    a module, run as `python -m MODULE ARGS` would
 """
@@ -408,7 +417,7 @@ def _parse(argv: List[str]) -> Tuple[float, Optional[str], List[str]]:
             try:
                 speed = _check_speed(float(text))
             except ValueError:
-                _usage_error(f"--speed must be a positive finite number, not {text!r}")
+                _usage_error(f"--speed must be a number from {MIN_SPEED} to {MAX_SPEED}, not {text!r}")
             continue
         if speed is None:
             _usage_error("--speed N is required, before the program")
