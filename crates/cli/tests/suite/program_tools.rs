@@ -369,3 +369,31 @@ fn a_waiting_wait_is_where_the_debugger_stands_and_console_names_are_taken() {
     assert!(t.contains("AP 1 (Actual position) motor 0 = "), "{t}");
     assert!(t.contains("GP 132 ("), "{t}");
 }
+
+#[test]
+fn run_to_the_end_of_the_clock_s_range_ends() {
+    // A WAIT begun near the end of the 64-bit clock would end past it: it
+    // waits until the end instead of looping (docs/behaviour.md rule 84).
+    let dir = tempfile::tempdir().unwrap();
+    let source = dir.path().join("wait.tmc");
+    std::fs::write(&source, "Loop:\n  WAIT TICKS, 0, 2147483647\n  JA Loop\n").unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tmclsim"))
+        .args(["run", source.to_str().unwrap(), "--for", "18446000000"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if started.elapsed() > std::time::Duration::from_secs(30) {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert!(status.is_some_and(|s| s.success()), "tmclsim run --for 18446000000 did not end within 30 s: {status:?}");
+}

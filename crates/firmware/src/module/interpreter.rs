@@ -64,7 +64,7 @@ impl Module {
         };
         let at = self.program.next_ns.max(self.now_ns);
         self.program.pc = pc.wrapping_add(1);
-        self.program.next_ns = at + self.program.instruction_ns;
+        self.program.next_ns = at.saturating_add(self.program.instruction_ns);
         self.program.executed += 1;
         let failed = match self.program_instruction(ins, at) {
             Ok(()) => None,

@@ -174,7 +174,11 @@ impl Module {
         self.program.single_step = true;
         self.start_program();
         while self.program.executed == before && self.now_ns < limit_ns && self.program.mode == RunMode::Run {
-            let next = if self.program.wait.is_some() { self.now_ns + slice_ns } else { self.program.next_ns.max(self.now_ns + 1) };
+            let next = if self.program.wait.is_some() {
+                self.now_ns.saturating_add(slice_ns)
+            } else {
+                self.program.next_ns.max(self.now_ns.saturating_add(1))
+            };
             self.advance_to(next.min(limit_ns));
         }
         self.program.single_step = false;
@@ -191,7 +195,7 @@ impl Module {
 
     pub(crate) fn heartbeat_deadline(&self) -> Option<u64> {
         let hb = self.globals[0][gp::HEARTBEAT as usize];
-        (hb > 0 && !self.link.heartbeat_tripped).then(|| self.link.last_frame_ns + hb as u64 * 1_000_000)
+        (hb > 0 && !self.link.heartbeat_tripped).then(|| self.link.last_frame_ns.saturating_add(hb as u64 * 1_000_000))
     }
 
     /// The next virtual time at which something happens on its own: a timer
@@ -236,7 +240,7 @@ impl Module {
         let mut next = earliest(self.heartbeat_deadline(), timer);
         let watches = self.driver_watches();
         if watches {
-            next = earliest(next, Some(self.now_ns + DRIVER_SAMPLE_NS));
+            next = earliest(next, Some(self.now_ns.saturating_add(DRIVER_SAMPLE_NS)));
         }
         let armed = self.motion_interrupts_armed();
         let mut quiet = !watches && !armed && !self.profile.features.closed_loop;
@@ -258,7 +262,7 @@ impl Module {
     /// When the motor comes to rest, if it moves and will.
     fn rest_deadline(&self, motor: usize) -> Option<u64> {
         match self.time_to_rest(motor) {
-            Some(s) if s > 0.0 => Some(self.now_ns + (s * 1e9).ceil() as u64),
+            Some(s) if s > 0.0 => Some(self.now_ns.saturating_add((s * 1e9).ceil() as u64)),
             _ => None,
         }
     }
@@ -278,7 +282,7 @@ impl Module {
         let mut probe = view.axis.motion.clone();
         let mut stops = |x: f64| view.stops_at(x);
         let step = probe.advance(EDGE_HORIZON_S, &ramp, &mut stops, &edges[..count], true);
-        step.crossed.map(|_| self.now_ns + (step.elapsed * 1e9).ceil().max(1.0) as u64)
+        step.crossed.map(|_| self.now_ns.saturating_add((step.elapsed * 1e9).ceil().max(1.0) as u64))
     }
 
     /// Timer `t`'s interrupt number and period in ns, while it runs (the
@@ -297,7 +301,7 @@ impl Module {
         let mut next = None;
         for t in 0..3u8 {
             if let Some((_, period)) = self.timer_period(t) {
-                next = earliest(next, Some(self.program.timers[t as usize].unwrap_or(self.now_ns + period)));
+                next = earliest(next, Some(self.program.timers[t as usize].unwrap_or(self.now_ns.saturating_add(period))));
             }
         }
         next
@@ -364,7 +368,7 @@ impl Module {
         if moving {
             axis.standstill_since = None;
         } else if let Some(t) = stopped_at {
-            axis.standstill_since = Some(self.now_ns + (t * 1e9) as u64);
+            axis.standstill_since = Some(self.now_ns.saturating_add((t * 1e9) as u64));
         } else if was_moving || axis.standstill_since.is_none() {
             axis.standstill_since = Some(self.now_ns);
         }
@@ -469,11 +473,11 @@ impl Module {
                 self.program.timers[t as usize] = None;
                 continue;
             };
-            let due = *self.program.timers[t as usize].get_or_insert(self.now_ns + period);
+            let due = *self.program.timers[t as usize].get_or_insert(self.now_ns.saturating_add(period));
             if self.now_ns >= due {
                 self.program.set_pending(n);
                 let behind = (self.now_ns - due) / period + 1;
-                self.program.timers[t as usize] = Some(due + behind * period);
+                self.program.timers[t as usize] = Some(due.saturating_add(behind.saturating_mul(period)));
             }
             let d = self.program.timers[t as usize].expect("set above");
             next = Some(next.map_or(d, |x: u64| x.min(d)));

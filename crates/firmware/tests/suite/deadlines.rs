@@ -111,3 +111,24 @@ fn a_polling_loop_leaves_when_the_move_ends_however_time_is_sliced() {
         assert_eq!(run(&polling, slice), (left_ms, executed, position), "sliced in {slice} ns");
     }
 }
+
+#[test]
+fn a_wait_past_the_end_of_the_clock_s_range_waits_until_the_end() {
+    // `Loop: WAIT TICKS, 0, 2147483647 / JA Loop` near the last nanosecond
+    // the clock holds: each WAIT would end past it; the deadline saturates
+    // (docs/behaviour.md rule 84), so the program waits instead of looping.
+    use tmclsim_firmware::{Bus, Module};
+    use tmclsim_protocol::mnemonic::parse_line;
+    let words: Vec<_> = ["WAIT TICKS, 0, 2147483647", "JA 0"].iter().map(|l| parse_line(l).unwrap()).collect();
+    let mut m = Module::built_in("tmcm-1141").unwrap();
+    m.load_program(&words).unwrap();
+    m.start_program();
+    let mut bus = Bus::single(m);
+    let end = u64::MAX - 1;
+    bus.advance_to(end - 30_000_000_000_000_000);
+    let before = bus.module(0).program().executed;
+    bus.advance_to(end);
+    let after = bus.module(0).program().executed;
+    assert!(after - before <= 4, "{} instructions in the last 3·10^16 ns: the WAIT ended early", after - before);
+    assert_eq!(bus.now_ns(), end);
+}

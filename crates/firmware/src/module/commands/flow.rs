@@ -31,7 +31,9 @@ impl Module {
     /// ticks (or the accumulator's, with -1) have passed.
     pub(crate) fn start_wait(&mut self, condition: WaitCondition, motor: u8, ticks: i32, at: u64) -> Result<(), Status> {
         let ticks = if ticks == -1 { self.registers.accumulator } else { ticks }.max(0) as u64;
-        let until = (ticks > 0 || condition == WaitCondition::Ticks).then_some(at + ticks * TICK_NS);
+        // Deadlines saturate: a WAIT that would end past the clock's range
+        // ends never (docs/behaviour.md rule 84).
+        let until = (ticks > 0 || condition == WaitCondition::Ticks).then_some(at.saturating_add(ticks.saturating_mul(TICK_NS)));
         if condition != WaitCondition::Ticks {
             self.motor(motor)?;
         }
