@@ -24,6 +24,7 @@ mod phase;
 pub use tmclsim_profile as profile;
 pub mod program;
 pub mod reference_search;
+pub mod scurve;
 pub mod sixpoint;
 pub mod snapshot;
 mod state;

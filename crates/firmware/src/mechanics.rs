@@ -6,7 +6,7 @@
 
 use crate::motion::{self, RampMode};
 use crate::motor::{Motor, MotorMut};
-use crate::parameter_numbers::{ap, sp};
+use crate::parameter_numbers::{ap, sp, tmc4361a};
 use crate::reference_search::{SearchAxis, Switch};
 use tmclsim_profile::{LimitSwitchRows, MotionController, MotionUnits};
 
@@ -33,7 +33,30 @@ impl Motor<'_> {
                 // TMC5130/TMC5160's 16.
                 accel_max: if self.at.features().motion_controller == MotionController::Eightpoint { 262_143 } else { 65_535 },
             },
+            MotionUnits::Tmc4361a => {
+                let p = &self.axis.params;
+                motion::Units::Tmc4361a {
+                    fclk: self.at.features().motion_clock_hz,
+                    internal: self.at.features().unit_mode.is_some_and(|n| p[n as usize] == 0),
+                    // The module writes all five accelerations as direct values
+                    // when one of them is too large for the pps registers.
+                    direct: tmc4361a::ACCELERATIONS.iter().any(|&n| f64::from(p[n as usize]) > motion::TMC4361A_MAX_PPS_ACC),
+                }
+            }
         }
+    }
+
+    /// The TMC4361A drives this axis: its rows number the ramp type, the
+    /// bows, the switches' enable and polarity bits, their swap and the
+    /// soft stop (docs/behaviour.md rules 114–118).
+    pub(crate) fn tmc4361a(&self) -> bool {
+        self.at.features().motion_controller == MotionController::Tmc4361a
+    }
+
+    /// The TMC4361A's own ramp values (AP 14–25) in µsteps, seconds; `None`
+    /// on the other motion controllers.
+    pub(crate) fn chip(&self) -> Option<motion::Tmc4361a> {
+        self.tmc4361a().then(|| self.axis.tmc4361a_ramp(self.units()))
     }
 
     /// The sixPoint (or eight-point) motion controller drives this axis:
@@ -46,7 +69,11 @@ impl Motor<'_> {
     /// −1 with the motor's direction reversed (GP 90; AP 251 on a
     /// sixPoint module), else 1.
     pub(crate) fn shaft_sign(&self) -> f64 {
-        if self.six_point() { if self.axis.params[sp::REVERSE_SHAFT as usize] == 1 { -1.0 } else { 1.0 } } else { self.at.shaft_sign() }
+        if self.six_point() || self.tmc4361a() {
+            if self.axis.params[sp::REVERSE_SHAFT as usize] == 1 { -1.0 } else { 1.0 }
+        } else {
+            self.at.shaft_sign()
+        }
     }
 
     /// AP 3: the actual speed in the module's velocity units.
@@ -94,6 +121,14 @@ impl Motor<'_> {
             let right = right ^ (p[sp::RIGHT_SWITCH_POLARITY as usize] == 1);
             return (left, right, home);
         }
+        if self.tmc4361a() {
+            // Bit 1 of AP 13 (left) and AP 12 (right) inverts the switch;
+            // AP 33 swaps the two inputs.
+            let p = &self.axis.params;
+            let (left, right) = if p[tmc4361a::SWAP_SWITCHES as usize] != 0 { (right, left) } else { (left, right) };
+            let inverted = |n: u8| p[n as usize] & tmc4361a::SWITCH_POLARITY != 0;
+            return (left ^ inverted(ap::LEFT_SWITCH_DISABLE), right ^ inverted(ap::RIGHT_SWITCH_DISABLE), home);
+        }
         let invert = self.at.switches_inverted();
         (left ^ invert, right ^ invert, home)
     }
@@ -106,13 +141,23 @@ impl Motor<'_> {
         }
         let (left, right, _) = self.switches_at(x);
         let p = &self.axis.params;
-        // AP 12/13 disable the switches, or on some modules enable them.
-        let enable = self.at.features().limit_switch_rows == LimitSwitchRows::Enable;
-        let stops = |n: u8| (p[n as usize] != 0) == enable;
+        // AP 12/13 disable the switches, or on some modules enable them
+        // (on some with bit 0, bit 1 being the polarity).
+        let rows = self.at.features().limit_switch_rows;
+        let stops = |n: u8| match rows {
+            LimitSwitchRows::Disable => p[n as usize] == 0,
+            LimitSwitchRows::Enable => p[n as usize] != 0,
+            LimitSwitchRows::EnablePolarity => p[n as usize] & tmc4361a::SWITCH_ENABLE != 0,
+        };
+        let soft = if self.tmc4361a() {
+            p[tmc4361a::SOFT_STOP as usize] != 0
+        } else {
+            p[if self.six_point() { sp::SOFT_STOP } else { ap::SOFT_STOP } as usize] == 1
+        };
         motion::Stops {
             block_positive: right && stops(ap::RIGHT_SWITCH_DISABLE),
             block_negative: left && stops(ap::LEFT_SWITCH_DISABLE),
-            soft: p[if self.six_point() { sp::SOFT_STOP } else { ap::SOFT_STOP } as usize] == 1,
+            soft,
         }
     }
 

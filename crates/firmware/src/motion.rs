@@ -13,10 +13,14 @@
 //! and snapped to the exact target on arrival.
 //!
 //! The sixPoint ramp of the TMC5130/TMC5160 modules plans its phases in
-//! [`crate::sixpoint`] on the same machinery.
+//! [`crate::sixpoint`], the TMC4361A's trapezoid and S-shaped ramp in
+//! [`crate::scurve`], on the same machinery (an S-shaped phase has a
+//! constant jerk: the motion then carries its acceleration as state).
 
 pub use crate::phase::Stops;
 use crate::phase::{EPS_LAND, EPS_POS, EPS_VEL, Phase, Sgn, Shape};
+use crate::scurve::State;
+pub use crate::scurve::Tmc4361a;
 use crate::sixpoint::Now;
 pub use crate::sixpoint::SixPoint;
 
@@ -93,6 +97,41 @@ pub enum Units {
         /// TMC5130/TMC5160, 2^18 − 1 on the TMC5240).
         accel_max: u32,
     },
+    /// The TMC4361A modules' (docs/behaviour.md rule 114): velocities in
+    /// pps and accelerations in pps², which the module writes into the
+    /// chip's 24.8 and 22.2 fixed-point registers (× 256, × 4); with
+    /// `internal` (the unit mode 0) the values are the registers. With
+    /// `direct` (one of AMAX, ASTART, DMAX, DFINAL, DSTOP above
+    /// 4 194 303) the module writes every acceleration as the chip's
+    /// direct value, `a·2^37/(16 MHz)²` truncated, which the chip runs as
+    /// `value·f_CLK²/2^37`.
+    Tmc4361a {
+        /// The chip's clock, Hz.
+        fclk: u32,
+        /// The unit mode is 0: the registers.
+        internal: bool,
+        /// The accelerations are the chip's direct values.
+        direct: bool,
+    },
+}
+
+/// The largest velocity a TMC4361A's 24.8 register holds, pps.
+const TMC4361A_VMAX: f64 = 8_388_607.996_093_75;
+/// The largest acceleration the module writes in pps² (22.2 registers);
+/// above, it switches to the chip's direct values.
+pub(crate) const TMC4361A_MAX_PPS_ACC: f64 = 4_194_303.0;
+
+/// The TMC4361A's acceleration register value of `value` (pps², or the
+/// register in unit mode 0) and the acceleration it means, µsteps/s².
+fn tmc4361a_accel(value: f64, fclk: f64, internal: bool, direct: bool) -> f64 {
+    if direct {
+        // The module's conversion: a float's value times 2^37 over
+        // (16 MHz)², truncated; the chip runs it at its own clock.
+        let register = (f64::from(value as f32) * pow2(37) / 2.56e14).trunc().max(1.0);
+        return register * fclk * fclk * pow2(-37);
+    }
+    let register = if internal { value.min(16_777_215.0) } else { (value * 4.0).min(16_777_215.0) };
+    register.max(1.0) * 0.25
 }
 
 /// The largest velocity register value of the TMC5130/TMC5160 (VMAX, 23
@@ -115,7 +154,7 @@ impl Units {
     pub fn max_value(self) -> i32 {
         match self {
             Units::Tmc429 { .. } => 2047,
-            Units::Pps | Units::Sixpoint { .. } => i32::MAX,
+            Units::Pps | Units::Sixpoint { .. } | Units::Tmc4361a { .. } => i32::MAX,
         }
     }
 
@@ -129,6 +168,7 @@ impl Units {
                 let register = if internal { v } else { (v / unit).round() };
                 register.clamp(-SIX_POINT_VMAX, SIX_POINT_VMAX) * unit
             }
+            Units::Tmc4361a { internal, .. } => (if internal { v / 256.0 } else { v }).clamp(-TMC4361A_VMAX, TMC4361A_VMAX),
         }
     }
 
@@ -143,6 +183,11 @@ impl Units {
                 let register = (pps / unit + pps.sgn() * 1e-9).trunc();
                 if internal { register } else { (register * unit).round() }
             }
+            Units::Tmc4361a { internal, .. } => {
+                // VACTUAL holds whole pps (towards zero).
+                let whole = (pps + pps.sgn() * 1e-9).trunc();
+                if internal { whole * 256.0 } else { whole }
+            }
         }
     }
 
@@ -156,6 +201,7 @@ impl Units {
                 let register = if internal { a } else { (a / unit).round().max(if a > 0.0 { 1.0 } else { 0.0 }) };
                 register.min(f64::from(accel_max)) * unit
             }
+            Units::Tmc4361a { fclk, internal, direct } => tmc4361a_accel(a, f64::from(fclk), internal, direct),
         }
     }
 
@@ -168,6 +214,13 @@ impl Units {
                 let value = pps2 / six_point_accel_unit(f64::from(fclk));
                 if internal { value } else { pps2 }
             }
+            Units::Tmc4361a { internal, .. } => {
+                if internal {
+                    pps2 * 4.0
+                } else {
+                    pps2
+                }
+            }
         }
     }
 
@@ -177,7 +230,7 @@ impl Units {
         match self {
             Units::Tmc429 { pulse_div, ramp_div } => accel_pps2(positioning_accel(a, ramp_div, pulse_div), ramp_div, pulse_div),
             Units::Pps => f64::from(a),
-            Units::Sixpoint { .. } => self.accel_pps2(f64::from(a)),
+            Units::Sixpoint { .. } | Units::Tmc4361a { .. } => self.accel_pps2(f64::from(a)),
         }
     }
 }
@@ -196,6 +249,60 @@ fn ceil_i64(x: f64) -> i64 {
     if (t as f64) < x { t.saturating_add(1) } else { t }
 }
 
+/// The first time in `(0, limit]` at which a phase of constant jerk `j`
+/// from velocity `v` and acceleration `a` has moved by `dx`: the velocity's
+/// roots split the phase into stretches where the position is monotonic;
+/// the first stretch that passes `dx` holds it, found by bisection.
+fn jerk_crossing(dx: f64, v: f64, a: f64, j: f64, limit: f64) -> Option<f64> {
+    let moved = |t: f64| v * t + 0.5 * a * t * t + j * t * t * t / 6.0 - dx;
+    let mut ends = [limit; 3];
+    let mut n = 0;
+    // v + a t + j t²/2 = 0.
+    let roots = if j == 0.0 {
+        if a == 0.0 { [f64::NAN; 2] } else { [-v / a, f64::NAN] }
+    } else {
+        let disc = a * a - 2.0 * j * v;
+        if disc < 0.0 {
+            [f64::NAN; 2]
+        } else {
+            let r = disc.sqrt();
+            let (t1, t2) = ((-a - r) / j, (-a + r) / j);
+            if t1 < t2 { [t1, t2] } else { [t2, t1] }
+        }
+    };
+    for r in roots {
+        if r > 0.0 && r < limit {
+            ends[n] = r;
+            n += 1;
+        }
+    }
+    ends[n] = limit;
+    let mut lo = 0.0;
+    for &hi in &ends[..=n] {
+        let (f_lo, f_hi) = (moved(lo), moved(hi));
+        if f_hi == 0.0 {
+            return (hi > 1e-12).then_some(hi);
+        }
+        if f_lo.sgn() * f_hi.sgn() < 0.0 {
+            let (mut a_, mut b_) = (lo, hi);
+            for _ in 0..200 {
+                let mid = 0.5 * (a_ + b_);
+                if mid <= a_ || mid >= b_ {
+                    break;
+                }
+                if moved(mid).sgn() == f_lo.sgn() {
+                    a_ = mid;
+                } else {
+                    b_ = mid;
+                }
+            }
+            return (b_ > 1e-12).then_some(b_);
+        }
+        lo = hi;
+    }
+    None
+}
+
 /// What happened during one `advance`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Step {
@@ -207,6 +314,9 @@ pub struct Step {
     pub crossed: Option<f64>,
     /// Seconds the step covered (less than asked when it ended at a crossing).
     pub elapsed: f64,
+    /// The phases the step walked through (a phase cut by the step's end
+    /// counts).
+    pub phases: usize,
 }
 
 /// AP 138.
@@ -290,7 +400,12 @@ impl Default for Motion {
 impl Motion {
     /// True when the motor does not move and nothing will make it move.
     pub fn is_idle(&self, ramp: &Ramp, stops: &Stops) -> bool {
-        self.v == 0.0 && self.plan(ramp, stops).is_none()
+        self.is_idle_on(ramp, None, stops)
+    }
+
+    /// [`Motion::is_idle`] on a TMC4361A (`chip`: its own ramp values).
+    pub fn is_idle_on(&self, ramp: &Ramp, chip: Option<&Tmc4361a>, stops: &Stops) -> bool {
+        self.v == 0.0 && self.plan(ramp, chip, stops).is_none()
     }
 
     /// Advances by `dt` seconds. `thresholds` are positions (in the space
@@ -299,8 +414,22 @@ impl Motion {
     /// ends at the first threshold reached.
     pub fn advance<F: FnMut(f64) -> Stops + ?Sized>(
         &mut self,
+        dt: f64,
+        ramp: &Ramp,
+        stops: &mut F,
+        thresholds: &[f64],
+        until_crossing: bool,
+    ) -> Step {
+        self.advance_on(dt, ramp, None, stops, thresholds, until_crossing)
+    }
+
+    /// [`Motion::advance`] on a TMC4361A (`chip`: its own ramp values,
+    /// beside VMAX, AMAX and the target speed of `ramp`).
+    pub fn advance_on<F: FnMut(f64) -> Stops + ?Sized>(
+        &mut self,
         mut dt: f64,
         ramp: &Ramp,
+        chip: Option<&Tmc4361a>,
         stops: &mut F,
         thresholds: &[f64],
         until_crossing: bool,
@@ -312,10 +441,11 @@ impl Motion {
                 break;
             }
             let s = stops(self.x);
-            let Some(phase) = self.plan(ramp, &s) else {
+            let Some(phase) = self.plan(ramp, chip, &s) else {
                 self.a = 0.0;
                 break;
             };
+            step.phases += 1;
             let mut t = phase.duration.min(dt);
             let mut crossing = None;
             for &th in thresholds {
@@ -378,11 +508,16 @@ impl Motion {
     /// Seconds until the motor comes to rest (on its target, or stopped
     /// for good), if it will; walks the planned phases without moving.
     pub fn time_to_rest<F: FnMut(f64) -> Stops + ?Sized>(&self, ramp: &Ramp, stops: &mut F) -> Option<f64> {
+        self.time_to_rest_on(ramp, None, stops)
+    }
+
+    /// [`Motion::time_to_rest`] on a TMC4361A (`chip`: its own ramp values).
+    pub fn time_to_rest_on<F: FnMut(f64) -> Stops + ?Sized>(&self, ramp: &Ramp, chip: Option<&Tmc4361a>, stops: &mut F) -> Option<f64> {
         let mut probe = self.clone();
         let mut total = 0.0;
         for _ in 0..MAX_PHASES {
             let s = stops(probe.x);
-            let Some(phase) = probe.plan(ramp, &s) else {
+            let Some(phase) = probe.plan(ramp, chip, &s) else {
                 return Some(total);
             };
             if !phase.duration.is_finite() {
@@ -434,6 +569,11 @@ impl Motion {
                 self.v = k * d * f;
                 self.a = -k * self.v;
             }
+            Shape::Jerk { v, a, j } => {
+                self.x += v * t + 0.5 * a * t * t + j * t * t * t / 6.0;
+                self.v = v + a * t + 0.5 * j * t * t;
+                self.a = a + j * t;
+            }
         }
     }
 
@@ -464,6 +604,7 @@ impl Motion {
                 }
             }
             Shape::Jump(_) | Shape::Wait => return None,
+            Shape::Jerk { v, a, j } => return jerk_crossing(dx, v, a, j, limit),
             Shape::Exponential { k } => {
                 let d0 = self.target - self.x;
                 let d1 = self.target - th;
@@ -478,7 +619,15 @@ impl Motion {
 
     /// The phase the ramp generator is in now; `None` when standing still
     /// with nothing to do.
-    fn plan(&self, ramp: &Ramp, stops: &Stops) -> Option<Phase> {
+    fn plan(&self, ramp: &Ramp, chip: Option<&Tmc4361a>, stops: &Stops) -> Option<Phase> {
+        if let Some(chip) = chip {
+            let now = State { x: self.x, v: self.v, a: self.a, target: self.target, zero_wait: self.zero_wait };
+            return if self.mode == RampMode::Velocity {
+                chip.plan_velocity(&now, ramp.target_velocity, ramp.accel_velocity, stops)
+            } else {
+                chip.plan_position(&now, ramp.vmax, ramp.accel_position, stops)
+            };
+        }
         if let Some(six) = &ramp.six {
             let now = Now { x: self.x, v: self.v, target: self.target, zero_wait: self.zero_wait };
             return if self.mode == RampMode::Velocity {

@@ -159,3 +159,48 @@ pub mod sp {
     /// Unit mode: 0 the chip's internal units, 1 pps.
     pub const UNIT_MODE: u8 = 255;
 }
+
+/// Axis parameter numbers of the TMC4361A modules (TMCM-1316, 1321, 1370,
+/// 1378, 3312, 3351, 1230/1231) that the other families number otherwise
+/// or lack, as ADI's open TMCL-Lite firmware for the TMCM-1316 and
+/// PyTrinamic number them: the TMC4361A's ramp rows (docs/behaviour.md
+/// rules 114–118).
+pub mod tmc4361a {
+    /// Ramp type: 0 trapezoid, 1 S-shaped.
+    pub const RAMP_TYPE: u8 = 14;
+    /// VSTART: the speed a move starts at.
+    pub const VSTART: u8 = 15;
+    /// ASTART: the acceleration below VBREAK (trapezoid), the
+    /// acceleration B1 starts from (S-shaped).
+    pub const ASTART: u8 = 16;
+    /// DMAX: the deceleration above VBREAK, the S-shaped ramp's largest.
+    pub const DMAX: u8 = 17;
+    /// VBREAK: where ASTART gives way to AMAX and DMAX to DFINAL.
+    pub const VBREAK: u8 = 18;
+    /// DFINAL: the deceleration below VBREAK (trapezoid).
+    pub const DFINAL: u8 = 19;
+    /// VSTOP: the speed at which the motor stops.
+    pub const VSTOP: u8 = 20;
+    /// DSTOP: the deceleration of a soft stop at a switch.
+    pub const DSTOP: u8 = 21;
+    /// BOW1: the jerk raising the acceleration (B1).
+    pub const BOW1: u8 = 22;
+    /// BOW2: the jerk bringing the acceleration back to 0 (B2).
+    pub const BOW2: u8 = 23;
+    /// BOW3: the jerk raising the deceleration (B3).
+    pub const BOW3: u8 = 24;
+    /// BOW4: the jerk bringing the deceleration back to 0 (B4).
+    pub const BOW4: u8 = 25;
+    /// Swap the left and right limit switches.
+    pub const SWAP_SWITCHES: u8 = 33;
+    /// Soft stop at a limit switch (1: decelerate with DSTOP).
+    pub const SOFT_STOP: u8 = 34;
+    /// Bit 0 of AP 12 and 13: the switch stops the motor.
+    pub const SWITCH_ENABLE: i32 = 1;
+    /// Bit 1 of AP 12 and 13: the switch's polarity is inverted.
+    pub const SWITCH_POLARITY: i32 = 2;
+    /// The accelerations the module writes together (AMAX, ASTART, DMAX,
+    /// DFINAL, DSTOP): when one of them is above 4 194 303 the module
+    /// switches the chip to its direct acceleration values.
+    pub const ACCELERATIONS: [u8; 5] = [5, 16, 17, 19, 21];
+}

@@ -1,8 +1,8 @@
 //! What the ramp planners share: the phases a motion is planned in, what
 //! the stop switches allow, and the tolerances against float dust. Below
 //! the planners (the TMC429's in [`crate::motion`], the sixPoint's in
-//! [`crate::sixpoint`]) and [`crate::motion::Motion`], which walks their
-//! phases.
+//! [`crate::sixpoint`], the TMC4361A's in [`crate::scurve`]) and
+//! [`crate::motion::Motion`], which walks their phases.
 
 /// Sign of a velocity or distance: −1, 0 or +1 (`f64::signum` gives +1
 /// for 0).
@@ -49,6 +49,11 @@ pub(crate) enum Shape {
     Jump(f64),
     /// Standing still for the ramp wait (sixPoint TZEROWAIT).
     Wait,
+    /// Constant jerk (µsteps/s³) from velocity `v` and acceleration `a`
+    /// (the motion's own, or the values a start jumps to): the TMC4361A's
+    /// S-shaped ramp. The position is a cubic in time, the velocity a
+    /// quadratic, the acceleration linear.
+    Jerk { v: f64, a: f64, j: f64 },
 }
 
 #[derive(Clone, Copy, Debug)]

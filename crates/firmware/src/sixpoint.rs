@@ -99,7 +99,7 @@ impl SixPoint {
 
     /// The acceleration that speeds the motor up from `u` and the speed at
     /// which that acceleration ends (a knee, or VMAX).
-    fn speeding_up(&self, u: f64, amax: f64, vmax: f64) -> (f64, f64) {
+    pub(crate) fn speeding_up(&self, u: f64, amax: f64, vmax: f64) -> (f64, f64) {
         let (bands, n) = self.bands(amax);
         let b = bands[..n].iter().find(|b| u < b.hi - EPS_VEL).unwrap_or(&bands[n - 1]);
         (b.up, b.hi.min(vmax))
@@ -114,7 +114,7 @@ impl SixPoint {
     /// The deceleration that slows the motor down from `u` and the speed at
     /// which it ends (a knee, or `floor`: VSTOP). Knees at or below the
     /// floor have no part.
-    fn slowing_down(&self, u: f64, floor: f64) -> (f64, f64) {
+    pub(crate) fn slowing_down(&self, u: f64, floor: f64) -> (f64, f64) {
         let b = self.band_below(u, 0.0);
         (b.down, b.lo.max(floor))
     }

@@ -20,6 +20,18 @@ const SIXPOINT_VELOCITIES: [u8; 13] = [2, 3, 4, 16, 19, 20, 22, 23, 181, 182, 18
 /// (AP 5), A1 (15), DMAX (17), D1 (18).
 const SIXPOINT_ACCELERATIONS: [u8; 4] = [5, 15, 17, 18];
 
+/// The velocities of a TMC4361A module whose unit AP 255 selects
+/// (docs/behaviour.md rule 114): target and actual speed (AP 2, 3), VMAX
+/// (4), VSTART (15), VBREAK (18), VSTOP (20), the stall and coolStep
+/// threshold speeds (181, 182) and the reference search speeds (194,
+/// 195).
+const TMC4361A_VELOCITIES: [u8; 10] = [2, 3, 4, 15, 18, 20, 181, 182, 194, 195];
+
+/// The accelerations of a TMC4361A module whose unit AP 255 selects:
+/// AMAX (AP 5), ASTART (16), DMAX (17), DFINAL (19), DSTOP (21). The bows
+/// (22–25) are pps³ in either unit mode, no quantity of the conversion.
+const TMC4361A_ACCELERATIONS: [u8; 5] = [5, 16, 17, 19, 21];
+
 /// The name a profile gives a quantity.
 fn quantity_name(q: Quantity) -> &'static str {
     match q {
@@ -45,7 +57,9 @@ fn quantity_by_unit(p: &Parameter) -> Option<&'static str> {
 /// pps² as written; `"sixpoint"`: as AP 255 selects). On a TMC429 module
 /// the profile's `quantity` says it; on a pps module the row's unit (pps,
 /// pps²); on a sixPoint module the rows of the sixPoint roles, and the
-/// other rows in pps by their unit.
+/// other rows in pps by their unit; on a TMC4361A module (`"tmc4361a"`:
+/// as AP 255 selects, 1 pps, 0 the chip's 24.8 and 22.2 registers) the
+/// rows of its roles likewise.
 pub fn quantity(profile: &Profile, p: &Parameter) -> Option<(&'static str, &'static str)> {
     match profile.features.motion_units {
         MotionUnits::Tmc429 => p.quantity.map(|q| (quantity_name(q), "tmc429")),
@@ -55,6 +69,15 @@ pub fn quantity(profile: &Profile, p: &Parameter) -> Option<(&'static str, &'sta
                 Some(("velocity", "sixpoint"))
             } else if SIXPOINT_ACCELERATIONS.contains(&p.number) {
                 Some(("acceleration", "sixpoint"))
+            } else {
+                quantity_by_unit(p).map(|q| (q, "pps"))
+            }
+        }
+        MotionUnits::Tmc4361a => {
+            if TMC4361A_VELOCITIES.contains(&p.number) {
+                Some(("velocity", "tmc4361a"))
+            } else if TMC4361A_ACCELERATIONS.contains(&p.number) {
+                Some(("acceleration", "tmc4361a"))
             } else {
                 quantity_by_unit(p).map(|q| (q, "pps"))
             }
@@ -70,7 +93,7 @@ fn conversion(profile: &Profile) -> Value {
     let roles: &[(&str, u8)] = match profile.features.motion_units {
         MotionUnits::Tmc429 => &[("microsteps", 140), ("ramp_divisor", 153), ("pulse_divisor", 154)],
         MotionUnits::Pps => &[("microsteps", 140)],
-        MotionUnits::Sixpoint => &[("microsteps", 140)],
+        MotionUnits::Sixpoint | MotionUnits::Tmc4361a => &[("microsteps", 140)],
     };
     let has = |n: u8| profile.axis_parameters().any(|p| p.number == n);
     let mut roles: serde_json::Map<String, Value> = roles.iter().filter(|(_, n)| has(*n)).map(|(k, n)| (k.to_string(), json!(n))).collect();
@@ -336,6 +359,66 @@ mod tests {
         got.sort();
         assert_eq!(got, expected);
         assert_eq!((row(&json, 21)["quantity"].clone(), row(&json, 21)["unit"].as_str()), (Value::Null, Some("512 clocks")));
+    }
+
+    /// A TMC4361A module's profile as a test makes it: the TMCM-1141's
+    /// rows with the TMC4361A's ramp rows (TMCL-Lite 1316 numbering).
+    fn tmc4361a_profile() -> Arc<Profile> {
+        let text = include_str!("../../../profiles/tmcm-1141.toml");
+        let mut sections: Vec<String> = text.split("\n[").map(str::to_string).collect();
+        let gone = [2, 3, 4, 5, 12, 13, 130, 135, 138, 149, 153, 154].map(|n| format!("[axis_parameter]]\nnumber = {n}\n"));
+        sections.retain(|s| !gone.iter().any(|g| s.starts_with(g.as_str())));
+        let mut text = sections.join("\n[").lines().filter(|l| !l.starts_with("quantity =")).collect::<Vec<_>>().join("\n");
+        text = text.replace(
+            "[features]\n",
+            "[features]\nmotion_controller = \"tmc4361a\"\nmotion_units = \"tmc4361a\"\nunit_mode = 255\nlimit_switch_rows = \"enable-polarity\"\n",
+        );
+        let rows: [(u8, &str, i64, &str); 15] = [
+            (2, "Target velocity", 8_388_607, "pps"),
+            (3, "Actual velocity", 8_388_607, "pps"),
+            (4, "Maximum positioning velocity", 8_388_607, "pps"),
+            (5, "Maximum acceleration", 16_777_215, "pps²"),
+            (12, "Right limit switch enable/polarity", 3, ""),
+            (13, "Left limit switch enable/polarity", 3, ""),
+            (14, "Ramp type", 1, ""),
+            (15, "Start velocity", 8_388_607, "pps"),
+            (16, "Start acceleration", 16_777_215, "pps²"),
+            (17, "Maximum deceleration", 16_777_215, "pps²"),
+            (18, "Break velocity", 8_388_607, "pps"),
+            (19, "Final deceleration", 16_777_215, "pps²"),
+            (21, "Stop deceleration", 16_777_215, "pps²"),
+            (22, "Bow 1", 16_777_215, "pps³"),
+            (255, "Unit mode", 1, ""),
+        ];
+        for (number, name, max, unit) in rows {
+            let default = if number == 255 { 1 } else { 0 };
+            let min = if number <= 3 { -max } else { 0 };
+            let unit = if unit.is_empty() { String::new() } else { format!("unit = \"{unit}\"\n") };
+            text.push_str(&format!(
+                "\n[[axis_parameter]]\nnumber = {number}\nname = \"{name}\"\naccess = \"RW\"\nmin = {min}\nmax = {max}\ndefault = {default}\n\
+                 default_source = \"assumed\"\n{unit}source = \"a test\"\n"
+            ));
+        }
+        Arc::new(Profile::from_toml(&text).unwrap())
+    }
+
+    /// On a TMC4361A module the ramp's velocities and accelerations follow
+    /// the unit mode (`tmc4361a`: 24.8 and 22.2 registers in unit mode 0);
+    /// a bow is pps³ either way, no quantity.
+    #[test]
+    fn a_tmc4361a_module_says_which_rows_follow_the_unit_mode() {
+        let json = of(&tmc4361a_profile());
+        assert_eq!((json["motion_units"].as_str(), json["motion_controller"].as_str()), (Some("tmc4361a"), Some("tmc4361a")));
+        assert_eq!(json["conversion"], json!({"microsteps": 140, "unit_mode": 255}));
+        let mut got = quantities(&json);
+        got.sort();
+        let velocities = [2, 3, 4, 15, 18, 181, 182, 194, 195].map(|n| (n, "velocity".to_string(), "tmc4361a".to_string()));
+        let accelerations = [5, 16, 17, 19, 21].map(|n| (n, "acceleration".to_string(), "tmc4361a".to_string()));
+        let mut expected: Vec<_> = velocities.into_iter().chain(accelerations).filter(|(n, _, _)| got.iter().any(|g| g.0 == *n)).collect();
+        expected.sort();
+        assert_eq!(got, expected);
+        assert_eq!(row(&json, 22)["quantity"], Value::Null, "a bow");
+        assert!(got.iter().any(|g| g.0 == 194), "the reference search speed follows the unit mode");
     }
 
     /// The conversion the app makes of a sixPoint module's values is the

@@ -146,7 +146,8 @@ pub enum FeatureProblem {
         name: String,
     },
     /// `motion_units` and `motion_controller` do not go together: the
-    /// sixPoint controller has the sixPoint units, and only it.
+    /// sixPoint controllers have the sixPoint units, the TMC4361A its
+    /// own, and only they.
     Units {
         /// The profile's motion controller.
         controller: crate::features::MotionController,
@@ -229,7 +230,8 @@ impl fmt::Display for FeatureProblem {
             FeatureProblem::Units { controller, units } => write!(
                 f,
                 "features.motion_units = \"{}\" does not go with features.motion_controller = \"{}\": \
-                 the sixpoint and eightpoint controllers take motion_units = \"sixpoint\", and only they do",
+                 the sixpoint and eightpoint controllers take motion_units = \"sixpoint\", the tmc4361a controller \
+                 motion_units = \"tmc4361a\", and only they do",
                 units.name(),
                 controller.name()
             ),

@@ -97,6 +97,11 @@ pub enum MotionUnits {
     /// (`v·f_CLK/2^24` µsteps/s, `a·f_CLK²/2^41` µsteps/s², with
     /// `motion_clock_hz`; docs/behaviour.md rule 104).
     Sixpoint,
+    /// The TMC4361A modules': pps, pps² and pps³ as written, the chip's
+    /// registers holding velocities in 24.8 and accelerations in 22.2
+    /// fixed point; with the unit mode (`unit_mode`'s row) at 0 the
+    /// register values themselves (docs/behaviour.md rule 114).
+    Tmc4361a,
 }
 
 impl MotionUnits {
@@ -106,6 +111,7 @@ impl MotionUnits {
             MotionUnits::Tmc429 => "tmc429",
             MotionUnits::Pps => "pps",
             MotionUnits::Sixpoint => "sixpoint",
+            MotionUnits::Tmc4361a => "tmc4361a",
         }
     }
 }
@@ -117,6 +123,7 @@ impl MotionController {
             MotionController::Tmc429 => "tmc429",
             MotionController::Sixpoint => "sixpoint",
             MotionController::Eightpoint => "eightpoint",
+            MotionController::Tmc4361a => "tmc4361a",
         }
     }
 }
@@ -132,6 +139,10 @@ pub enum LimitSwitchRows {
     /// 1 enables the automatic stop at the switch, 0 leaves the switch
     /// without effect on the motor ("automatic right/left stop").
     Enable,
+    /// Bit 0 enables the automatic stop at the switch, bit 1 inverts its
+    /// polarity (the TMC4361A modules' "limit switch enable/polarity").
+    #[serde(rename = "enable-polarity")]
+    EnablePolarity,
 }
 
 /// The motion controller a module's axes run on: the part of the
@@ -150,6 +161,11 @@ pub enum MotionController {
     /// V2 (AP 35) and its A2 (AP 34) and D2 (AP 36), docs/behaviour.md
     /// rule 113.
     Eightpoint,
+    /// The TMC4361A: a trapezoid with the sixPoint's bands (VSTART,
+    /// ASTART to VBREAK, AMAX to VMAX, DMAX to VBREAK, DFINAL to VSTOP)
+    /// or, with AP 14 = 1, an S-shaped ramp whose acceleration changes
+    /// with the bows BOW1…BOW4 (AP 22…25).
+    Tmc4361a,
 }
 
 /// The global parameters (bank 0) holding a module's own CAN identifiers.
@@ -275,8 +291,8 @@ pub struct Features {
     #[serde(default)]
     pub motion_controller: MotionController,
     /// The axis parameter of the unit mode (AP 255: 1 pps, 0 the chip's
-    /// registers) on a module with `motion_units = "sixpoint"`. `None`:
-    /// always pps.
+    /// registers) on a module with `motion_units = "sixpoint"` or
+    /// `"tmc4361a"`. `None`: always pps.
     #[serde(default)]
     pub unit_mode: Option<u8>,
     /// What AP 12 and 13 say of the stop switches. Absent: they disable.
@@ -383,6 +399,10 @@ impl Features {
                         Some(_) => "pps and pps² with the unit mode 1, the chip's internal units with 0",
                         None => "pps and pps², as the chip's registers hold them",
                     },
+                    MotionUnits::Tmc4361a => match self.unit_mode {
+                        Some(_) => "pps, pps², pps³ with the unit mode 1; with 0 the registers (velocities × 256, accelerations × 4)",
+                        None => "pps, pps² and pps³",
+                    },
                 }
                 .to_string(),
             ),
@@ -392,6 +412,9 @@ impl Features {
                 match self.limit_switch_rows {
                     LimitSwitchRows::Disable => "AP 12/13 = 1 disables the right/left stop switch",
                     LimitSwitchRows::Enable => "AP 12/13 = 1 enables the automatic stop at the right/left switch",
+                    LimitSwitchRows::EnablePolarity => {
+                        "AP 12/13 bit 0 enables the automatic stop at the right/left switch, bit 1 inverts its polarity"
+                    }
                 }
                 .to_string(),
             ),
@@ -401,6 +424,7 @@ impl Features {
                     MotionController::Tmc429 => "TMC429 (trapezoid, AP 4/5/130, modes by AP 138)",
                     MotionController::Sixpoint => "sixPoint (TMC5130/TMC5160: VSTART, A1, V1, AMAX, VMAX, DMAX, D1, VSTOP)",
                     MotionController::Eightpoint => "eight-point (TMC5240: VSTART, A1, V1, A2, V2, AMAX, VMAX, DMAX, D2, D1, VSTOP)",
+                    MotionController::Tmc4361a => "TMC4361A (trapezoid with VBREAK, or S-shaped with BOW1…BOW4 by AP 14)",
                 }
                 .to_string(),
             ),

@@ -781,11 +781,12 @@ fn check_features(profile: &Profile) -> Result<(), FeatureProblem> {
         return Err(FeatureProblem::QuantityInPps { number: p.number, name: p.name.clone() });
     }
     let points = matches!(f.motion_controller, MotionController::Sixpoint | MotionController::Eightpoint);
-    if (f.motion_units == MotionUnits::Sixpoint) != points {
+    let tmc4361a = f.motion_controller == MotionController::Tmc4361a;
+    if (f.motion_units == MotionUnits::Sixpoint) != points || (f.motion_units == MotionUnits::Tmc4361a) != tmc4361a {
         return Err(FeatureProblem::Units { controller: f.motion_controller, units: f.motion_units });
     }
     if let Some(n) = f.unit_mode
-        && (f.motion_units != MotionUnits::Sixpoint || profile.axis_parameter(n).is_none())
+        && (!matches!(f.motion_units, MotionUnits::Sixpoint | MotionUnits::Tmc4361a) || profile.axis_parameter(n).is_none())
     {
         return Err(FeatureProblem::MissingAxisParameter { key: "unit_mode", number: n });
     }
@@ -1033,6 +1034,31 @@ mod feature_tests {
         let t = text(name);
         assert_eq!(t.matches(line).count(), 1, "{line}");
         t.replace(line, by)
+    }
+
+    /// The TMC4361A's units go with its controller and only with it; its
+    /// switch rows' bits parse as `enable-polarity`.
+    #[test]
+    fn the_tmc4361a_s_units_go_with_its_controller_only() {
+        let t = text("tmcm-1260");
+        let ok = t
+            .replace(
+                "\nmotion_controller = \"sixpoint\"\n",
+                "\nmotion_controller = \"tmc4361a\"\nlimit_switch_rows = \"enable-polarity\"\n",
+            )
+            .replace("\nmotion_units = \"sixpoint\"\n", "\nmotion_units = \"tmc4361a\"\n");
+        let p = Profile::from_toml(&ok).unwrap();
+        let f = &p.features;
+        assert_eq!(
+            (f.motion_controller, f.motion_units, f.limit_switch_rows, f.unit_mode),
+            (MotionController::Tmc4361a, MotionUnits::Tmc4361a, LimitSwitchRows::EnablePolarity, Some(255))
+        );
+        assert_eq!((f.motion_controller.name(), f.motion_units.name()), ("tmc4361a", "tmc4361a"));
+        assert!(f.list().iter().any(|(k, v)| *k == "limit_switch_rows" && v.contains("bit 1")));
+        let mixed = t.replace("\nmotion_units = \"sixpoint\"\n", "\nmotion_units = \"tmc4361a\"\n");
+        assert!(Profile::from_toml(&mixed).is_err(), "sixPoint controller, TMC4361A units");
+        let mixed = ok.replace("\nmotion_units = \"tmc4361a\"\n", "\nmotion_units = \"sixpoint\"\n");
+        assert!(Profile::from_toml(&mixed).is_err(), "TMC4361A controller, sixPoint units");
     }
 
     #[test]

@@ -325,6 +325,11 @@ impl Module {
                 a.motion.x * sign + a.mech_offset
             });
             let mut axis = Axis::new(params, coordinates, mech, self.now_ns);
+            if profile.features.motion_controller == tmclsim_profile::MotionController::Tmc4361a {
+                // AP 138 is a row of its own there (docs/behaviour.md rule 114).
+                axis.ramp_mode_row = false;
+                axis.motion.mode = crate::motion::RampMode::Position;
+            }
             // ROR and ROL take the speeds AP 2 (target speed) takes.
             if let Some(p) = profile.axis_parameter(crate::parameter_numbers::ap::TARGET_SPEED) {
                 axis.speed_limit = p.max.min(i64::from(i32::MAX)) as i32;

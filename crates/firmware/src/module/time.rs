@@ -278,10 +278,10 @@ impl Module {
         if count == 0 {
             return None;
         }
-        let ramp = view.ramp();
+        let (ramp, chip) = (view.ramp(), view.chip());
         let mut probe = view.axis.motion.clone();
         let mut stops = |x: f64| view.stops_at(x);
-        let step = probe.advance(EDGE_HORIZON_S, &ramp, &mut stops, &edges[..count], true);
+        let step = probe.advance_on(EDGE_HORIZON_S, &ramp, chip.as_ref(), &mut stops, &edges[..count], true);
         step.crossed.map(|_| self.now_ns.saturating_add((step.elapsed * 1e9).ceil().max(1.0) as u64))
     }
 
@@ -309,9 +309,9 @@ impl Module {
 
     fn time_to_rest(&self, motor: usize) -> Option<f64> {
         let view = self.motor_view(motor);
-        let ramp = view.ramp();
+        let (ramp, chip) = (view.ramp(), view.chip());
         let mut stops = |x: f64| view.stops_at(x);
-        view.axis.motion.time_to_rest(&ramp, &mut stops)
+        view.axis.motion.time_to_rest_on(&ramp, chip.as_ref(), &mut stops)
     }
 
     fn advance_axis(&mut self, motor: usize, dt_ns: u64) {
@@ -326,19 +326,19 @@ impl Module {
         // A reference search looks at every switch edge it passes; plain
         // motion goes through the whole step at once.
         for _ in 0..64 {
-            let ramp = self.motor_view(motor).ramp();
+            let (ramp, chip) = (self.motor_view(motor).ramp(), self.motor_view(motor).chip());
             let x_before = self.axes[motor].motion.x;
             let step = if self.world.axes[motor].has_switch_positions() {
                 let mut motion = std::mem::take(&mut self.axes[motor].motion);
                 let view = self.motor_view(motor);
                 let mut stops = |x: f64| view.stops_at(x);
-                let step = motion.advance(left, &ramp, &mut stops, edges, searching);
+                let step = motion.advance_on(left, &ramp, chip.as_ref(), &mut stops, edges, searching);
                 self.axes[motor].motion = motion;
                 step
             } else {
                 // The switches read the same everywhere: so do the stops.
                 let fixed = self.motor_view(motor).stops_at(x_before);
-                self.axes[motor].motion.advance(left, &ramp, &mut |_| fixed, edges, searching)
+                self.axes[motor].motion.advance_on(left, &ramp, chip.as_ref(), &mut |_| fixed, edges, searching)
             };
             let alarms = self.motor_view_mut(motor).drive(x_before, step.elapsed);
             self.sound(motor, alarms);

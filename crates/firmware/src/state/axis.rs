@@ -2,8 +2,8 @@
 //! the per-axis state of the reference search, the driver and the closed
 //! loop.
 
-use crate::motion::{self, Motion, Ramp, RampMode, SixPoint, Units};
-use crate::parameter_numbers::{ap, sp};
+use crate::motion::{self, Motion, Ramp, RampMode, SixPoint, Tmc4361a, Units};
+use crate::parameter_numbers::{ap, sp, tmc4361a};
 use crate::reference_search::ReferenceSearch;
 use std::cell::Cell;
 use tmclsim_profile::MotionController;
@@ -44,6 +44,9 @@ pub struct Axis {
     /// The plain ramp last worked out and the parameter words it came
     /// from (`Module::ramp`).
     pub(crate) ramp_cache: Cell<Option<(RampKey, Ramp)>>,
+    /// AP 138 is the ramp mode (the TMC429 modules'); elsewhere the mode
+    /// is the ramp generator's alone and AP 138 a row of its own.
+    pub ramp_mode_row: bool,
 }
 
 impl Axis {
@@ -67,12 +70,15 @@ impl Axis {
             closed_loop: Default::default(),
             speed_limit: 2047,
             ramp_cache: Cell::new(None),
+            ramp_mode_row: true,
         }
     }
 
     /// Selects a ramp mode: AP 138 and the ramp generator's mode together.
     pub fn set_ramp_mode(&mut self, mode: RampMode) {
-        self.params[ap::RAMP_MODE as usize] = mode as i32;
+        if self.ramp_mode_row {
+            self.params[ap::RAMP_MODE as usize] = mode as i32;
+        }
         self.motion.mode = mode;
     }
 
@@ -193,6 +199,29 @@ impl Axis {
             d2: if eight { accel(sp::D2) } else { 0.0 },
             vstop: units.velocity_pps(value(sp::VSTOP)),
             zero_wait: value(sp::RAMP_WAIT) * 512.0 / fclk,
+        }
+    }
+
+    /// The TMC4361A's ramp values (AP 14–25) in µsteps and seconds, read
+    /// in `units` (bows in pps³ in either unit mode); an acceleration of 0
+    /// acts as the smallest the register holds (docs/behaviour.md rules
+    /// 114–118).
+    pub(crate) fn tmc4361a_ramp(&self, units: Units) -> Tmc4361a {
+        let p = &self.params;
+        let value = |n: u8| f64::from(p[n as usize].max(0));
+        let speed = |n: u8| units.velocity_pps(value(n));
+        let accel = |n: u8| units.accel_pps2(value(n));
+        let bow = |n: u8| value(n).min(16_777_215.0);
+        Tmc4361a {
+            s_shaped: p[tmc4361a::RAMP_TYPE as usize] == 1,
+            vstart: speed(tmc4361a::VSTART),
+            astart: accel(tmc4361a::ASTART),
+            vbreak: speed(tmc4361a::VBREAK),
+            dmax: accel(tmc4361a::DMAX),
+            dfinal: accel(tmc4361a::DFINAL),
+            vstop: speed(tmc4361a::VSTOP),
+            dstop: accel(tmc4361a::DSTOP),
+            bows: [bow(tmc4361a::BOW1), bow(tmc4361a::BOW2), bow(tmc4361a::BOW3), bow(tmc4361a::BOW4)],
         }
     }
 

@@ -25,6 +25,7 @@ mod single_axis_family;
 mod sixpoint;
 mod sixpoint_family;
 mod sixpoint_module;
+mod tmc4361a;
 mod tmcm_1310;
 mod tmcm_351;
 mod world_lines;

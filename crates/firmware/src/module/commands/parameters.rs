@@ -72,11 +72,12 @@ impl Module {
         let closed_loop = self.profile.features.closed_loop;
         let encoder = self.profile.features.encoder != tmclsim_profile::Encoder::None;
         let mut motor = self.motor_view_mut(m);
-        let six_point = motor.view().six_point();
+        // AP 251 reverses the shaft on the sixPoint and TMC4361A modules.
+        let shaft_row = motor.view().six_point() || motor.view().tmc4361a();
         match param {
             // The shaft turns the other way from now on; the carriage stays
             // where it is (docs/behaviour.md rule 108).
-            sp::REVERSE_SHAFT if six_point => {
+            sp::REVERSE_SHAFT if shaft_row => {
                 let mech = motor.view().mechanical_position();
                 motor.axis.params[param as usize] = value;
                 let sign = motor.view().shaft_sign();
@@ -84,7 +85,7 @@ impl Module {
             }
             ap::TARGET_POSITION => motor.set_target(value),
             ap::ACTUAL_POSITION => motor.set_counter(value),
-            ap::RAMP_MODE => {
+            ap::RAMP_MODE if motor.axis.ramp_mode_row => {
                 motor.axis.set_ramp_mode(RampMode::from_code(value));
                 // AP 138 keeps the word as written.
                 motor.axis.params[param as usize] = value;

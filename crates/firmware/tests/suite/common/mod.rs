@@ -100,3 +100,60 @@ pub fn hex(s: &str) -> [u8; 9] {
 pub fn load(m: &mut Module, torque: f64) {
     m.world_mut().axes[0].loads = vec![Load { torque, ..Load::default() }];
 }
+
+/// A TMC4361A module for the tests, made from the TMCM-1260's profile:
+/// its sixPoint rows replaced by the TMC4361A's (the TMCL-Lite 1316
+/// numbering: AP 14 ramp type, 15–25 the ramp and bows, 12/13 enable and
+/// polarity bits, 33 swap, 34 soft stop, 255 unit mode) and its features
+/// saying `motion_controller = "tmc4361a"`.
+pub fn tmc4361a_profile() -> std::sync::Arc<tmclsim_firmware::profile::Profile> {
+    let text = include_str!("../../../../../profiles/tmcm-1260.toml");
+    let rows: [(u8, &str, i64, i64, &str); 21] = [
+        (2, "Target velocity", -8_388_607, 8_388_607, "pps"),
+        (3, "Actual velocity", -8_388_607, 8_388_607, "pps"),
+        (4, "Maximum positioning velocity", 0, 8_388_607, "pps"),
+        (5, "Maximum acceleration", 0, 16_777_215, "pps²"),
+        (12, "Right limit switch enable/polarity", 0, 3, ""),
+        (13, "Left limit switch enable/polarity", 0, 3, ""),
+        (14, "Ramp type", 0, 1, ""),
+        (15, "Start velocity", 0, 8_388_607, "pps"),
+        (16, "Start acceleration", 0, 16_777_215, "pps²"),
+        (17, "Maximum deceleration", 0, 16_777_215, "pps²"),
+        (18, "Break velocity", 0, 8_388_607, "pps"),
+        (19, "Final deceleration", 0, 16_777_215, "pps²"),
+        (20, "Stop velocity", 0, 8_388_607, "pps"),
+        (21, "Stop deceleration", 0, 16_777_215, "pps²"),
+        (22, "Bow 1", 0, 16_777_215, "pps³"),
+        (23, "Bow 2", 0, 16_777_215, "pps³"),
+        (24, "Bow 3", 0, 16_777_215, "pps³"),
+        (25, "Bow 4", 0, 16_777_215, "pps³"),
+        (33, "Swap limit switches", 0, 1, ""),
+        (34, "Soft stop enable", 0, 1, ""),
+        (255, "Unit mode", 0, 1, ""),
+    ];
+    let mut sections: Vec<String> = text.split("\n[").map(str::to_string).collect();
+    sections.retain(|s| !(2..=5).chain(12..=40).chain([255]).any(|n| s.starts_with(&format!("[axis_parameter]]\nnumber = {n}\n"))));
+    let mut text = sections.join("\n[");
+    text = text
+        .replace("\nmotion_controller = \"sixpoint\"\n", "\nmotion_controller = \"tmc4361a\"\nlimit_switch_rows = \"enable-polarity\"\n");
+    text = text.replace("\nmotion_units = \"sixpoint\"\n", "\nmotion_units = \"tmc4361a\"\n");
+    for (number, name, min, max, unit) in rows {
+        let default = match number {
+            255 => 1,
+            12 | 13 => 1,
+            4 | 5 | 17 => 51_200,
+            _ => 0,
+        };
+        let unit = if unit.is_empty() { String::new() } else { format!("unit = \"{unit}\"\n") };
+        text.push_str(&format!(
+            "\n[[axis_parameter]]\nnumber = {number}\nname = \"{name}\"\naccess = \"RW\"\nmin = {min}\nmax = {max}\ndefault = {default}\n\
+             default_source = \"assumed\"\n{unit}source = \"a test\"\n"
+        ));
+    }
+    std::sync::Arc::new(tmclsim_firmware::profile::Profile::from_toml(&text).unwrap())
+}
+
+/// A TMC4361A module (`tmc4361a_profile`) on a bus of its own.
+pub fn tmc4361a_module() -> BusOfOne {
+    BusOfOne::new(Module::new(tmc4361a_profile()))
+}
