@@ -13,6 +13,9 @@
 //   sixpoint  as the motor's unit mode (AP 255) says: 1 pps as written,
 //             0 the TMC5130/TMC5160's registers (v·f_CLK/2^24 pps,
 //             a·f_CLK²/2^41 pps²)
+//   tmc4361a  as the motor's unit mode (AP 255) says: 1 pps as written,
+//             0 the TMC4361A's registers (24.8 and 22.2 fixed point:
+//             v/256 pps, a/4 pps²)
 // rpm needs the microstep resolution (AP 140) besides.
 
 const choice = {
@@ -94,7 +97,7 @@ function registers(profile, d) {
  * controller's units) or "pps"; null while the unit mode is not read. */
 function internalName(units, d) {
   if (units === "pps") return "pps";
-  if (units !== "sixpoint") return "int";
+  if (units !== "sixpoint" && units !== "tmc4361a") return "int";
   const r = registers(shown.profile, d);
   return r == null ? null : r ? "int" : "pps";
 }
@@ -126,6 +129,11 @@ export function factor(quantity, units, profile, d) {
     if (r == null || !clock) return null;
     // v_pps = v · f_CLK / 2^24, a_pps = a · f_CLK² / 2^41 (AP 255 = 0)
     pps = !r ? 1 : quantity === "acceleration" ? (clock * clock) / 2 ** 41 : clock / 2 ** 24;
+  } else if (units === "tmc4361a") {
+    const r = registers(profile, d);
+    if (r == null) return null;
+    // 24.8 and 22.2 fixed point (AP 255 = 0)
+    pps = !r ? 1 : quantity === "acceleration" ? 1 / 4 : 1 / 256;
   } else {
     const [rd, pd] = [read("ramp_divisor"), read("pulse_divisor")];
     if (!clock || pd == null || (quantity === "acceleration" && rd == null)) return null;
