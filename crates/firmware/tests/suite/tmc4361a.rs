@@ -567,3 +567,34 @@ fn the_demo_s_gentle_bows_still_arrive() {
         assert!(top <= 51_200, "no faster than VMAX: {top}");
     }
 }
+
+/// Every built-in TMC4361A module moves on every axis with both ramp
+/// types, to the target microstep, and stops on MST (none yet: vacuous).
+#[test]
+fn every_tmc4361a_module_moves_with_both_ramps() {
+    use tmclsim_firmware::Profile;
+    for name in Profile::names() {
+        let p = Profile::built_in(name).unwrap();
+        if p.features.motion_controller != tmclsim_firmware::profile::MotionController::Tmc4361a {
+            continue;
+        }
+        let mut m = BusOfOne::built_in(name);
+        for motor in 0..p.module.axes {
+            for (n, v) in [(4, 51_200), (5, 51_200), (17, 51_200), (22, 100_000), (23, 100_000), (24, 100_000), (25, 100_000)] {
+                send(&mut m, &format!("SAP {n}, {motor}, {v}"));
+            }
+            for (ramp_type, target) in [(1, 100_000), (0, -20_000)] {
+                send(&mut m, &format!("SAP 14, {motor}, {ramp_type}"));
+                send(&mut m, &format!("MVP ABS, {motor}, {target}"));
+                until(&mut m, 20_000, |m| send(m, &format!("GAP 8, {motor}")) == 1)
+                    .unwrap_or_else(|| panic!("{name} motor {motor}: arrives"));
+                assert_eq!(send(&mut m, &format!("GAP 1, {motor}")), target, "{name} motor {motor}");
+            }
+            send(&mut m, &format!("ROR {motor}, 30000"));
+            m.advance(2_000 * MS);
+            assert_eq!(send(&mut m, &format!("GAP 3, {motor}")), 30_000, "{name} motor {motor}");
+            send(&mut m, &format!("MST {motor}"));
+            until(&mut m, 10_000, |m| send(m, &format!("GAP 3, {motor}")) == 0).unwrap_or_else(|| panic!("{name} motor {motor}: stops"));
+        }
+    }
+}
