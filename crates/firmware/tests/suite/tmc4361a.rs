@@ -598,3 +598,31 @@ fn every_tmc4361a_module_moves_with_both_ramps() {
         }
     }
 }
+
+/// The reference search runs on the S-shaped ramp as on the others: to
+/// the left switch and back to it, the counter 0 there.
+#[test]
+fn a_reference_search_on_the_s_shaped_ramp() {
+    let mut m = module();
+    m.world_mut().axes[0].left_switch = Some(-50_000.0);
+    for (n, v) in [
+        (14, 1),
+        (4, 100_000),
+        (5, 40_000),
+        (17, 50_000),
+        (22, 100_000),
+        (23, 200_000),
+        (24, 125_000),
+        (25, 250_000),
+        (193, 1),
+        (194, 50_000),
+        (195, 5_000),
+    ] {
+        send(&mut m, &format!("SAP {n}, 0, {v}"));
+    }
+    send(&mut m, "RFS START, 0");
+    until(&mut m, 60_000, |m| send(m, "RFS STATUS, 0") == 0).expect("the search ends");
+    assert_eq!(send(&mut m, "GAP 1, 0"), 0);
+    assert_eq!(send(&mut m, "GAP 3, 0"), 0);
+    assert_eq!(send(&mut m, "GAP 11, 0"), 1, "on the left switch");
+}
