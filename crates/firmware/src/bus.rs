@@ -9,12 +9,13 @@
 //! must carry out (EEPROM images to persist, 138 events to send) it takes
 //! with [`Bus::take_effects`]; observers look at [`Bus::snapshot`].
 
-use crate::clock::{Clock, Speed};
+use crate::clock::{Budget, Clock, Speed};
 use crate::module::Module;
 use crate::module::can::CanFrame;
 use crate::snapshot::ModuleSnapshot;
 use crate::world_command::WorldCommand;
 use crate::world_error::WorldError;
+use std::time::Duration;
 use tmclsim_protocol::FRAME_LEN;
 
 /// The replies to one frame and when they may go out.
@@ -60,7 +61,16 @@ pub struct Bus {
     /// Deliver bytes at the modules' baud rate (GP 65), as a real RS485
     /// bus does.
     wire_timing: bool,
+    /// Virtual time fell behind the wall clock's speed: the modules could
+    /// not compute it as fast (docs/behaviour.md rule 119). How often.
+    fell_behind: u64,
 }
+
+/// The most wall-clock time one catch-up to the wall clock's now may take:
+/// a request, the clock task and a stop signal never wait longer for the
+/// modules. What the modules could not compute within it is given up:
+/// virtual time goes on from where they are (docs/behaviour.md rule 119).
+pub const CATCH_UP_BUDGET: Duration = Duration::from_millis(2);
 
 impl Bus {
     /// Modules on one link, brought to one virtual time (the latest of
@@ -71,7 +81,7 @@ impl Bus {
             m.advance_to(now_ns);
         }
         let saved = modules.iter().map(Module::eeprom_generation).collect();
-        Bus { modules, clock: Clock::Stepped, speed: Speed::REAL_TIME, now_ns, saved, wire_timing: false }
+        Bus { modules, clock: Clock::Stepped, speed: Speed::REAL_TIME, now_ns, saved, wire_timing: false, fell_behind: 0 }
     }
 
     /// A bus of one.
@@ -122,10 +132,62 @@ impl Bus {
         self.clock.now_ns(self.now_ns)
     }
 
-    /// Brings every module to the clock's now.
+    /// Brings every module to the clock's now (within
+    /// [`CATCH_UP_BUDGET`] of wall-clock time on a wall clock).
     pub fn catch_up(&mut self) {
-        let now = self.now_ns();
-        self.advance_to(now);
+        self.reach_now(|_| true);
+    }
+
+    /// How often virtual time fell behind the wall clock's speed because
+    /// the modules could not compute it as fast (0: never).
+    pub fn fell_behind(&self) -> u64 {
+        self.fell_behind
+    }
+
+    /// Brings the modules `pick` takes to the clock's now and answers the
+    /// time they reached. On a wall clock it moves in slices sized to take
+    /// about a tenth of the budget's wall-clock time and stops when the
+    /// catch-up has taken [`CATCH_UP_BUDGET`]: the backlog is then given up and the
+    /// clock goes on from where the modules are, so that virtual time runs
+    /// as fast as the modules can compute it (docs/behaviour.md rule 119).
+    fn reach_now(&mut self, pick: impl Fn(&Module) -> bool) -> u64 {
+        let target = self.now_ns();
+        if self.clock.is_stepped() {
+            for m in self.modules.iter_mut().filter(|m| pick(m)) {
+                m.advance_to(target);
+            }
+            self.now_ns = self.now_ns.max(target);
+            return target;
+        }
+        let budget = Budget::new(CATCH_UP_BUDGET);
+        // Slices of virtual time that take about a tenth of a millisecond
+        // of wall-clock time each: a millisecond of virtual time at first,
+        // twice as much after a quick slice, half after a slow one.
+        let mut slice: u64 = 1_000_000;
+        let mut at = self.modules.iter().filter(|m| pick(m)).map(Module::now_ns).min().unwrap_or(target).min(target);
+        loop {
+            let before = budget.elapsed();
+            at = at.saturating_add(slice).min(target);
+            for m in self.modules.iter_mut().filter(|m| pick(m)) {
+                m.advance_to(at);
+            }
+            if at >= target {
+                break;
+            }
+            if budget.spent() {
+                self.clock = Clock::wall_from(at, self.speed);
+                self.fell_behind += 1;
+                break;
+            }
+            let took = budget.elapsed().saturating_sub(before);
+            if took < CATCH_UP_BUDGET / 20 {
+                slice = slice.saturating_mul(2);
+            } else if took > CATCH_UP_BUDGET / 5 {
+                slice = (slice / 2).max(1_000);
+            }
+        }
+        self.now_ns = self.now_ns.max(at);
+        at
     }
 
     /// Moves every module to virtual time `t_ns` (no-op for the past).
@@ -166,11 +228,7 @@ impl Bus {
     /// (the others may lag until they are next looked at): what their
     /// programs do until now is then told apart from what the frame does.
     pub fn catch_up_addressed(&mut self, address: u8) {
-        let now = self.now_ns();
-        for m in self.modules.iter_mut().filter(|m| m.answers_to(address)) {
-            m.advance_to(now);
-        }
-        self.now_ns = now;
+        self.reach_now(|m| m.answers_to(address));
     }
 
     /// The next virtual time at which something happens on its own on any
@@ -189,8 +247,8 @@ impl Bus {
     /// download belongs to the link that started it, docs/behaviour.md
     /// rule 91).
     pub fn handle_frame_from(&mut self, link: crate::link_id::LinkId, frame: &[u8; FRAME_LEN]) -> Answer {
-        let now = self.now_ns();
-        self.now_ns = now;
+        let single = self.modules.len() == 1;
+        let now = self.reach_now(|m| single || m.answers_to(frame[0]));
         let mut answer = Answer::default();
         let wire_timing = self.wire_timing;
         let reply = |answer: &mut Answer, m: &Module, r: [u8; FRAME_LEN]| {
@@ -363,6 +421,39 @@ mod tests {
 
     fn frame(address: u8, op: u8, kind: u8, value: i32) -> [u8; FRAME_LEN] {
         Request::new(address, Instruction::new(op, kind, 0, value)).encode()
+    }
+
+    /// A tight program loop (`CALC ADD, 1 / JA 0`) running on `m`.
+    fn tight_loop(mut m: Module) -> Module {
+        let words = [Instruction::new(19, 0, 0, 1), Instruction::new(22, 0, 0, 0)];
+        m.load_program(&words).unwrap();
+        m.start_program();
+        m
+    }
+
+    #[test]
+    fn a_wall_clock_faster_than_the_modules_falls_behind_instead_of_piling_up() {
+        // docs/behaviour.md rule 119: 100 000 virtual seconds a wall second
+        // of a tight loop cannot be computed; each catch-up gives up after
+        // its budget and the clock goes on from where the modules are.
+        let mut bus = Bus::new(vec![tight_loop(module(1)), tight_loop(module(2))]);
+        bus.set_speed(Speed::new(Speed::MAX).unwrap());
+        bus.set_stepped(false);
+        for _ in 0..3 {
+            std::thread::sleep(Duration::from_millis(30)); // about time: let the wall clock run ahead
+            bus.catch_up();
+        }
+        assert!(bus.fell_behind() >= 1, "never fell behind");
+        // The clock now reads where the modules are, not the backlog.
+        let behind = bus.now_ns();
+        assert!(bus.modules().iter().all(|m| m.now_ns() <= behind));
+        // A request is answered at once by the module it is for.
+        let answer = bus.handle_frame(&frame(2, 6, 1, 0));
+        assert_eq!(Reply::decode(&answer.replies[0]).unwrap().status, Status::Ok.code());
+        // A stepped clock computes all it is told to, and never falls behind.
+        let mut stepped = Bus::new(vec![tight_loop(module(1))]);
+        stepped.advance(1_000_000_000);
+        assert_eq!((stepped.now_ns(), stepped.fell_behind()), (1_000_000_000, 0));
     }
 
     #[test]

@@ -97,6 +97,31 @@ impl std::str::FromStr for Speed {
     }
 }
 
+/// Wall-clock time allowed for work done on the wall clock's behalf (a
+/// bus catching up with it), from when it was made.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Budget {
+    start: Instant,
+    limit: Duration,
+}
+
+impl Budget {
+    /// A budget of `limit` from now.
+    pub(crate) fn new(limit: Duration) -> Budget {
+        Budget { start: Instant::now(), limit }
+    }
+
+    /// The budget is used up.
+    pub(crate) fn spent(&self) -> bool {
+        self.start.elapsed() >= self.limit
+    }
+
+    /// Wall-clock time since the budget was made.
+    pub(crate) fn elapsed(&self) -> Duration {
+        self.start.elapsed()
+    }
+}
+
 impl Clock {
     /// A wall clock that reads `now_ns` at this instant, running `speed`
     /// times as fast as the wall clock.

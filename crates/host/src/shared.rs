@@ -115,6 +115,14 @@ impl SharedBus {
         self.state.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
+    /// How often virtual time fell behind the clock's speed
+    /// ([`Bus::fell_behind`]), and the speed; a look that changes nothing
+    /// and wakes nobody.
+    pub fn fell_behind(&self) -> (u64, f64) {
+        let s = self.lock();
+        (s.bus.fell_behind(), s.bus.speed().factor())
+    }
+
     /// The counters of this bus's clock and frames so far.
     pub fn stats(&self) -> Stats {
         *self.stats.lock().unwrap_or_else(std::sync::PoisonError::into_inner)

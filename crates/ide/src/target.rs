@@ -92,6 +92,12 @@ pub trait Target: Send + Sync + 'static {
     fn speed(&self) -> f64 {
         1.0
     }
+    /// Virtual time has fallen behind the speed at least once: the
+    /// modules could not compute it as fast (docs/behaviour.md rule 119);
+    /// never on a link to real modules.
+    fn fell_behind(&self) -> bool {
+        false
+    }
     /// A typed picture of a virtual module.
     fn snapshot(&self, _id: usize) -> Option<ModuleSnapshot> {
         None

@@ -12,8 +12,25 @@ pub(crate) async fn run(bus: Arc<SharedBus>, mut stop: watch::Receiver<bool>) {
     let changed = Arc::new(Notify::new());
     let notify = changed.clone();
     bus.set_waker(move || notify.notify_one());
+    let mut behind = bus.fell_behind().0;
     loop {
         let due = bus.tick();
+        let (now_behind, speed) = bus.fell_behind();
+        if now_behind > behind {
+            if behind == 0 {
+                eprintln!(
+                    "tmclsim: virtual time falls behind --speed {speed}: the modules cannot compute it as fast; it runs as fast as they can (docs/behaviour.md rule 119)"
+                );
+            }
+            behind = now_behind;
+            // The backlog was given up: requests, the control socket and a
+            // stop signal have their turn before the modules go on.
+            tokio::select! {
+                _ = tokio::time::sleep(std::time::Duration::from_micros(500)) => {}
+                _ = stop.changed() => return,
+            }
+            continue;
+        }
         let at = due.and_then(|ns| bus.instant_of(ns));
         let sleep = async {
             match at {

@@ -41,7 +41,7 @@ pub fn router(app: App) -> Router {
 async fn info(State(app): State<App>) -> Json<Value> {
     Json(json!({
         "target": app.target.kind(), "link": app.target.describe(), "speed": app.target.speed(),
-        "version": env!("CARGO_PKG_VERSION"),
+        "behind": app.target.fell_behind(), "version": env!("CARGO_PKG_VERSION"),
     }))
 }
 

@@ -83,6 +83,10 @@ impl Target for VirtualTarget {
         self.places.first().map_or(1.0, |p| p.bus.with_bus(|b| b.speed().factor()))
     }
 
+    fn fell_behind(&self) -> bool {
+        self.places.iter().any(|p| p.bus.fell_behind().0 > 0)
+    }
+
     fn modules(&self) -> &[ModuleEntry] {
         &self.entries
     }

@@ -91,7 +91,10 @@ async function pick(modules, info, id) {
 async function main() {
   unitControls(document.getElementById("units"), document.getElementById("fullsteps"));
   const info = await get("/api/info");
-  const speed = info.speed && info.speed !== 1 ? ` · time ×${info.speed}` : "";
+  // Virtual time that fell behind its speed runs as fast as the modules
+  // can compute it (docs/behaviour.md rule 119).
+  const behind = info.behind ? " (behind: the modules cannot keep up)" : "";
+  const speed = info.speed && info.speed !== 1 ? ` · time ×${info.speed}${behind}` : "";
   document.getElementById("target").textContent = `${info.target === "virtual" ? "virtual modules" : "TMCL link"} · ${info.link}${speed}`;
   let modules = await get("/api/modules");
   let ctxRef = null;
