@@ -7,7 +7,10 @@ its motor and IO API is driven, over the pty and over TCP.
 What a parameter allows (access, range) is read from `tmclsim profile`,
 the served module's own table; a parameter the class names but the
 profile lacks must be refused with status 3 (wrong type), as the module's
-manual has no such row (docs/modules.md: AP 141 on the TMCM-1141)."""
+manual has no such row (docs/modules.md: AP 141 on the TMCM-1141). A
+class that makes more motor objects than the module has axes (PyTrinamic's
+TMCM3216 makes six for a three-axis module) is driven on the module's axes;
+the others are refused with status 4 (no such motor)."""
 
 import inspect
 import re
@@ -46,6 +49,12 @@ def profile_tables(profile):
         elif current is not None and (m := ROW.match(line)):
             current[int(m.group(1))] = (m.group(2), int(m.group(3)), int(m.group(4)))
     return tables
+
+
+def profile_axes(profile):
+    """The module's number of axes (`tmclsim profile`'s first line)."""
+    text = subprocess.run([tmclsim_binary(), "profile", profile], capture_output=True, text=True, check=True).stdout
+    return int(re.search(r"(\d+) axis", text.splitlines()[0]).group(1))
 
 
 def served_classes():
@@ -102,10 +111,13 @@ def test_every_named_parameter(serve, link, class_name, profile):
     with connect(served, link) as interface:
         module = cls(interface)
         motor_type = type(module.motors[0])
+        axes = min(len(module.motors), profile_axes(profile))
+        for axis in range(axes, len(module.motors)):
+            assert refused(lambda: module.get_axis_parameter(1, axis)) == 4, f"{profile} has no motor {axis}"
         checked = 0
         for name, number in enum(motor_type, "AP").items():
             row = tables["axis"].get(number)
-            for axis in range(len(module.motors)):
+            for axis in range(axes):
                 if row is None:
                     assert refused(lambda: module.get_axis_parameter(number, axis)) == 3, f"{profile} lacks AP {number} ({name})"
                     continue
@@ -142,7 +154,8 @@ def test_motor_api(serve, link, class_name, profile):
     served = serve("--module", profile, "--world", "free")
     with connect(served, link) as interface:
         module = cls(interface)
-        axes = sorted({0, len(module.motors) - 1})
+        count = min(len(module.motors), profile_axes(profile))
+        axes = sorted({0, count - 1})
         for axis in axes:
             motor = module.motors[axis]
             motor.linear_ramp.max_velocity = min(speed, 2047)
@@ -172,7 +185,7 @@ def test_motor_api(serve, link, class_name, profile):
                 settings.microstep_resolution = 6
                 assert settings.microstep_resolution == 6
         # The other axes did not move.
-        for axis in range(1, len(module.motors) - 1):
+        for axis in range(1, count - 1):
             assert module.motors[axis].actual_position == 0
 
 
@@ -198,8 +211,11 @@ def test_io(serve, link, class_name, profile):
                 assert module.get_digital_output(number) == 1, name
                 module.clear_digital_output(number)
                 assert module.get_digital_output(number) == 0, name
-            elif name == "VIN":
+            elif name in ("VIN", "Voltage"):
                 assert module.get_analog_input(number) == 240, "the supply, 24.0 V"
+            elif name == "Temperature":
+                # GIO 9, 1 on the TMCM-1290: the module's temperature in °C.
+                assert -50 <= module.get_analog_input(number) <= 150, name
             elif name.startswith("AIN"):
                 assert 0 <= module.get_analog_input(number) <= 4095, name
             else:

@@ -13,12 +13,15 @@ use tmclsim_profile::{ReferenceSearchFamily, StallDetection};
 /// speed (AP 2, 3), VMAX (4), V1 (16), VSTART (19), VSTOP (20), the
 /// driver's threshold speeds (high speed 22, dcStep 23, stop on stall 181,
 /// coolStep 182, stealthChop 186) and the reference search speeds (194,
-/// 195). AP 29 (measured speed) is pps in either mode.
-const SIXPOINT_VELOCITIES: [u8; 13] = [2, 3, 4, 16, 19, 20, 22, 23, 181, 182, 186, 194, 195];
+/// 195), and an eight-point module's V2 (35, rule 113; the eight-point
+/// modules have no unit mode: pps always). AP 29 (measured speed) is pps
+/// in either mode.
+const SIXPOINT_VELOCITIES: [u8; 14] = [2, 3, 4, 16, 19, 20, 22, 23, 35, 181, 182, 186, 194, 195];
 
 /// The accelerations of a sixPoint module whose unit AP 255 selects: AMAX
-/// (AP 5), A1 (15), DMAX (17), D1 (18).
-const SIXPOINT_ACCELERATIONS: [u8; 4] = [5, 15, 17, 18];
+/// (AP 5), A1 (15), DMAX (17), D1 (18), and an eight-point module's A2
+/// (34) and D2 (36).
+const SIXPOINT_ACCELERATIONS: [u8; 6] = [5, 15, 17, 18, 34, 36];
 
 /// The velocities of a TMC4361A module whose unit AP 255 selects
 /// (docs/behaviour.md rule 114): target and actual speed (AP 2, 3), VMAX

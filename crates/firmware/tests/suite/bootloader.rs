@@ -219,17 +219,25 @@ fn the_firmware_state_is_kept_in_the_eeprom_image() {
 }
 
 #[test]
-fn every_sixpoint_module_updates_through_its_bootloader() {
+fn every_sixpoint_and_eight_point_module_updates_through_its_bootloader() {
+    use tmclsim_profile::MotionController;
     for name in tmclsim_firmware::Profile::names() {
         let profile = tmclsim_firmware::Profile::built_in(name).unwrap();
-        if profile.features.motion_controller != tmclsim_profile::MotionController::Sixpoint {
+        if !matches!(profile.features.motion_controller, MotionController::Sixpoint | MotionController::Eightpoint) {
             continue;
         }
         let digits = profile.module.type_number.to_string();
         let [major, minor] = profile.module.firmware;
+        // What the module stores: A1 with STAP where it has STAP (the
+        // eight-point modules have none), a user variable with STGP.
+        let stap = profile.has_opcode(7);
         let mut m = BusOfOne::built_in(name);
-        send(&mut m, "SAP 15, 0, 4321");
-        send(&mut m, "STAP 15, 0");
+        if stap {
+            send(&mut m, "SAP 15, 0, 4321");
+            send(&mut m, "STAP 15, 0");
+        }
+        send(&mut m, "SGP 3, 2, 1234");
+        send(&mut m, "STGP 3, 2");
         assert_eq!(version_text(&mut m, 1), format!("{digits}V{major}{minor:02}"), "{name}");
         enter(&mut m, 1);
         assert_eq!(version_text(&mut m, 1), format!("{digits}B100"), "{name}: the bootloader's text");
@@ -237,6 +245,9 @@ fn every_sixpoint_module_updates_through_its_bootloader() {
         write_image(&mut m, &image(&f, [major, minor + 1]));
         assert!(ask(&mut m, 1, 205, 0, 0, 0).is_none(), "{name}: BOOT_START_APPL");
         assert_eq!(version_text(&mut m, 1), format!("{digits}V{major}{:02}", minor + 1), "{name}: the new version");
-        assert_eq!(send(&mut m, "GAP 15, 0"), 4321, "{name}: the stored A1 is kept");
+        if stap {
+            assert_eq!(send(&mut m, "GAP 15, 0"), 4321, "{name}: the stored A1 is kept");
+        }
+        assert_eq!(send(&mut m, "GGP 3, 2"), 1234, "{name}: the stored user variable is kept");
     }
 }
