@@ -79,14 +79,18 @@ struct Piece {
 }
 
 impl SixPoint {
-    /// The ramp's bands from standstill up: A1/D1 below V1 (when V1 > 0),
-    /// A2/D2 from V1 to V2 (when V2 is above V1), AMAX/DMAX above. How
+    /// The ramp's bands from standstill up: A1/D1 below V1, A2/D2 from V1
+    /// to V2 (when V2 is above V1), AMAX/DMAX above; with V1 = 0 only
+    /// AMAX/DMAX. How
     /// many there are.
     fn bands(&self, amax: f64) -> ([Band; 3], usize) {
         let mut bands = [Band::default(); 3];
         let mut n = 0;
         let mut lo = 0.0;
-        for (knee, up, down) in [(self.v1, self.a1, self.d1), (self.v2, self.a2, self.d2)] {
+        // V1 = 0 switches the knees off: AMAX and DMAX only (the eight-point
+        // ramp too, the TMCM-1290 manual §7.6; rule 113).
+        let knees = if self.v1 > 0.0 { [(self.v1, self.a1, self.d1), (self.v2, self.a2, self.d2)] } else { [(0.0, 0.0, 0.0); 2] };
+        for (knee, up, down) in knees {
             if knee > lo {
                 bands[n] = Band { lo, hi: knee, up, down };
                 n += 1;

@@ -74,12 +74,13 @@ fn ramp(s: Set) -> Ramp {
 fn closed_form(s: Set, d: f64) -> Vec<(f64, f64, f64)> {
     // The knees, ascending: A1/D1 below V1, A2/D2 from V1 to V2, AMAX/DMAX
     // above; a knee of 0 (or V2 not above V1) has no band.
+    // V1 = 0 switches both knees off (rule 113).
     let mut knees = Vec::new();
     if s.v1 > 0.0 {
         knees.push(s.v1);
-    }
-    if s.v2 > s.v1.max(0.0) {
-        knees.push(s.v2);
+        if s.v2 > s.v1 {
+            knees.push(s.v2);
+        }
     }
     let band = |w: f64, rising: bool| {
         // Rising through w: the band w lies in (w < knee); falling: the
@@ -87,7 +88,7 @@ fn closed_form(s: Set, d: f64) -> Vec<(f64, f64, f64)> {
         let below = |k: f64| if rising { w < k } else { w <= k };
         if s.v1 > 0.0 && below(s.v1) {
             (s.a1, s.d1)
-        } else if s.v2 > s.v1.max(0.0) && below(s.v2) {
+        } else if s.v1 > 0.0 && s.v2 > s.v1 && below(s.v2) {
             (s.a2, s.d2)
         } else {
             (s.amax, s.dmax)
@@ -260,7 +261,7 @@ fn the_eight_point_move_has_its_eight_points() {
         ("too short for VMAX (peak above V2)", EIGHT, 30_000.0),
         ("too short for V2 (peak between V1 and V2)", EIGHT, 9_000.0),
         ("too short for V1", EIGHT, 5_500.0),
-        ("V1 = 0: A2 from VSTART", Set { v1: 0.0, ..EIGHT }, 100_000.0),
+        ("V1 = 0: AMAX and DMAX only", Set { v1: 0.0, ..EIGHT }, 100_000.0),
         ("V2 = 0: the sixPoint ramp", Set { v2: 0.0, ..EIGHT }, 100_000.0),
         ("V2 not above V1: no A2/D2 band", Set { v2: 8000.0, ..EIGHT }, 100_000.0),
         ("V2 above VMAX: A2 up to VMAX", Set { v2: 60_000.0, ..EIGHT }, 100_000.0),
@@ -268,6 +269,9 @@ fn the_eight_point_move_has_its_eight_points() {
     for (name, s, d) in table {
         check(name, s, d);
     }
+    // V1 = 0 is AMAX and DMAX only, whatever V2 says.
+    let only = closed_form(Set { v1: 0.0, ..EIGHT }, 100_000.0);
+    assert!(only.iter().all(|p| p.0 == 0.0 || p.0.abs() == 30_000.0 || p.0.abs() == 20_000.0), "{only:?}");
     // V2 = 0 is exactly the sixPoint ramp.
     let mut six = Motion { target: 77_777.0, ..Motion::default() };
     let mut eight = six.clone();
