@@ -1,12 +1,17 @@
 """Software nobody here wrote, on the sixPoint modules (TMC5130/TMC5160)
-and the eight-point modules (TMC5240): PyTrinamic's own demo scripts for
-the TMCM-1210, 1211, 1240, 1241, 1260, 1270, 1276, 1278, 6212 and 6214 and
-for the TMCM-1290 and 3216, from its source distribution on PyPI
+and the TMC4361A modules and the eight-point modules (TMC5240):
+PyTrinamic's own demo scripts for the TMCM-1210, 1211, 1240, 1241, 1260,
+1270, 1276, 1278, 6212 and 6214, for the TMCM-1316, 1321, 1370, 1378,
+3312, 3351 and the TMCM-123x (TMCM-1230 and 1231 run the demos of
+PyTrinamic's TMCM123x_0_1, the TMCL ones: not those in its CANopen
+folder), and for the TMCM-1290 and 3216, from its source distribution on
+PyPI
 (pytrinamic_examples.sdist_dir), unchanged, against served modules at
 speed 1, as a user runs them against the real ones.
 
-- rotate_demo.py of every module: rotates, stops, doubles the distance,
-  moves back to 0. It ends at 0 on every motor it drives.
+- rotate_demo.py of every module: rotates, stops, (most of them) doubles
+  the distance, moves back to 0. It prints each step it announces and ends
+  at 0 on every motor it drives.
 - six_point_ramp_demo.py (TMCM-1210, 1211, 1276, 1278, 6214): sets the
   sixPoint ramp (VSTART, A1, V1, AMAX, VMAX, DMAX, D1, VSTOP, the ramp
   wait), moves to 100 000 and back to 0 while sampling position and
@@ -23,8 +28,15 @@ speed 1, as a user runs them against the real ones.
 - stop_switch_demo.py (TMCM-1276, 1278, 1290, 3216): rotates until the
   right stop switch stops the motor, then rotates back
   (sixpoint_stop_switch_world.toml).
-- StallGuard2_demo.py (TMCM-1240, 1241, 6214): calibrates stallGuard2, then
-  waits until a load stops the motor (sixpoint_stallguard2_world.toml).
+- StallGuard2_demo.py (TMCM-1240, 1241, 6214, 1230, 1231): calibrates
+  stallGuard2, then waits until a load stops the motor
+  (sixpoint_stallguard2_world.toml).
+- s_shaped_ramp_demo.py (TMCM-1316, 1321, 1370, 1378): sets the TMC4361A's
+  S-shaped ramp (AP 14 = 1; the bows, VSTART, AMAX, DMAX, …), moves to
+  100 000 and straight back to 0 while sampling position and velocity, and
+  plots them. The sampled acceleration has no jump a bow does not explain
+  (`acceleration_jumps`: a trapezoid's corners are jumps), and the motor
+  ends at 0.
 
 A demo that names its own connection (PCAN, a serial port chosen
 interactively) gets the served module's: run_demo.py runs it with every
@@ -48,24 +60,33 @@ from pytrinamic_examples import HERE, DownloadFailed, run_example, sdist_dir
 from pytrinamic_links import connect, connection_arguments, wait_until
 from tmclsim_binary import tmclsim_binary
 
-MODULES = [1210, 1211, 1240, 1241, 1260, 1270, 1276, 1278, 6212, 6214, 1290, 3216]
+SIXPOINT_MODULES = [1210, 1211, 1240, 1241, 1260, 1270, 1276, 1278, 6212, 6214]
+TMC4361A_MODULES = [1316, 1321, 1370, 1378, 3312, 3351, 1230, 1231]
+EIGHTPOINT_MODULES = [1290, 3216]
+MODULES = SIXPOINT_MODULES + TMC4361A_MODULES + EIGHTPOINT_MODULES
 ROTATE = "rotate_demo.py"
 SIX_POINT = "six_point_ramp_demo.py"
 EIGHT_POINT = "eight_point_ramp_demo.py"
 STOP_SWITCH = "stop_switch_demo.py"
 STALLGUARD2 = "StallGuard2_demo.py"
+S_SHAPED = "s_shaped_ramp_demo.py"
 # The modules whose examples have the demo besides rotate_demo.py.
 SIX_POINT_MODULES = [1210, 1211, 1276, 1278, 6214]
 EIGHT_POINT_MODULES = [1290, 3216]
 STOP_SWITCH_MODULES = [1276, 1278, 1290, 3216]
-STALLGUARD2_MODULES = [1240, 1241, 6214]
+STALLGUARD2_MODULES = [1240, 1241, 6214, 1230, 1231]
+S_SHAPED_MODULES = [1316, 1321, 1370, 1378]
 RAMP_DEMOS = [(m, SIX_POINT) for m in SIX_POINT_MODULES] + [(m, EIGHT_POINT) for m in EIGHT_POINT_MODULES]
 DEMOS = (
     [(m, ROTATE) for m in MODULES]
     + RAMP_DEMOS
     + [(m, STOP_SWITCH) for m in STOP_SWITCH_MODULES]
     + [(m, STALLGUARD2) for m in STALLGUARD2_MODULES]
+    + [(m, S_SHAPED) for m in S_SHAPED_MODULES]
 )
+# The examples folder of a module whose demos PyTrinamic files under
+# another name than TMCM<number> (its TMCL demos, not the CANopen ones).
+EXAMPLE_FOLDERS = {1230: "TMCM123x_0_1", 1231: "TMCM123x_0_1"}
 RUNNER = HERE / "run_demo.py"
 STOP_SWITCH_WORLD = HERE / "sixpoint_stop_switch_world.toml"
 STALLGUARD2_WORLD = HERE / "sixpoint_stallguard2_world.toml"
@@ -107,7 +128,7 @@ def sdist():
 
 
 def demo_path(sdist, module, script):
-    return sdist / "examples" / "modules" / f"TMCM{module}" / "TMCL" / script
+    return sdist / "examples" / "modules" / EXAMPLE_FOLDERS.get(module, f"TMCM{module}") / "TMCL" / script
 
 
 def own_connection(text):
@@ -204,12 +225,16 @@ def test_every_demo_is_in_the_source_distribution(sdist):
 @pytest.mark.slow
 @pytest.mark.parametrize("module", MODULES, ids=lambda m: f"TMCM-{m}")
 def test_rotate_demo(module, sdist, serve, tmp_path):
-    """rotate_demo.py rotates, stops, doubles the distance and moves back:
-    it reports each step and every motor it drives ends at position 0."""
+    """rotate_demo.py rotates, stops, (most of them) doubles the distance
+    and moves back: it reports each step it announces (TMCM-1316's does
+    not double the distance) and every motor it drives ends at position
+    0."""
     demo = run_demo(sdist, serve, tmp_path, module, ROTATE)
     out = demo.run.stdout.lower()
+    announced = demo.text.lower()
     for step in ("rotating", "stopping", "doubling moved distance", "furthest point reached", "moving back to 0", "reached position 0"):
-        assert step in out, f"no {step!r} in the output\n{demo.report()}"
+        if step in announced or step in ("rotating", "stopping", "moving back to 0", "reached position 0"):
+            assert step in out, f"no {step!r} in the output\n{demo.report()}"
     axes = sorted({int(n) for n in re.findall(r"module\.motors\[(\d+)\]", demo.text)})
     for axis in axes:
         position, velocity, reached = read_axis(demo.served, demo.link, axis, 1, 3, 8)
@@ -267,10 +292,15 @@ def slope(points):
     return statistics.median((points[i + half][1] - points[i][1]) / (points[i + half][0] - points[i][0]) for i in range(len(points) - half))
 
 
-def moves(t, v):
-    """The runs of moving samples (velocity not 0): [[(t, v)…]…]."""
+def moves(t, v, reversals=False):
+    """The runs of moving samples (velocity not 0): [[(t, v)…]…]. With
+    `reversals` a sample moving the other way than its run starts a new
+    run too (a demo that starts the next move without waiting)."""
     runs, run = [], []
     for ti, vi in zip(t, v):
+        if vi != 0 and reversals and run and (vi > 0) != (run[-1][1] > 0):
+            runs.append(run)
+            run = []
         if vi != 0:
             run.append((ti, vi))
         elif run:
@@ -507,6 +537,169 @@ def test_the_ramp_check_tells_a_wrong_phase_apart():
     assert max(abs(x) for x in v) < served["MaxVelocity"] - 50
     assert ramp_phases(t, v, served, clock, 2) == []
     assert any("top speed" in f for f in ramp_phases(t, v, {**served, "MaxVelocity": 41000}, clock, 2))
+
+
+# ------------------------------------------------------- S-shaped ramp
+
+# The S-shaped ramp's check (`acceleration_jumps`). The sampled velocity is
+# read from a tight loop (three requests a sample, one every millisecond or
+# so, its velocity in whole pps): differentiated sample by sample, it is
+# noise (1 pps over 1 ms is 1000 pps²). The acceleration is sampled per
+# window of ACCELERATION_WINDOW s instead: `slope` of the window's samples
+# (robust against a late sample). Two windows one window apart may differ
+# by what the largest bow explains over the window (bow × window) plus
+# ACCELERATION_TOLERANCE, the sampling's error (measured: the demo's
+# windows, a few hundred samples each, differ by at most 50 pps² more than
+# the bows explain, on a machine busy with builds). A trapezoid's
+# corners jump by whole accelerations (the demo's smallest, DMAX 20 000 to
+# DFINAL 8000, is 12 000 pps²): with the windows ACCELERATION_STRIDE apart a
+# jump lies within a sixteenth of the window from a window's edge, and the
+# two windows on either side differ by nearly all of it.
+ACCELERATION_WINDOW = 0.25
+ACCELERATION_STRIDE = ACCELERATION_WINDOW / 8
+ACCELERATION_TOLERANCE = 1500
+# The fewest samples a window needs (hundreds on an idle machine).
+MIN_WINDOW_SAMPLES = 10
+
+
+def windowed_accelerations(run, window=ACCELERATION_WINDOW, stride=ACCELERATION_STRIDE):
+    """The acceleration of a run of (t, speed) samples sampled per window:
+    {k: (start, slope, samples)} for the windows [start, start + window),
+    start = the run's first sample + k × `stride`, that fit into the run
+    and hold MIN_WINDOW_SAMPLES."""
+    found = {}
+    times = [ti for ti, _ in run]
+    i, k = 0, 0
+    while times[0] + k * stride + window <= times[-1]:
+        start = times[0] + k * stride
+        while times[i] < start:
+            i += 1
+        j = i
+        while j < len(run) and times[j] < start + window:
+            j += 1
+        if j - i >= MIN_WINDOW_SAMPLES:
+            found[k] = (start, slope(run[i:j]), j - i)
+        k += 1
+    return found, k
+
+
+def acceleration_jumps(t, v, bow, n_moves, window=ACCELERATION_WINDOW, tolerance=ACCELERATION_TOLERANCE):
+    """What is wrong with a sampled S-shaped velocity profile of `n_moves`
+    moves (each one way, the next one may follow without a standstill
+    sample): a jump of the windowed acceleration (`windowed_accelerations`)
+    between two windows one window apart beyond `bow` × window +
+    `tolerance` (`bow`: the largest of the ramp's jerks, pps³), windows with
+    too few samples, a move too short to sample. An empty list when the
+    acceleration is continuous."""
+    runs = moves(t, v, reversals=True)
+    if len(runs) != n_moves:
+        return [f"{len(runs)} runs of moving samples, expected {n_moves} moves: " + ", ".join(f"{r[0][0]:.3f}…{r[-1][0]:.3f} s" for r in runs)]
+    stride = window / round(window / ACCELERATION_STRIDE)
+    apart = round(window / stride)
+    limit = bow * window + tolerance
+    found = []
+    for n, run in enumerate(runs):
+        where = f"move {n + 1} ({run[0][0]:.3f}…{run[-1][0]:.3f} s)"
+        windows, fitted = windowed_accelerations([(ti, abs(vi)) for ti, vi in run], window, stride)
+        pairs = [(windows[k], windows[k + apart]) for k in windows if k + apart in windows]
+        if not pairs:
+            found.append(f"{where}: no two windows of {window} s with {MIN_WINDOW_SAMPLES} samples or more one window apart")
+            continue
+        if len(windows) < fitted * 0.9:
+            found.append(f"{where}: {fitted - len(windows)} of {fitted} windows of {window} s with fewer than {MIN_WINDOW_SAMPLES} samples")
+        a, b = max(pairs, key=lambda ab: abs(ab[1][1] - ab[0][1]))
+        jump = b[1] - a[1]
+        if abs(jump) > limit:
+            found.append(f"{where}: the acceleration jumps from {a[1]:.0f} ({a[0]:.3f}…{a[0] + window:.3f} s, {a[2]} samples) to "
+                         f"{b[1]:.0f} pps² ({b[0]:.3f}…{b[0] + window:.3f} s, {b[2]} samples): {jump:+.0f}, a bow of {bow} pps³ "
+                         f"explains {bow * window:.0f} over {window} s (+{tolerance} sampling tolerance)")
+    return found
+
+
+def bows(params):
+    """The demo's bows (AP 22-25 by PyTrinamic's names Bow1…Bow4)."""
+    found = [params[f"Bow{n}"] for n in range(1, 5) if f"Bow{n}" in params]
+    assert len(found) == 4, f"the demo sets the bows {found}, expected four: {params}"
+    return found
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("module", S_SHAPED_MODULES, ids=lambda m: f"TMCM-{m}")
+def test_s_shaped_ramp_demo(module, sdist, serve, tmp_path):
+    """s_shaped_ramp_demo.py's sampled velocity is continuous in its
+    acceleration on both moves (`acceleration_jumps` with the demo's bows),
+    the first move goes up and the second down, and the motor ends at 0."""
+    demo = run_demo(sdist, serve, tmp_path, module, S_SHAPED)
+    assert (demo.figures / "figure-1.png").exists(), demo.report()
+    lines = plotted_lines(demo.figures)
+    t, v = lines["Velocity"]
+    tp, p = lines["Position"]
+    assert tp == t, "the position and the velocity are plotted over different times"
+    params = demo_parameters(demo.text)
+    assert params.get("RampType") == 1, f"the demo does not choose the S-shaped ramp: {params}"
+    targets = [int(x) for x in re.findall(r"motor\.move_to\(\s*(-?\d+)\s*\)", demo.text)]
+    assert targets == [100000, 0], targets
+    found = acceleration_jumps(t, v, max(bows(params)), len(targets))
+    runs = moves(t, v, reversals=True)
+    if len(runs) == 2 and not (runs[0][0][1] > 0 > runs[1][0][1]):
+        found.append(f"the first move starts at {runs[0][0][1]:g} pps, the second at {runs[1][0][1]:g}: expected up, then down")
+    if max(p) > targets[0] or min(p) < targets[1]:
+        found.append(f"the sampled positions reach {min(p):g}…{max(p):g}, beyond the targets {targets}")
+    position, velocity, reached = read_axis(demo.served, demo.link, 0, 1, 3, 8)
+    if (position, velocity, reached) != (targets[-1], 0, 1):
+        found.append(f"after the demo: position {position}, speed {velocity}, reached {reached}; expected {targets[-1]}, 0, 1")
+    summary = f"{len(t)} samples over {t[-1]:.2f} s; the demo's parameters {params}; plot {demo.figures / 'figure-1.png'}"
+    assert not found, "\n".join(found) + f"\n{summary}\n{demo.report()}"
+
+
+def synthetic_s_curve(phases, v0, a0, step=0.001):
+    """A velocity profile of constant-jerk phases [(duration, jerk)] from
+    speed `v0` and acceleration `a0`, sampled every `step` s in whole pps,
+    one move up and the same move down."""
+    t, v = [], []
+    now = 0.0
+    for sign in (1, -1):
+        speed, acc = v0, a0
+        for duration, jerk in phases:
+            end = now + duration
+            while now < end:
+                t.append(now)
+                v.append(sign * round(max(speed, 0.0)))
+                speed += acc * step + jerk * step * step / 2
+                acc += jerk * step
+                now += step
+    return t, v
+
+
+# s_shaped_ramp_demo.py's ramp by PyTrinamic's names, mapped onto the
+# sixPoint names `synthetic_profile` takes for the trapezoid (AP 14 = 0):
+# VSTART, ASTART up to VBREAK, AMAX up to VMAX, DMAX down to VBREAK,
+# DFINAL down to VSTOP (0).
+S_SHAPED_AS_TRAPEZOID = {
+    "MaxVelocity": 51200, "MaxAcceleration": 51200, "A1": 5000, "V1": 7000, "MaxDeceleration": 20000,
+    "D1": 8000, "StartVelocity": 5000, "StopVelocity": 0, "RampWaitTime": 0,
+}
+
+
+def test_the_acceleration_check_tells_a_trapezoid_apart():
+    """`acceleration_jumps` passes an S-curve of the demo's bows (500 pps³)
+    sampled every millisecond, with a late sample; it fails the trapezoid
+    with the demo's accelerations (to 100 000 and back) and an S-curve
+    whose acceleration jumps by half the trapezoid's smallest corner
+    midway."""
+    bow = 500
+    # From VSTART with AMAX cut to what BOW2 brings back to 0, up to the
+    # top speed, then braking with BOW3 and BOW4 to rest (B2, B3, B34, B4).
+    s_curve = [(8, -bow), (6, -bow), (1, 0), (6, bow)]
+    t, v = synthetic_s_curve(s_curve, 5000, 4000)
+    assert acceleration_jumps(t, v, bow, 2) == []
+    late = list(t)
+    late[3000] += 0.03
+    assert acceleration_jumps(late, v, bow, 2) == []
+    trapezoid = acceleration_jumps(*synthetic_profile(S_SHAPED_AS_TRAPEZOID, 16_000_000, step=0.001), bow, 2)
+    assert len(trapezoid) == 2 and all("jumps" in f for f in trapezoid), trapezoid
+    half_corner = acceleration_jumps(*synthetic_s_curve([(8, -bow), (0.001, -6000 / 0.001), (6, -bow), (1, 0), (6, bow)], 5000, 4000), bow, 2)
+    assert half_corner and all("jumps" in f for f in half_corner), half_corner
 
 
 # ------------------------------------------------------------ stop switch
