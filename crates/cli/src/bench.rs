@@ -10,9 +10,31 @@ use tmclsim_firmware::{Bus, Module, Profile};
 use tmclsim_protocol::Request;
 use tmclsim_protocol::mnemonic::parse_line;
 
-/// The modules the in-process and motion rows measure: the TMC429
-/// family's and the sixPoint family's (each row names its module).
-const BENCH_MODULES: [&str; 2] = ["tmcm-1141", "tmcm-1260"];
+/// The modules the in-process and motion rows measure, each with what its
+/// rows add to its name and the commands that set it up first: the TMC429
+/// family's, the sixPoint family's and a TMC4361A module's with its
+/// S-shaped ramp (each row names its module).
+const BENCH_MODULES: [(&str, &str, &[&str]); 3] =
+    [("tmcm-1141", "", &[]), ("tmcm-1260", "", &[]), ("tmcm-1316", ", S-shaped ramp", S_SHAPED)];
+
+/// The TMC4361A's S-shaped ramp (AP 14 = 1) with the four bows at
+/// 51200 pps³: a second from no acceleration to the default AMAX (51200
+/// pps²). With the bows at their default 0 the S-shaped ramp would be the
+/// trapezoid (docs/behaviour.md rule 116).
+const S_SHAPED: &[&str] = &["SAP 14, 0, 1", "SAP 22, 0, 51200", "SAP 23, 0, 51200", "SAP 24, 0, 51200", "SAP 25, 0, 51200"];
+
+/// A module of its own for the rows, set up with the `setup` commands (each
+/// must succeed: status 100).
+fn set_up(profile: &Arc<Profile>, setup: &[&str]) -> Result<Module, String> {
+    let mut m = Module::new(profile.clone());
+    for line in setup {
+        let reply = m.handle_frame(&Request::new(1, parse_line(line).unwrap()).encode());
+        if reply.is_none_or(|r| r[2] != 100) {
+            return Err(format!("{}: `{line}` answered {reply:?}", profile.module.name));
+        }
+    }
+    Ok(m)
+}
 
 /// The command mix every measurement uses.
 const MIX: &[&str] = &["GAP 1, 0", "SAP 4, 0, 1500", "GGP 66, 0", "GIO 0, 0", "MVP ABS, 0, 5000", "GAP 8, 0"];
@@ -58,11 +80,12 @@ pub fn run(args: crate::BenchArgs) -> Result<std::process::ExitCode, String> {
 
 /// Every row of the table, stage by stage.
 fn measure(args: &crate::BenchArgs, frames: &[[u8; 9]]) -> Result<(), String> {
-    // In-process, one core: a TMC429 module and a sixPoint module (the
-    // TMCM-1260's ramp, the same command mix).
+    // In-process, one core: a TMC429 module, a sixPoint module (the
+    // TMCM-1260's ramp) and a TMC4361A module (the TMCM-1316's S-shaped
+    // ramp), the same command mix.
     stage("in-process handle_frame");
-    for module in BENCH_MODULES {
-        let mut m = Module::built_in(module)?;
+    for (module, suffix, setup) in BENCH_MODULES {
+        let mut m = set_up(&Profile::built_in(module)?, setup)?;
         let n = args.in_process;
         let t = Instant::now();
         let mut sink = 0u64;
@@ -74,7 +97,7 @@ fn measure(args: &crate::BenchArgs, frames: &[[u8; 9]]) -> Result<(), String> {
         let dt = t.elapsed();
         std::hint::black_box(sink);
         row!(
-            "| in-process `handle_frame`, {} | {n} | {:.1} M commands/s ({:.1} ns each) |",
+            "| in-process `handle_frame`, {}{suffix} | {n} | {:.1} M commands/s ({:.1} ns each) |",
             m.profile().module.name,
             n as f64 / dt.as_secs_f64() / 1e6,
             dt.as_nanos() as f64 / n as f64
@@ -177,7 +200,7 @@ fn programs() -> Result<(), String> {
         |src: &str| tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d));
     // A compute-only loop: 3 instructions per turn, never ending.
     let compute = asm("Loop:\n  CALC ADD, 1\n  COMP 2000000000\n  JC LT, Loop\n  STOP\n")?;
-    let (n, wall) = run_program(&profile, &compute, 3_600_000_000_000)?;
+    let (n, wall) = run_program(&profile, &[], &compute, 3_600_000_000_000)?;
     row!(
         "| VM, compute-only loop, 1 h of virtual time | {n} | {:.1} M instructions/s, {:.0}× real time |",
         n as f64 / wall / 1e6,
@@ -185,11 +208,11 @@ fn programs() -> Result<(), String> {
     );
     // The manual's 2.4 program (moves and WAIT POS) for an hour.
     let motion = asm(FIRST_STEPS)?;
-    let (n, wall) = run_program(&profile, &motion, 3_600_000_000_000)?;
+    let (n, wall) = run_program(&profile, &[], &motion, 3_600_000_000_000)?;
     row!("| VM, manual 2.4 program (MVP/WAIT POS), 1 h of virtual time | {n} | {:.0}× real time ({:.3} ms) |", 3600.0 / wall, wall * 1e3);
     // A busy motion loop: GAP/COMP/JC polling while the motor moves, on
     // each motion controller.
-    for module in BENCH_MODULES {
+    for (module, suffix, setup) in BENCH_MODULES {
         let profile = tmclsim_firmware::Profile::built_in(module)?;
         let asm = |src: &str| {
             tmclsim_asm::assemble(src, "bench.tmc", &tmclsim_asm::NoIncludes, Some(&profile)).map_err(|d| tmclsim_asm::render(&d))
@@ -197,18 +220,18 @@ fn programs() -> Result<(), String> {
         let polling = asm(
             "Loop:\n  MVP ABS, 0, 512000\nWait1:\n  GAP 8, 0\n  JC ZE, Wait1\n  MVP ABS, 0, 0\nWait2:\n  GAP 8, 0\n  JC ZE, Wait2\n  JA Loop\n",
         )?;
-        let (n, wall) = run_program(&profile, &polling, 600_000_000_000)?;
+        let (n, wall) = run_program(&profile, setup, &polling, 600_000_000_000)?;
         row!(
-            "| VM, polling motion loop (GAP 8/JC), 10 min of virtual time, {} | {n} | {:.1} M instructions/s, {:.0}× real time |",
+            "| VM, polling motion loop (GAP 8/JC), 10 min of virtual time, {}{suffix} | {n} | {:.1} M instructions/s, {:.0}× real time |",
             profile.module.name,
             n as f64 / wall / 1e6,
             600.0 / wall
         );
         // Virtual time alone with a move in progress: a host's GAP now and
         // then, the motor running back and forth.
-        let wall = moving_module(&profile)?;
+        let wall = moving_module(&profile, setup)?;
         row!(
-            "| motion, 1 h of virtual time with moves in progress, {} | 3600 s | {:.0} simulated s per wall s |",
+            "| motion, 1 h of virtual time with moves in progress, {}{suffix} | 3600 s | {:.0} simulated s per wall s |",
             profile.module.name,
             3600.0 / wall
         );
@@ -228,10 +251,10 @@ fn programs() -> Result<(), String> {
 
 /// An hour of virtual time on a module of its own whose motor moves back
 /// and forth all the time (a move of 10 million µsteps each way at the
-/// profile's default ramp, a host's GAP 1 every 10 ms): the wall time in
-/// seconds.
-fn moving_module(profile: &Arc<Profile>) -> Result<f64, String> {
-    let mut bus = Bus::single(Module::new(profile.clone()));
+/// profile's default ramp after the `setup` commands, a host's GAP 1 every
+/// 10 ms): the wall time in seconds.
+fn moving_module(profile: &Arc<Profile>, setup: &[&str]) -> Result<f64, String> {
+    let mut bus = Bus::single(set_up(profile, setup)?);
     let frame = |line: &str| Request::new(1, parse_line(line).unwrap()).encode();
     let (out, back, gap, reached) = (frame("MVP ABS, 0, 10000000"), frame("MVP ABS, 0, 0"), frame("GAP 1, 0"), frame("GAP 8, 0"));
     let t = Instant::now();
@@ -248,10 +271,11 @@ fn moving_module(profile: &Arc<Profile>) -> Result<f64, String> {
     Ok(t.elapsed().as_secs_f64())
 }
 
-/// Runs `program` on a module of its own for `ns` of virtual time: the
-/// instructions it executed and the wall time, in seconds, that took.
-fn run_program(profile: &Arc<Profile>, program: &tmclsim_asm::Program, ns: u64) -> Result<(u64, f64), String> {
-    let mut m = Module::new(profile.clone());
+/// Runs `program` on a module of its own, set up with the `setup`
+/// commands, for `ns` of virtual time: the instructions it executed and the
+/// wall time, in seconds, that took.
+fn run_program(profile: &Arc<Profile>, setup: &[&str], program: &tmclsim_asm::Program, ns: u64) -> Result<(u64, f64), String> {
+    let mut m = set_up(profile, setup)?;
     m.load_program(&program.instructions).map_err(|s| s.to_string())?;
     m.start_program();
     let mut bus = Bus::single(m);

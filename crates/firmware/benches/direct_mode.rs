@@ -54,15 +54,31 @@ fn bench(c: &mut Criterion) {
         g.bench_function(name, |b| b.iter(|| bus.advance(black_box(25_000_000))));
     }
     g.finish();
-    // The TMC429 family's and the sixPoint family's motion controllers.
-    for (module, rotate) in [("tmcm-1141", "ROR 0, 1000"), ("tmcm-1260", "ROR 0, 50000")] {
-        c.bench_function(&format!("advance 1 ms while moving, {module}"), |b| {
+    // The TMC429 family's, the sixPoint family's and the TMC4361A's motion
+    // controllers, the TMC4361A with its S-shaped ramp (AP 14 = 1; the four
+    // bows at 51200 pps³, a second from no acceleration to the default
+    // AMAX: with bows of 0 the S-shaped ramp is the trapezoid).
+    let s_shaped = ["SAP 14, 0, 1", "SAP 22, 0, 51200", "SAP 23, 0, 51200", "SAP 24, 0, 51200", "SAP 25, 0, 51200"];
+    for (module, name, rotate, setup) in [
+        ("tmcm-1141", "tmcm-1141", "ROR 0, 1000", &[][..]),
+        ("tmcm-1260", "tmcm-1260", "ROR 0, 50000", &[][..]),
+        ("tmcm-1316", "tmcm-1316 S-shaped", "ROR 0, 50000", &s_shaped[..]),
+    ] {
+        let set_up = || {
             let mut bus = Bus::single(Module::built_in(module).unwrap());
+            for (line, f) in setup.iter().zip(frames(setup)) {
+                let answer = bus.handle_frame(&f);
+                assert!(answer.replies.first().is_some_and(|r| r[2] == 100), "{module}: `{line}` failed");
+            }
+            bus
+        };
+        c.bench_function(&format!("advance 1 ms while moving, {name}"), |b| {
+            let mut bus = set_up();
             bus.handle_frame(&frames(&[rotate])[0]);
             b.iter(|| bus.advance(black_box(1_000_000)));
         });
-        c.bench_function(&format!("advance 1 ms during a move, {module}"), |b| {
-            let mut bus = Bus::single(Module::built_in(module).unwrap());
+        c.bench_function(&format!("advance 1 ms during a move, {name}"), |b| {
+            let mut bus = set_up();
             let (out, back, reached) = (frames(&["MVP ABS, 0, 1000000"])[0], frames(&["MVP ABS, 0, 0"])[0], frames(&["GAP 8, 0"])[0]);
             bus.handle_frame(&out);
             let mut outward = true;
