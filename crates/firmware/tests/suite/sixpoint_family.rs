@@ -176,8 +176,19 @@ fn bad_values_and_missing_rows_answer_the_module_s_statuses() {
 /// An eight-point ramp's values: VSTART 100, A1 10 000 to V1 5000, A2
 /// 20 000 to V2 15 000, AMAX 40 000 to VMAX 25 000, DMAX 40 000, D2
 /// 20 000, D1 10 000 down to VSTOP 200 (pps, pps²).
-const EIGHT: [(u8, i32); 11] =
-    [(19, 100), (15, 10_000), (16, 5000), (34, 20_000), (35, 15_000), (5, 40_000), (4, 25_000), (17, 40_000), (36, 20_000), (18, 10_000), (20, 200)];
+const EIGHT: [(u8, i32); 11] = [
+    (19, 100),
+    (15, 10_000),
+    (16, 5000),
+    (34, 20_000),
+    (35, 15_000),
+    (5, 40_000),
+    (4, 25_000),
+    (17, 40_000),
+    (36, 20_000),
+    (18, 10_000),
+    (20, 200),
+];
 
 /// An acceleration in pps² as the chip runs it: the nearest register value
 /// at the profile's clock (docs/behaviour.md rule 104).
@@ -264,15 +275,11 @@ fn an_eight_point_module_has_no_stap_its_settings_come_back_from_an_autostart_pr
         assert_eq!(send(&mut again, "GGP 7, 2"), 4711, "{name}: the stored user variable");
         // The module's way to keep them: a program that sets them, started
         // at power-up (GP 77 = 1, stored automatically).
-        let program: Vec<_> = [
-            format!("SAP 34, {last}, 12345"),
-            format!("SAP 35, {last}, 23456"),
-            format!("SAP 36, {last}, 34567"),
-            "STOP".to_string(),
-        ]
-        .iter()
-        .map(|l| parse_line(l).unwrap())
-        .collect();
+        let program: Vec<_> =
+            [format!("SAP 34, {last}, 12345"), format!("SAP 35, {last}, 23456"), format!("SAP 36, {last}, 34567"), "STOP".to_string()]
+                .iter()
+                .map(|l| parse_line(l).unwrap())
+                .collect();
         again.load_program(&program).unwrap_or_else(|s| panic!("{name}: {s:?}"));
         send(&mut again, "SGP 77, 0, 1");
         let mut third = power_cycle(&again);
