@@ -182,19 +182,25 @@ impl SixPoint {
         Phase::accel(-v.sgn() * dec, (w - end) / dec)
     }
 
+    /// A stop switch blocks the way: standing, nothing to do; moving, a hard
+    /// stop at once or, with the soft stop, the braking ramp (rule 108).
+    fn at_a_switch(&self, m: &Now, stops: &Stops) -> Option<Phase> {
+        if m.v == 0.0 {
+            None
+        } else if !stops.soft {
+            Some(Phase::jump(0.0))
+        } else {
+            Some(self.braking(m.v))
+        }
+    }
+
     /// Velocity mode: AMAX towards the target speed, either way; a reversal
     /// passes through standstill and the ramp wait.
     pub(crate) fn plan_velocity(&self, m: &Now, target_velocity: f64, amax: f64, stops: &Stops) -> Option<Phase> {
         let a = amax;
         let mut vt = target_velocity;
         if stops.blocks(vt.sgn()) || stops.blocks(m.v.sgn()) {
-            if m.v == 0.0 {
-                return None;
-            }
-            if !stops.soft {
-                return Some(Phase::jump(0.0));
-            }
-            return Some(self.braking(m.v));
+            return self.at_a_switch(m, stops);
         }
         if m.v == 0.0 {
             if vt == 0.0 {
@@ -231,13 +237,7 @@ impl SixPoint {
         // motor overshoots and comes back.
         let dir = if d < EPS_POS { -m.v.sgn() } else { delta.sgn() };
         if stops.blocks(dir) || stops.blocks(m.v.sgn()) {
-            if m.v == 0.0 {
-                return None;
-            }
-            if !stops.soft {
-                return Some(Phase::jump(0.0));
-            }
-            return Some(self.braking(m.v));
+            return self.at_a_switch(m, stops);
         }
         if m.v == 0.0 {
             if m.zero_wait > 0.0 {

@@ -481,6 +481,7 @@ fn a_sixpoint_session_checks_clean_on_the_module_its_136_names() {
     while host.value("GAP 8, 0") == 0 {
         host.value("GAP 1, 0");
         assert!(start.elapsed() < Duration::from_secs(10), "the motor never arrived");
+        // A poll's interval: the loop ends on arrival or at its deadline.
         std::thread::sleep(Duration::from_millis(20));
     }
     assert_eq!(host.value("GAP 1, 0"), 20_000);

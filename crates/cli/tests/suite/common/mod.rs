@@ -226,14 +226,7 @@ impl Server {
 
     /// Waits up to `limit` for the process to end; its exit code.
     pub fn exit_code_within(&mut self, limit: Duration) -> Option<i32> {
-        let started = Instant::now();
-        while started.elapsed() < limit {
-            if let Some(status) = self.child.try_wait().unwrap() {
-                return status.code();
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        None
+        exit_within(&mut self.child, limit).and_then(|s| s.code())
     }
 
     /// Stops the server as Ctrl-C would (SIGTERM; see [`interrupt`]) and
@@ -260,6 +253,19 @@ impl Drop for Server {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// Waits up to `limit` for `child` to end (polling every 20 ms); its exit
+/// status, or `None` when it still runs.
+pub fn exit_within(child: &mut Child, limit: Duration) -> Option<std::process::ExitStatus> {
+    let started = Instant::now();
+    while started.elapsed() < limit {
+        if let Some(status) = child.try_wait().unwrap() {
+            return Some(status);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    None
 }
 
 /// Asks a child process to stop as Ctrl-C would: SIGTERM. On Windows
